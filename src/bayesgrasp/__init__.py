@@ -1,0 +1,76 @@
+"""bayesgrasp: Bayesian planning of parallel-jaw squeeze plans that orient planar parts.
+
+The data flow is one-directional (design.md): part -> diameter function -> transfer
+functions -> problem -> planners -> report.
+
+Examples
+--------
+>>> import bayesgrasp as bg
+>>> part = bg.Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)], name="rectangle")
+>>> report = bg.plan_exact(bg.Problem.build(part))
+>>> [round(o.expected_cost, 2) for o in report.options]
+[6.3, 6.0]
+"""
+
+from .diameter import DiameterFunction, diameter_function
+from .errors import (
+    BayesGraspError,
+    CostError,
+    MissingExtraError,
+    PartError,
+    PartFileError,
+    PlanningError,
+    PriorError,
+)
+from .geometry import ConvexPolygon, Part
+from .io import read_part, resolve_part
+from .planning import PlanOption, PlanReport, PlanStep, execute_plan, plan_exact
+from .prior import (
+    DensityPrior,
+    HistogramPrior,
+    Prior,
+    SamplePrior,
+    UniformPrior,
+    parse_prior,
+    von_mises,
+)
+from .problem import CostModel, Goal, Problem
+from .tolerance import DEFAULT_TOLERANCE, Tolerance
+from .transfer import TransferFunction, squeeze_function
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "DEFAULT_TOLERANCE",
+    "BayesGraspError",
+    "ConvexPolygon",
+    "CostError",
+    "CostModel",
+    "DensityPrior",
+    "DiameterFunction",
+    "Goal",
+    "HistogramPrior",
+    "MissingExtraError",
+    "Part",
+    "PartError",
+    "PartFileError",
+    "PlanOption",
+    "PlanReport",
+    "PlanStep",
+    "PlanningError",
+    "Prior",
+    "PriorError",
+    "Problem",
+    "SamplePrior",
+    "Tolerance",
+    "TransferFunction",
+    "UniformPrior",
+    "diameter_function",
+    "execute_plan",
+    "parse_prior",
+    "plan_exact",
+    "read_part",
+    "resolve_part",
+    "squeeze_function",
+    "von_mises",
+]

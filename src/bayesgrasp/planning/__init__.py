@@ -1,0 +1,6 @@
+"""Planners: each takes a :class:`~bayesgrasp.problem.Problem` and returns a plan report."""
+
+from .exact import plan_exact
+from .plan import PlanOption, PlanReport, PlanStep, execute_plan
+
+__all__ = ["PlanOption", "PlanReport", "PlanStep", "execute_plan", "plan_exact"]

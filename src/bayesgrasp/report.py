@@ -1,0 +1,151 @@
+"""Reports: plain dictionaries for ``--json`` and text tables for people.
+
+Everything here turns library values into output; nothing is computed that the library does
+not already know. JSON angles are radians (``*_rad``); tables show degrees.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from .geometry import Part
+from .planning.plan import PlanOption, PlanReport
+from .prior import Prior, UniformPrior
+from .problem import Problem
+from .transfer import TransferFunction
+
+__all__ = [
+    "part_json",
+    "plan_json",
+    "plan_table",
+    "squeeze_json",
+    "squeeze_table",
+    "transfer_json",
+]
+
+
+def _f(x: float | None) -> float | None:
+    """A float for JSON (``None`` for missing or non-finite values)."""
+    if x is None or not math.isfinite(x):
+        return None
+    return float(x)
+
+
+def part_json(part: Part) -> dict[str, Any]:
+    """The ``part`` object shared by every schema."""
+    out: dict[str, Any] = {
+        "name": part.name,
+        "vertices": part.hull.vertices.tolist(),
+        "n_sides": part.hull.n_sides,
+        "symmetry_order": part.hull.symmetry_order,
+    }
+    if part.units is not None:
+        out["units"] = part.units
+    return out
+
+
+def transfer_json(f: TransferFunction, prior: Prior) -> dict[str, Any]:
+    """Stable orientations, basins, probabilities (first action at angle 0) and period."""
+    probs = prior.mass(f.basin_lo, f.basin_hi)
+    return {
+        "stable_orientations_rad": f.stable.tolist(),
+        "basins_rad": np.stack([f.basin_lo, f.basin_hi], axis=1).tolist(),
+        "probabilities": np.asarray(probs).tolist(),
+        "period_rad": float(f.period),
+    }
+
+
+def squeeze_json(part: Part, f: TransferFunction, prior: Prior | None = None) -> dict[str, Any]:
+    """The ``bayesgrasp.squeeze/1`` document."""
+    return {
+        "schema": "bayesgrasp.squeeze/1",
+        "part": part_json(part),
+        **transfer_json(f, prior or UniformPrior()),
+    }
+
+
+def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -> str:
+    """A text table of stable orientations (degrees), basins and probabilities."""
+    probs = np.asarray((prior or UniformPrior()).mass(f.basin_lo, f.basin_hi))
+    units = f" ({part.units})" if part.units else ""
+    lines = [
+        f"{part.name}{units}: {part.hull.n_sides} sides, symmetry order "
+        f"{part.hull.symmetry_order}, {f.kind} period {math.degrees(f.period):.4g} deg",
+        f"{'state':>5}  {'stable (deg)':>12}  {'basin (deg)':>23}  {'probability':>11}",
+    ]
+    for i, (s, lo, hi, p) in enumerate(zip(f.stable, f.basin_lo, f.basin_hi, probs, strict=True)):
+        basin = f"({math.degrees(lo):9.3f}, {math.degrees(hi):9.3f})"
+        lines.append(f"{i:>5}  {math.degrees(s):12.3f}  {basin:>23}  {p:11.4f}")
+    return "\n".join(lines)
+
+
+def option_json(o: PlanOption) -> dict[str, Any]:
+    """One plan option (``bayesgrasp.plan/2`` form, which includes the plan/1 fields)."""
+    return {
+        "squeezes": o.n_actions,
+        "actions_rad": list(o.alphas),
+        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in o.steps],
+        "first_squeeze_rad": o.first_angle,
+        "final_orientation_rad": o.final_orientation,
+        "success_probability": o.success_probability,
+        "expected_cost": _f(o.expected_cost),
+        "tolerance_rad": _f(o.tolerance),
+    }
+
+
+def plan_json(report: PlanReport, schema: str = "bayesgrasp.plan/1") -> dict[str, Any]:
+    """The ``bayesgrasp.plan/1`` document (top-level fields follow the Bayes plan)."""
+    pb: Problem = report.problem
+    bayes = report.bayes_plan
+    out: dict[str, Any] = {
+        "schema": schema,
+        "part": part_json(pb.part),
+        "method": report.method,
+        "stable_orientations_rad": pb.states.stable.tolist(),
+        "stable_probabilities": pb.state_distribution(bayes.first_angle).tolist(),
+        "period_rad": float(pb.states.period),
+        "first_squeeze_rad": bayes.first_angle,
+        "options": [option_json(o) for o in report.options],
+        "bayes": report.bayes,
+        "most_certain": report.most_certain,
+    }
+    if report.nodes is not None:
+        out["nodes"] = report.nodes
+    return out
+
+
+def _plan_text(o: PlanOption) -> str:
+    alphas = ", ".join(f"{math.degrees(a):+.2f}" for a in o.alphas)
+    kinds = {s.kind for s in o.steps}
+    if kinds != {"squeeze"}:
+        return " ".join(
+            f"{'S' if s.kind == 'squeeze' else 'P'}({math.degrees(s.alpha):+.2f})" for s in o.steps
+        )
+    return f"[{alphas}]" if alphas else "-"
+
+
+def plan_table(report: PlanReport) -> str:
+    """One row per plan length: angles (degrees), success probability, expected cost."""
+    pb = report.problem
+    lines = [
+        f"{pb.part.name}: {pb.part.hull.n_sides} sides, {pb.n_states} stable orientations, "
+        f"prior {pb.prior.name}, goal {pb.goal.kind}, method {report.method}",
+        f"first squeeze at {math.degrees(report.bayes_plan.first_angle):.2f} deg (world frame); "
+        "alpha = gripper turn before each further squeeze",
+        f"{'k':>3}  {'alphas (deg)':<34} {'final (deg)':>11} {'P(success)':>10} "
+        f"{'E[cost]':>8} {'tol (deg)':>9}",
+    ]
+    for i, o in enumerate(report.options):
+        marks = ("B" if i == report.bayes else " ") + ("C" if i == report.most_certain else " ")
+        tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f}"
+        lines.append(
+            f"{o.n_actions:>3}  {_plan_text(o):<34} {math.degrees(o.final_orientation):11.2f} "
+            f"{o.success_probability:10.4f} {o.expected_cost:8.3f} {tol:>9} {marks}"
+        )
+    lines.append("B = Bayes plan (least expected cost), C = most certain plan")
+    if report.nodes is not None:
+        lines.append(f"breadth-first nodes generated: {report.nodes}")
+    return "\n".join(lines)
