@@ -1,6 +1,7 @@
 """Planners: each takes a :class:`~bayesgrasp.problem.Problem` and returns a plan report."""
 
+from .bfs import plan_bfs
 from .exact import plan_exact
 from .plan import PlanOption, PlanReport, PlanStep, execute_plan
 
-__all__ = ["PlanOption", "PlanReport", "PlanStep", "execute_plan", "plan_exact"]
+__all__ = ["PlanOption", "PlanReport", "PlanStep", "execute_plan", "plan_bfs", "plan_exact"]
