@@ -151,6 +151,57 @@ def demo() -> None:
         typer.echo(report.plan_table(plan_exact(Problem.build(load("example")))))
 
 
+@app.command()
+def study(
+    polygons: Annotated[
+        int, typer.Option(min=1, help="How many random polygons (the seed: 2000).")
+    ] = 2000,
+    seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 1,
+    method: Annotated[Method, typer.Option(help="Planner whose plans give the figures.")] = (
+        Method.exact
+    ),
+    bfs_stats: Annotated[
+        bool,
+        typer.Option(
+            "--bfs-stats/--no-bfs-stats",
+            help="Also run the breadth-first baseline for its node statistics.",
+        ),
+    ] = True,
+    as_json: JsonOpt = False,
+) -> None:
+    """The seed's study: hulls of 10 random points in the unit square, planned and counted."""
+    from .study import run_study, study_json, study_table
+
+    kwargs: dict[str, Any] = {
+        "polygons": polygons,
+        "seed": seed,
+        "method": method.value,
+        "bfs_stats": bfs_stats or method is Method.bfs,
+    }
+    if sys.stderr.isatty():
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+        with Progress(
+            "[progress.description]{task.description}",
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+            transient=True,
+        ) as bar:
+            task = bar.add_task("planning polygons", total=polygons)
+            res = run_study(
+                **kwargs, progress=lambda done, _total: bar.update(task, completed=done)
+            )
+    else:
+        res = run_study(**kwargs)
+    if as_json:
+        emit_json(study_json(res))
+    else:
+        typer.echo(study_table(res))
+
+
 # typer vendors click; its exception base is reached through a public subclass.
 _ClickException: type[Exception] = next(
     c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException"
