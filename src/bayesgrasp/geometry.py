@@ -13,6 +13,7 @@ rotation of the part *as given* relative to the gripper frame.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 from .errors import PartError
 from .tolerance import DEFAULT_TOLERANCE, Tolerance
 
-__all__ = ["ConvexPolygon", "Part", "as_points", "polygon_area_centroid"]
+__all__ = ["ConvexPolygon", "Part", "as_points", "find_crossing", "polygon_area_centroid"]
 
 FloatArray = NDArray[np.float64]
 
@@ -293,6 +294,9 @@ class Part:
         Defaults to the hull's area centroid.
     units : str or None
         The units of the coordinates, when known (reported, never converted).
+    holes : tuple of ndarray of shape (K, 2)
+        Holes inside the outline (parts built by :meth:`from_outline`); they move the
+        centre of mass, never the hull.
 
     Examples
     --------
@@ -306,6 +310,7 @@ class Part:
     outline: FloatArray
     center_of_mass: FloatArray
     units: str | None = None
+    holes: tuple[FloatArray, ...] = ()
 
     @classmethod
     def from_points(
@@ -339,6 +344,114 @@ class Part:
         com.setflags(write=False)
         return cls(name, hull, outline, com, units)
 
+    @classmethod
+    def from_outline(
+        cls,
+        outline: ArrayLike,
+        holes: Sequence[ArrayLike] = (),
+        name: str = "part",
+        center_of_mass: ArrayLike | None = None,
+        units: str | None = None,
+        tol: Tolerance = DEFAULT_TOLERANCE,
+    ) -> Part:
+        """Build a part from a simple (possibly non-convex) outline, optionally with holes.
+
+        The outline is an ordered ring, closed implicitly (a repeated closing vertex is
+        dropped). The gripper sees its convex hull; the default centre of mass is the area
+        centroid of the outline minus the holes (uniform density), not the hull's.
+
+        Parameters
+        ----------
+        outline : array_like of shape (N, 2)
+            Vertices in order around the outline, either direction.
+        holes : sequence of array_like of shape (K, 2), optional
+            Rings strictly inside the outline, not touching it or each other.
+        name : str
+        center_of_mass : array_like of shape (2,), optional
+            Overrides the area centroid; must lie inside the hull.
+        units : str, optional
+        tol : Tolerance, optional
+
+        Returns
+        -------
+        Part
+            ``outline`` and ``holes`` are stored counter-clockwise without repeated
+            vertices.
+
+        Raises
+        ------
+        PartError
+            Fewer than 3 distinct vertices, non-finite coordinates, a self-intersecting
+            outline (two edges that cross or touch, or an edge that folds back), a hole
+            outside the outline or crossing it, zero area, or a centre of mass outside the
+            hull.
+
+        Examples
+        --------
+        >>> p = Part.from_outline([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)], name="L")
+        >>> p.hull.n_sides, np.round(p.center_of_mass, 6).tolist()
+        (5, [0.833333, 0.833333])
+        >>> Part.from_outline([(0, 0), (1, 1), (1, 0), (0, 1)])  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        bayesgrasp.errors.PartError: `outline` must be a simple polygon; it crosses itself ...
+        """
+        ring = _clean_ring(outline, "outline")
+        rings = [ring] + [_clean_ring(h, f"holes[{k}]") for k, h in enumerate(holes)]
+        names = ["outline"] + [f"holes[{k}]" for k in range(len(rings) - 1)]
+        for r, what in zip(rings, names, strict=True):
+            fold = _fold_back(r)
+            if fold is not None:
+                x, y = r[fold]
+                raise PartError(
+                    f"`{what}` must be a simple polygon; it folds back on itself at vertex "
+                    f"{fold} ({x:.6g}, {y:.6g})"
+                )
+        hit = find_crossing(rings)
+        if hit is not None:
+            ra, _, rb, _ = hit
+            point = _crossing_point(rings, hit)
+            where = "it crosses itself" if ra == rb else f"it crosses `{names[rb]}`"
+            raise PartError(
+                f"`{names[ra]}` must be a simple polygon; {where} near "
+                f"({point[0]:.6g}, {point[1]:.6g})"
+            )
+        oriented: list[FloatArray] = []
+        areas: list[float] = []
+        centroids: list[FloatArray] = []
+        for r in rings:
+            a, c = polygon_area_centroid(r)
+            oriented.append(r if a > 0 else r[::-1].copy())
+            areas.append(abs(a))
+            centroids.append(c)
+        extent = float(np.max(np.ptp(ring, axis=0)))
+        for k in range(1, len(rings)):
+            if not _point_in_ring(oriented[k][0], oriented[0]):
+                raise PartError(f"`{names[k]}` must lie inside `outline`; it lies outside")
+            for m in range(1, len(rings)):
+                if m != k and _point_in_ring(oriented[k][0], oriented[m]):
+                    raise PartError(f"`{names[k]}` lies inside `{names[m]}`; holes cannot nest")
+        net = areas[0] - sum(areas[1:])
+        if net <= tol.length_for(extent) * extent:
+            raise PartError(f"`outline` must enclose a non-zero area; got area {net:.6g}")
+        hull = ConvexPolygon.from_points(oriented[0], tol)
+        if center_of_mass is None:
+            weighted = areas[0] * centroids[0] - sum(
+                (a * c for a, c in zip(areas[1:], centroids[1:], strict=True)), np.zeros(2)
+            )
+            com = np.asarray(weighted / net, dtype=np.float64)
+        else:
+            com = as_points(
+                np.reshape(np.asarray(center_of_mass, dtype=object), (1, -1)), "center_of_mass"
+            )[0].copy()
+        if not hull_contains(hull, com):
+            raise PartError(
+                f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull"
+            )
+        for arr in (*oriented, com):
+            arr.setflags(write=False)
+        return cls(name, hull, oriented[0], com, units, tuple(oriented[1:]))
+
 
 def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
     """Whether ``point`` lies strictly inside the convex polygon (by more than the tolerance)."""
@@ -348,3 +461,140 @@ def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
     cross = e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0]
     lengths = np.hypot(e[:, 0], e[:, 1])
     return bool(np.all(cross / lengths > hull.tol.length_for(hull.size)))
+
+
+def _clean_ring(points: ArrayLike, what: str) -> FloatArray:
+    """A ring as float64 (N, 2) without repeated consecutive vertices or closing vertex."""
+    ring = as_points(points, what)
+    if len(ring) > 1:
+        ring = ring[~np.all(ring == np.roll(ring, -1, axis=0), axis=1)]
+    if len(ring) < 3:
+        raise PartError(f"`{what}` must have at least 3 distinct vertices; got {len(ring)}")
+    return np.array(ring, dtype=np.float64)
+
+
+def _fold_back(ring: FloatArray) -> int | None:
+    """Index of a vertex where the ring turns back along its incoming edge, if any."""
+    u = ring - np.roll(ring, 1, axis=0)  # (N, 2) incoming edges
+    w = np.roll(ring, -1, axis=0) - ring  # (N, 2) outgoing edges
+    cross = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
+    dot = (u * w).sum(axis=1)
+    scale = np.hypot(u[:, 0], u[:, 1]) * np.hypot(w[:, 0], w[:, 1])
+    bad = np.flatnonzero((np.abs(cross) <= 1e-12 * scale) & (dot < 0))
+    return int(bad[0]) if len(bad) else None
+
+
+def _point_in_ring(point: FloatArray, ring: FloatArray) -> bool:
+    """Even-odd test: whether ``point`` lies inside the ring (vectorised over edges)."""
+    x, y = float(point[0]), float(point[1])
+    a, b = ring, np.roll(ring, -1, axis=0)
+    straddle = (a[:, 1] > y) != (b[:, 1] > y)  # (N,) edges crossing the horizontal line
+    dy = np.where(straddle, b[:, 1] - a[:, 1], 1.0)
+    x_cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
+    return bool(np.count_nonzero(straddle & (x < x_cross)) % 2)
+
+
+def _crossing_point(rings: Sequence[FloatArray], hit: tuple[int, int, int, int]) -> FloatArray:
+    """A point where the two segments named by ``hit`` meet (for error messages)."""
+    ra, sa, rb, sb = hit
+    a0, a1 = rings[ra][sa], rings[ra][(sa + 1) % len(rings[ra])]
+    b0, b1 = rings[rb][sb], rings[rb][(sb + 1) % len(rings[rb])]
+    da, db = a1 - a0, b1 - b0
+    denom = da[0] * db[1] - da[1] * db[0]
+    if denom == 0.0:  # collinear overlap: any shared point will do
+        for p in (b0, b1, a0, a1):
+            if min(a0[0], a1[0]) <= p[0] <= max(a0[0], a1[0]) and min(a0[1], a1[1]) <= p[1] <= max(
+                a0[1], a1[1]
+            ):
+                return np.asarray(p, dtype=np.float64)
+        return np.asarray(a0, dtype=np.float64)  # pragma: no cover - not reached
+    t = ((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / denom
+    return np.asarray(a0 + t * da, dtype=np.float64)
+
+
+_PAIR_CHUNK = 1 << 20  # candidate segment pairs examined per vectorised batch
+
+
+def find_crossing(rings: Sequence[FloatArray]) -> tuple[int, int, int, int] | None:
+    """Find two non-adjacent edges of a set of rings that cross or touch.
+
+    A sweep along the axis where the edges are shortest pairs every edge with the edges whose
+    intervals overlap it on that axis (sort and prune); the pairs are filtered on the other
+    axis and settled by exact orientation tests, in vectorised batches. Typical outlines
+    (short edges) give O(N log N) work; the worst case is O(N^2).
+
+    Parameters
+    ----------
+    rings : sequence of ndarray of shape (N_k, 2)
+        Closed rings without repeated closing vertex and without repeated vertices.
+
+    Returns
+    -------
+    tuple of int or None
+        ``(ring_a, edge_a, ring_b, edge_b)`` for one offending pair (edge ``i`` runs from
+        vertex ``i`` to vertex ``i + 1``), or ``None`` when the rings are simple and disjoint.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    >>> find_crossing([square]) is None
+    True
+    >>> find_crossing([np.array([[0.0, 0], [1, 1], [1, 0], [0, 1]])])
+    (0, 0, 0, 2)
+    """
+    starts = np.concatenate(rings)  # (S, 2)
+    ends = np.concatenate([np.roll(r, -1, axis=0) for r in rings])  # (S, 2)
+    ring_id = np.concatenate([np.full(len(r), k, dtype=np.intp) for k, r in enumerate(rings)])
+    edge_id = np.concatenate([np.arange(len(r), dtype=np.intp) for r in rings])
+    ring_len = np.asarray([len(r) for r in rings], dtype=np.intp)[ring_id]
+    lo = np.minimum(starts, ends)  # (S, 2) bounding boxes
+    hi = np.maximum(starts, ends)
+    axis = int(np.argmin((hi - lo).sum(axis=0)))
+    other = 1 - axis
+    order = np.argsort(lo[:, axis], kind="stable")
+    lo_sorted = lo[order, axis]
+    stop = np.searchsorted(lo_sorted, hi[order, axis], side="right")  # (S,)
+    counts = stop - np.arange(len(order)) - 1  # partners after each edge in sweep order
+    cum = np.cumsum(counts)
+    row = 0
+    n = len(order)
+    while row < n:
+        base = cum[row - 1] if row else 0
+        last = int(np.searchsorted(cum, base + _PAIR_CHUNK, side="right"))
+        last = max(last, row + 1)
+        c = counts[row:last]
+        total = int(c.sum())
+        if total:
+            i_sorted = np.repeat(np.arange(row, last), c)
+            j_sorted = i_sorted + 1 + (np.arange(total) - np.repeat(np.cumsum(c) - c, c))
+            a, b = order[i_sorted], order[j_sorted]
+            keep = (lo[a, other] <= hi[b, other]) & (lo[b, other] <= hi[a, other])
+            gap = np.abs(edge_id[a] - edge_id[b])
+            adjacent = (ring_id[a] == ring_id[b]) & ((gap == 1) | (gap == ring_len[a] - 1))
+            keep &= ~adjacent
+            a, b = a[keep], b[keep]
+            hits = _segments_meet(starts[a], ends[a], starts[b], ends[b])
+            if hits.any():
+                k = int(np.flatnonzero(hits)[0])
+                pa, pb = sorted((int(a[k]), int(b[k])))
+                return (int(ring_id[pa]), int(edge_id[pa]), int(ring_id[pb]), int(edge_id[pb]))
+        row = last
+    return None
+
+
+def _segments_meet(p: FloatArray, q: FloatArray, r: FloatArray, s: FloatArray) -> NDArray[np.bool_]:
+    """Whether segments pq and rs share a point, for boxes already known to overlap."""
+
+    def orient(a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+        out: FloatArray = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (
+            c[:, 0] - a[:, 0]
+        )
+        return out
+
+    o1, o2 = orient(p, q, r), orient(p, q, s)
+    o3, o4 = orient(r, s, p), orient(r, s, q)
+    # With overlapping boxes, opposite (or zero) signs on both sides mean the segments meet,
+    # including the collinear case (all four zero).
+    return np.asarray(
+        (np.sign(o1) * np.sign(o2) <= 0) & (np.sign(o3) * np.sign(o4) <= 0), dtype=np.bool_
+    )

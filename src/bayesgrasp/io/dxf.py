@@ -1,0 +1,368 @@
+"""DXF part files: the closed outline drawn in the model space (parsing is ezdxf's).
+
+Outlines come from closed entities (LWPOLYLINE and 2D/3D POLYLINE with bulges, CIRCLE, a
+full ELLIPSE, a closed SPLINE) and from loops of open entities (LINE, ARC, elliptic arcs,
+open SPLINEs and polylines) joined end to end: endpoints closer than the chordal tolerance
+are the same point. Chains that end, or that branch (three entities at a point), are not
+outlines and are left out. Block references (INSERT) are expanded.
+
+The outer ring is the outline; rings inside it are holes (they move the centre of mass).
+Several separate outer rings need a choice: ``layer`` keeps the entities of one layer.
+Units come from the header's ``$INSUNITS`` (``None`` when unitless). Entities are
+projected onto the xy plane of the world coordinate system.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..geometry import Part
+from ._common import (
+    ReadOptions,
+    Ring,
+    assemble_part,
+    chordal_tolerance,
+    fail,
+    flatten_rings,
+    need,
+    read_bytes,
+)
+from ._flatten import Adaptive, Bezier, Curve, EllipticArc, Polyline
+
+__all__ = ["INSUNITS", "read_dxf"]
+
+log = logging.getLogger("bayesgrasp.io")
+
+FloatArray = NDArray[np.float64]
+
+#: ``$INSUNITS`` codes and the unit names reported in :attr:`Part.units` (0 is unitless).
+INSUNITS = {
+    1: "in",
+    2: "ft",
+    3: "mi",
+    4: "mm",
+    5: "cm",
+    6: "m",
+    7: "km",
+    8: "µin",
+    9: "mil",
+    10: "yd",
+    11: "Å",
+    12: "nm",
+    13: "µm",
+    14: "dm",
+    15: "dam",
+    16: "hm",
+    17: "Gm",
+    18: "au",
+    19: "ly",
+    20: "pc",
+    21: "US ft",
+    22: "US in",
+    23: "US yd",
+    24: "US mi",
+}
+
+_MAX_BLOCK_DEPTH = 8
+
+
+def _xy(v: Any) -> FloatArray:
+    return np.array([float(v[0]), float(v[1])], dtype=np.float64)
+
+
+class _Frame:
+    """Object coordinates (OCS) of an entity, projected onto the world xy plane."""
+
+    def __init__(self, entity: Any) -> None:
+        ocs = entity.ocs()
+        self.linear = np.array(
+            [[ocs.ux[0], ocs.uy[0]], [ocs.ux[1], ocs.uy[1]]], dtype=np.float64
+        )  # (2, 2) OCS x, y axes seen in world x, y
+        self.uz = np.array([ocs.uz[0], ocs.uz[1]], dtype=np.float64)
+
+    def point(self, x: float, y: float, z: float = 0.0) -> FloatArray:
+        out: FloatArray = self.linear @ np.array([x, y]) + z * self.uz
+        return out
+
+    def vector(self, x: float, y: float) -> FloatArray:
+        out: FloatArray = self.linear @ np.array([x, y])
+        return out
+
+
+def _circle_arc(
+    frame: _Frame, center: Any, radius: float, t0: float, span: float, elevation: float
+) -> EllipticArc:
+    return EllipticArc(
+        frame.point(center[0], center[1], elevation),
+        frame.vector(radius, 0.0),
+        frame.vector(0.0, radius),
+        t0,
+        span,
+    )
+
+
+def _bulge_curve(
+    frame: _Frame, p: FloatArray, q: FloatArray, bulge: float, elevation: float
+) -> Curve:
+    """The segment from ``p`` to ``q`` (OCS) with a bulge: a line, or a circular arc."""
+    wp, wq = frame.point(p[0], p[1], elevation), frame.point(q[0], q[1], elevation)
+    if bulge == 0.0:
+        return Polyline(np.array([wp, wq]))
+    from ezdxf.math import bulge_center
+
+    sweep = 4.0 * math.atan(bulge)  # signed: positive is counter-clockwise
+    c = bulge_center(tuple(p), tuple(q), bulge)
+    radius = float(np.hypot(p[0] - c[0], p[1] - c[1]))
+    t0 = math.atan2(p[1] - c[1], p[0] - c[0])
+    arc = _circle_arc(frame, c, radius, t0, sweep, elevation)
+    return EllipticArc(arc.center, arc.major, arc.minor, arc.t0, arc.span, pin=(wp, wq))
+
+
+def _polyline_curves(
+    frame: _Frame, points: list[tuple[float, float, float]], closed: bool, elevation: float
+) -> list[Curve]:
+    """Curves of a polyline given as (x, y, bulge) in its OCS."""
+    pts = [(np.array([x, y], dtype=np.float64), b) for x, y, b in points]
+    if closed and len(pts) > 1 and np.array_equal(pts[0][0], pts[-1][0]):
+        pts = pts[:-1]
+    n = len(pts)
+    curves: list[Curve] = []
+    for i in range(n if closed else n - 1):
+        (p, b), (q, _) = pts[i], pts[(i + 1) % n]
+        if not np.array_equal(p, q):
+            curves.append(_bulge_curve(frame, p, q, float(b), elevation))
+    return curves
+
+
+def _spline_curves(entity: Any) -> list[Curve]:
+    bs = entity.construction_tool()
+    ctrl = np.array([[v[0], v[1]] for v in bs.control_points], dtype=np.float64)
+    if bs.is_rational or not bs.is_clamped:
+        first = _xy(bs.point(bs.max_t * 0.0))
+        last = _xy(bs.point(bs.max_t))
+        box = np.array([ctrl.min(axis=0), ctrl.max(axis=0)])
+        return [Adaptive(lambda tol: ((v[0], v[1]) for v in bs.flattening(tol)), first, last, box)]
+    return [
+        Bezier(np.array([[v[0], v[1]] for v in piece], dtype=np.float64))
+        for piece in bs.bezier_decomposition()
+    ]
+
+
+def _entity_curves(entity: Any) -> tuple[list[Curve], bool] | None:
+    """(curves, closed) of one entity, or None for entities that are not outlines."""
+    kind = entity.dxftype()
+    dxf = entity.dxf
+    if kind == "LINE":
+        s, e = _xy(dxf.start), _xy(dxf.end)
+        return ([Polyline(np.array([s, e]))] if not np.array_equal(s, e) else [], False)
+    if kind in ("ARC", "CIRCLE"):
+        frame = _Frame(entity)
+        center = dxf.center
+        if kind == "CIRCLE":
+            return [_circle_arc(frame, center, dxf.radius, 0.0, 2 * math.pi, center[2])], True
+        t0 = math.radians(dxf.start_angle)
+        span = math.radians((dxf.end_angle - dxf.start_angle) % 360.0) or 2 * math.pi
+        arc = _circle_arc(frame, center, dxf.radius, t0, span, center[2])
+        pin = (_xy(entity.start_point), _xy(entity.end_point))
+        return [EllipticArc(arc.center, arc.major, arc.minor, t0, span, pin)], False
+    if kind == "ELLIPSE":
+        ce = entity.construction_tool()
+        span = (ce.end_param - ce.start_param) % (2 * math.pi)
+        full = span < 1e-12 or abs(span - 2 * math.pi) < 1e-12
+        span = 2 * math.pi if full else span
+        arc = EllipticArc(
+            _xy(ce.center), _xy(ce.major_axis), _xy(ce.minor_axis), ce.start_param, span
+        )
+        return [arc], full
+    if kind == "SPLINE":
+        curves = _spline_curves(entity)
+        closed = bool(entity.closed) or bool(
+            np.allclose(curves[0].start(), curves[-1].end(), rtol=0, atol=0)
+        )
+        return curves, closed
+    if kind == "LWPOLYLINE":
+        frame = _Frame(entity)
+        pts = [(float(x), float(y), float(b)) for x, y, b in entity.get_points("xyb")]
+        closed = bool(entity.closed) or (len(pts) > 2 and pts[0][:2] == pts[-1][:2])
+        return _polyline_curves(frame, pts, closed, float(dxf.elevation)), closed
+    if kind == "POLYLINE":
+        closed = bool(entity.is_closed)
+        if entity.is_2d_polyline:
+            frame = _Frame(entity)
+            verts = [v for v in entity.vertices if not v.dxf.flags & 16]  # not spline frame
+            pts = [(v.dxf.location[0], v.dxf.location[1], v.dxf.bulge) for v in verts]
+            closed = closed or (len(pts) > 2 and pts[0][:2] == pts[-1][:2])
+            elevation = float(entity.dxf.elevation[2])
+            return _polyline_curves(frame, pts, closed, elevation), closed
+        if entity.is_3d_polyline:
+            loc = np.array([_xy(v.dxf.location) for v in entity.vertices])
+            if closed:
+                loc = np.vstack([loc, loc[:1]])
+            return [Polyline(loc)], closed
+    return None
+
+
+def _entities(msp: Any, layer: str | None) -> Iterator[Any]:
+    """Model-space entities of the layer, with block references expanded."""
+
+    def expand(entity: Any, depth: int) -> Iterator[Any]:
+        if entity.dxftype() == "INSERT" and depth < _MAX_BLOCK_DEPTH:
+            for sub in entity.virtual_entities():
+                yield from expand(sub, depth + 1)
+        else:
+            yield entity
+
+    for entity in msp:
+        if layer is None or str(entity.dxf.layer).lower() == layer.lower():
+            yield from expand(entity, 0)
+
+
+def _chain(pieces: list[tuple[list[Curve], str, str]], gap: float) -> tuple[list[Ring], list[str]]:
+    """Join open pieces end to end into loops; return the loops and why others were left."""
+    from scipy.cluster.hierarchy import DisjointSet
+    from scipy.spatial import cKDTree
+
+    if not pieces:
+        return [], []
+    ends = np.array([[c[0].start(), c[-1].end()] for c, _, _ in pieces]).reshape(-1, 2)
+    nodes = DisjointSet(range(len(ends)))
+    for i, j in cKDTree(ends).query_pairs(gap):
+        nodes.merge(i, j)
+    node = np.array([nodes[k] for k in range(len(ends))]).reshape(-1, 2)  # (P, 2) node ids
+    alive = np.ones(len(pieces), dtype=bool)
+    notes: list[str] = []
+    while True:  # peel pieces at dangling ends (degree 1) and branches (degree > 2)
+        ids, counts = np.unique(node[alive].ravel(), return_counts=True)
+        degree = dict(zip(ids.tolist(), counts.tolist(), strict=True))
+        drop = [
+            int(k)
+            for k in np.flatnonzero(alive)
+            if degree[node[k, 0]] != 2 or degree[node[k, 1]] != 2
+        ]
+        if not drop:
+            break
+        for k in drop:
+            end = 0 if degree[node[k, 0]] != 2 else 1
+            at = ends[2 * k + end]
+            why = "branches" if degree[node[k, end]] > 2 else "ends"
+            notes.append(f"{pieces[k][1]}: its chain {why} at ({at[0]:.6g}, {at[1]:.6g})")
+            alive[k] = False
+    incident: dict[int, list[int]] = {}
+    for k in np.flatnonzero(alive).tolist():
+        for n in node[k]:
+            incident.setdefault(int(n), []).append(int(k))
+    rings: list[Ring] = []
+    used = np.zeros(len(pieces), dtype=bool)
+    for k0 in np.flatnonzero(alive).tolist():
+        if used[k0]:
+            continue
+        curves: list[Curve] = []
+        sources: list[str] = []
+        k, forward = k0, True
+        start_node = int(node[k0, 0])
+        while True:
+            used[k] = True
+            cs, source, _ = pieces[k]
+            curves += cs if forward else [c.reverse() for c in reversed(cs)]
+            sources.append(source)
+            at = int(node[k, 1] if forward else node[k, 0])
+            if at == start_node:
+                break
+            nxt = [m for m in incident[at] if not used[m]]
+            if not nxt:  # pragma: no cover - degree-2 nodes always continue the loop
+                break
+            k = int(nxt[0])
+            forward = int(node[k, 0]) == at
+        label = (
+            sources[0]
+            if len(sources) == 1
+            else f"loop of {sources[0]} and {len(sources) - 1} more entities"
+        )
+        rings.append(Ring(tuple(curves), label, pieces[int(k0)][2]))
+    return rings, notes
+
+
+def read_dxf(path: Path, options: ReadOptions) -> Part:
+    """Read the outline of a DXF drawing.
+
+    Examples
+    --------
+    >>> import ezdxf, tempfile
+    >>> doc = ezdxf.new(units=4)
+    >>> _ = doc.modelspace().add_lwpolyline(
+    ...     [(0, 0, 0), (20, 0, 1), (20, 10, 0), (0, 10, 0)], format="xyb", close=True)
+    >>> f = Path(tempfile.mkdtemp()) / "tab.dxf"
+    >>> doc.saveas(f)
+    >>> p = read_dxf(f, ReadOptions(tolerance=0.001))
+    >>> p.units, round(float(p.outline[:, 0].max()), 2)
+    ('mm', 25.0)
+    """
+    ezdxf = need("ezdxf")
+    read_bytes(path)
+    if options.element is not None:
+        raise fail(path, "`element` applies to SVG, GeoJSON and WKT; in DXF choose a `layer`")
+    try:
+        doc = ezdxf.readfile(str(path))
+    except Exception as exc:  # ezdxf raises several types on malformed input
+        raise fail(path, f"not a readable DXF file ({type(exc).__name__}: {exc})") from None
+    code = doc.header.get("$INSUNITS", 0)
+    units = INSUNITS.get(int(code)) if isinstance(code, int | float) else None
+    msp = doc.modelspace()
+
+    closed_rings: list[Ring] = []
+    pieces: list[tuple[list[Curve], str, str]] = []
+    skipped: dict[str, int] = {}
+    try:
+        for entity in _entities(msp, options.layer):
+            layer = str(entity.dxf.layer)
+            source = f"{entity.dxftype()} #{entity.dxf.handle} on layer {layer}"
+            got = _entity_curves(entity)
+            if got is None:
+                skipped[entity.dxftype()] = skipped.get(entity.dxftype(), 0) + 1
+                continue
+            curves, closed = got
+            if not curves:
+                continue
+            if closed:
+                closed_rings.append(Ring(tuple(curves), source, layer))
+            else:
+                pieces.append((curves, source, layer))
+    except (ValueError, TypeError, IndexError, ZeroDivisionError, ezdxf.DXFError) as exc:
+        raise fail(path, f"an entity cannot be read ({type(exc).__name__}: {exc})") from None
+    if skipped:
+        log.info("%s: skipped entities that are not outlines: %s", path, skipped)
+
+    every = [c for r in closed_rings for c in r.curves] + [c for p in pieces for c in p[0]]
+    if not every:
+        layers = sorted({str(e.dxf.layer) for e in msp})
+        where = (
+            f" on layer {options.layer!r} (layers: {', '.join(layers)})" if options.layer else ""
+        )
+        raise fail(path, f"no lines, arcs, circles, ellipses, splines or polylines{where}")
+    boxes = np.array([c.bounds() for c in every])
+    if not np.all(np.isfinite(boxes)):
+        raise fail(path, "coordinates must be finite; the drawing has NaN or infinite values")
+    bounds = np.array([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+    tol = chordal_tolerance(path, options, bounds)
+    loops, notes = _chain(pieces, tol)
+    for note in notes:
+        log.info("%s: left out %s", path, note)
+    rings = closed_rings + loops
+    if not rings:
+        detail = f"; {notes[0]}" if notes else ""
+        raise fail(path, f"no closed outline{detail}")
+    flat = flatten_rings(path, rings, tol, options)
+    layers = sorted({r.group for r in rings})
+    if options.layer is None and len(layers) > 1:
+        choose = f"choose one with --layer (layers: {', '.join(layers)})"
+    else:
+        choose = "keep one part per layer (or per file) and choose it with --layer"
+    name = path.stem if options.layer is None else f"{path.stem}:{options.layer}"
+    return assemble_part(path, flat, name, units, choose)
