@@ -252,6 +252,9 @@ def test_tree_count_matches_literal_unmerged_search(rng: np.random.Generator) ->
             continue
         assert tree == naive_tree_count(pb, res.stats.target)
         assert tree >= res.stats.nodes
+        unmerged = search_bfs(pb, merge=False, node_limit=10_000)
+        assert unmerged.stats.nodes == tree
+        assert_allclose(probabilities(unmerged.report), probabilities(res.report), atol=1e-9)
         checked += 1
     assert checked >= 30
 

@@ -336,6 +336,7 @@ def search_bfs(
     fallback_limit: int = 1000,
     first_angles: Sequence[float] | None = None,
     tree_count: bool = True,
+    merge: bool = True,
 ) -> BfsResult:
     """The seed's breadth-first search, with its node limit and best-first fallback.
 
@@ -355,6 +356,9 @@ def search_bfs(
         0 under the uniform prior, else the exact planner's first angles).
     tree_count : bool
         Also count the nodes of a search that merges no duplicates (``tree_nodes``).
+    merge : bool
+        Merge identical hyperstates (default). ``False`` searches the literal tree: every
+        node is kept, also in the fallback.
 
     Returns
     -------
@@ -387,6 +391,8 @@ def search_bfs(
     seen: dict[bytes, list[tuple[int, float]]] = {}
 
     def is_new(key: bytes, depth: int, attempt: float) -> bool:
+        if not merge:
+            return True
         if key not in seen:
             seen[key] = [(depth, attempt)]
             return True
@@ -446,7 +452,7 @@ def search_bfs(
         heap: list[tuple[float, int, int]] = []
         for v in range(len(s.roots)):  # the roots are nodes 0..R-1
             key = s.keys(s.dist[v])[0]
-            if key not in seen2:
+            if key not in seen2 or not merge:
                 seen2.add(key)
                 fallback_nodes += 1
                 heapq.heappush(heap, (-s.prob[v], s.depth[v], v))
@@ -458,7 +464,7 @@ def search_bfs(
                 ch = s.children(s.dist[u], ti)
                 probs = s.goal_prob(ch)
                 for a, key in enumerate(s.keys(ch)):
-                    if key in seen2:
+                    if key in seen2 and merge:
                         continue
                     seen2.add(key)
                     v = s.add_child(u, ti, a, ch[a], float(probs[a]))
@@ -495,7 +501,9 @@ def search_bfs(
     n_nodes = bfs_nodes + fallback_nodes
     report = PlanReport(problem, options, bayes, most, "bfs", n_nodes)
     tree = None
-    if tree_count and completed and found is not None:
+    if not merge and completed and found is not None:
+        tree = n_nodes
+    elif tree_count and completed and found is not None:
         tree = _tree_nodes(s, s.depth[found], target)
     stats = SearchStats(
         n_nodes,
