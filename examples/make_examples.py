@@ -49,9 +49,9 @@ BRACKET_HOLES = [((60.0, 10.0), 4.0), ((10.0, 45.0), 4.0)]  # (centre, radius)
 BRACKET_SLOT = ((30.0, 10.0), (45.0, 10.0), 3.0)  # centres of the two ends, radius
 
 PEANUT_PATH = (
-    "M 10 30 C 10 10 30 5 40 15 C 50 5 70 10 70 30 "
-    "C 70 50 50 55 40 45 C 30 55 10 50 10 30 Z "
-    "M 31 30 A 6 6 0 1 0 19 30 A 6 6 0 1 0 31 30 Z"
+    "M 8 30 C 8 14 26 8 38 18 C 50 4 76 8 76 30 "
+    "C 76 54 50 58 38 44 C 28 53 8 48 8 30 Z "
+    "M 29 30 A 6 6 0 1 0 17 30 A 6 6 0 1 0 29 30 Z"
 )
 PEANUT_OFFSET = (2.0, 3.0)  # the group's translation
 
@@ -60,7 +60,8 @@ PLATE_HOLE = [[18, 20], [18, 26], [22, 26], [22, 20], [18, 20]]
 
 
 def write_bracket(path: Path) -> None:
-    """The DXF bracket."""
+    """The DXF bracket (fixed dates and GUIDs, so that regenerating it changes nothing)."""
+    ezdxf.options.write_fixed_meta_data_for_testing = True
     doc = ezdxf.new("R2010", units=4)
     doc.layers.add("OUTLINE", color=7)
     doc.layers.add("CENTER", color=1, linetype="CENTER")

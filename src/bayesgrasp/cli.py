@@ -9,12 +9,14 @@ from __future__ import annotations
 import enum
 import json
 import sys
+from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 
 from . import report
 from .errors import BayesGraspError
+from .geometry import Part
 from .io import resolve_part
 from .planning import plan_exact
 from .prior import parse_prior
@@ -26,7 +28,8 @@ app = typer.Typer(
     help=(
         "Plan parallel-jaw squeeze sequences that orient a planar part at least expected "
         "cost (Goldberg & Mason, Bayesian Grasping). PART is a catalogue name "
-        f"({', '.join(catalogue_names())}) or a part file (.json, .csv)."
+        f"({', '.join(catalogue_names())}) or a part file (.json, .csv, .wkt, .geojson, "
+        ".svg, .dxf)."
     ),
     no_args_is_help=True,
     add_completion=False,
@@ -34,8 +37,60 @@ app = typer.Typer(
     rich_markup_mode=None,
 )
 
-PartArg = Annotated[str, typer.Argument(help="Catalogue name or part file (.json, .csv).")]
+PartArg = Annotated[
+    str,
+    typer.Argument(help="Catalogue name or part file (.json, .csv, .wkt, .geojson, .svg, .dxf)."),
+]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON for machines.")]
+
+
+class PartFormat(enum.StrEnum):
+    """Part file formats (default: from the file's extension)."""
+
+    json = "json"
+    csv = "csv"
+    wkt = "wkt"
+    geojson = "geojson"
+    svg = "svg"
+    dxf = "dxf"
+
+
+# Options of every command that reads a PART (see bayesgrasp.io.read_part).
+FormatOpt = Annotated[
+    PartFormat | None,
+    typer.Option("--format", help="Format of the part file (default: from its extension)."),
+]
+ElementOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--element",
+        metavar="ID",
+        help="Which outline when the file has several: SVG element id, GeoJSON feature "
+        "name or id, or polygon index (GeoJSON, WKT).",
+    ),
+]
+LayerOpt = Annotated[str | None, typer.Option("--layer", help="DXF: read only this layer.")]
+FlattenTolOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--flatten-tol",
+        help="Chordal tolerance for flattening curves, in the file's units "
+        "(default: 0.1% of the drawing's diagonal).",
+    ),
+]
+
+
+def load_part(
+    part: str,
+    fmt: PartFormat | None = None,
+    element: str | None = None,
+    layer: str | None = None,
+    flatten_tol: float | None = None,
+) -> Part:
+    """Resolve PART and the part-file options into a part."""
+    return resolve_part(
+        part, fmt.value if fmt else None, element=element, layer=layer, tolerance=flatten_tol
+    )
 
 
 def emit_json(doc: dict[str, Any]) -> None:
@@ -64,9 +119,13 @@ def squeeze(
         str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
     ] = "uniform",
     as_json: JsonOpt = False,
+    fmt: FormatOpt = None,
+    element: ElementOpt = None,
+    layer: LayerOpt = None,
+    flatten_tol: FlattenTolOpt = None,
 ) -> None:
     """Stable orientations of a squeeze, their basins and probabilities after one squeeze."""
-    p = resolve_part(part)
+    p = load_part(part, fmt, element, layer, flatten_tol)
     pr = parse_prior(prior)
     f = squeeze_function(p.hull)
     if as_json:
@@ -76,7 +135,7 @@ def squeeze(
 
 
 def build_problem(
-    part: str,
+    part: str | Part,
     prior: str,
     squeeze_cost: float,
     verify_cost: float,
@@ -94,9 +153,8 @@ def build_problem(
         retry=retry_cost,
         push_grasp=push_grasp_cost,
     )
-    return Problem.build(
-        resolve_part(part), parse_prior(prior), cost, Goal(goal.value), actions=actions
-    )
+    p = resolve_part(part) if isinstance(part, str) else part
+    return Problem.build(p, parse_prior(prior), cost, Goal(goal.value), actions=actions)
 
 
 @app.command()
@@ -123,9 +181,32 @@ def plan(
         int | None, typer.Option(min=1, help="Longest plan to consider.")
     ] = None,
     as_json: JsonOpt = False,
+    fmt: FormatOpt = None,
+    element: ElementOpt = None,
+    layer: LayerOpt = None,
+    flatten_tol: FlattenTolOpt = None,
+    plot_file: Annotated[
+        Path | None,
+        typer.Option(
+            "--plot",
+            metavar="FILE",
+            help="Also draw the part, its diameter function and the Bayes plan's "
+            "distributions into FILE (.png, .svg, .pdf).",
+        ),
+    ] = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan."""
-    pb = build_problem(part, prior, squeeze_cost, verify_cost, first_squeeze_cost, retry_cost, goal)
+    if plot_file is not None:
+        check_figure_path(plot_file)
+    pb = build_problem(
+        load_part(part, fmt, element, layer, flatten_tol),
+        prior,
+        squeeze_cost,
+        verify_cost,
+        first_squeeze_cost,
+        retry_cost,
+        goal,
+    )
     if method is Method.bfs:
         from .planning.bfs import plan_bfs
 
@@ -136,6 +217,121 @@ def plan(
         emit_json(report.plan_json(rep))
     else:
         typer.echo(report.plan_table(rep))
+    if plot_file is not None:
+        from .plotting import plan_figure
+
+        save_figure(plan_figure(rep), plot_file)
+        typer.echo(f"bayesgrasp: wrote {plot_file}", err=True)
+
+
+IMAGE_FORMATS = ("png", "svg", "pdf")
+
+
+def check_figure_path(path: Path) -> None:
+    """Refuse a figure file name that cannot be written, before any work is done."""
+    if path.suffix.lstrip(".").lower() not in IMAGE_FORMATS:
+        raise typer.BadParameter(
+            f"the figure file must end in .png, .svg or .pdf; got {path.name!r}",
+            param_hint="--plot",
+        )
+    if not path.parent.is_dir():
+        raise typer.BadParameter(
+            f"no folder {str(path.parent)!r} to write into", param_hint="--plot"
+        )
+
+
+def save_figure(fig: Any, path: Path) -> None:
+    """Write a figure; a bad file name is a usage error (exit 2), not a traceback."""
+    check_figure_path(path)
+    try:
+        fig.savefig(path, dpi=110)
+    except OSError as exc:
+        raise typer.BadParameter(
+            f"cannot write {path}: {exc.strerror or exc}", param_hint="--plot"
+        ) from None
+
+
+class PlotPlan(enum.StrEnum):
+    """Which plan the figures show."""
+
+    bayes = "bayes"
+    most_certain = "most-certain"
+    guaranteed = "guaranteed"
+
+
+@app.command()
+def plot(
+    part: PartArg,
+    out: Annotated[
+        Path, typer.Option("--out", metavar="DIR", help="Folder for the figures (created).")
+    ] = Path("figures"),
+    which: Annotated[
+        PlotPlan,
+        typer.Option("--plan", help="The plan to draw: Bayes, most certain, or guaranteed."),
+    ] = PlotPlan.bayes,
+    prior: Annotated[
+        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
+    ] = "uniform",
+    push_grasp: Annotated[
+        bool, typer.Option("--push-grasp", help="Also draw the push-grasp function.")
+    ] = False,
+    image_formats: Annotated[
+        str, typer.Option("--image-formats", help="Comma-separated: png, svg, pdf.")
+    ] = "png,svg",
+    animation: Annotated[
+        bool,
+        typer.Option(
+            "--animation/--no-animation", help="Also write the plan's animation (plan.gif)."
+        ),
+    ] = True,
+    frames: Annotated[
+        int, typer.Option(min=4, max=240, help="Animation frames per plan step.")
+    ] = 20,
+    as_json: JsonOpt = False,
+    fmt: FormatOpt = None,
+    element: ElementOpt = None,
+    layer: LayerOpt = None,
+    flatten_tol: FlattenTolOpt = None,
+) -> None:
+    """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif."""
+    from .plotting import write_figures
+
+    formats = [f.strip().lower() for f in image_formats.split(",") if f.strip()]
+    bad = [f for f in formats if f not in IMAGE_FORMATS]
+    if bad or not formats:
+        raise typer.BadParameter(
+            f"expected a comma-separated list of png, svg, pdf; got {image_formats!r}",
+            param_hint="--image-formats",
+        )
+    pb = Problem.build(load_part(part, fmt, element, layer, flatten_tol), parse_prior(prior))
+    if which is PlotPlan.guaranteed:
+        from .planning.guaranteed import plan_guaranteed
+
+        option = plan_guaranteed(pb).option
+    else:
+        rep = plan_exact(pb)
+        option = rep.bayes_plan if which is PlotPlan.bayes else rep.most_certain_plan
+    label = {"bayes": "Bayes", "most-certain": "most certain"}.get(which.value, which.value)
+    try:
+        files = write_figures(
+            pb,
+            option,
+            out,
+            label=label,
+            formats=formats,
+            push_grasp=push_grasp,
+            animation=animation,
+            frames_per_step=frames,
+        )
+    except OSError as exc:
+        raise typer.BadParameter(
+            f"cannot write into {out}: {exc.strerror or exc}", param_hint="--out"
+        ) from None
+    if as_json:
+        emit_json({"schema": "bayesgrasp.plot/1", "files": [str(f) for f in files]})
+    else:
+        for f in files:
+            typer.echo(str(f))
 
 
 @app.command()
@@ -200,6 +396,171 @@ def study(
         emit_json(study_json(res))
     else:
         typer.echo(study_table(res))
+
+
+class Engine(enum.StrEnum):
+    """How a plan is executed."""
+
+    kinematic = "kinematic"
+    mujoco = "mujoco"
+
+
+class NoiseKind(enum.StrEnum):
+    """Distribution of the gripper angle error."""
+
+    normal = "normal"
+    uniform = "uniform"
+
+
+def simulated_plan(which: str, pb: Problem) -> tuple[Any, str]:
+    """The plan option named by ``--plan`` (bayes, most-certain, guaranteed or a file)."""
+    from .execute import SimulationError, plan_from_json
+
+    if which in ("bayes", "most-certain"):
+        rep = plan_exact(pb)
+        return (rep.bayes_plan, "Bayes") if which == "bayes" else (rep.most_certain_plan, which)
+    if which == "guaranteed":
+        try:
+            from .planning.guaranteed import plan_guaranteed
+        except ImportError:
+            raise SimulationError(
+                "--plan guaranteed needs bayesgrasp.planning.guaranteed, which this "
+                "installation lacks; use bayes, most-certain or a plan file"
+            ) from None
+        return plan_guaranteed(pb).option, which
+    path = Path(which)
+    if path.suffix.lower() != ".json":
+        raise SimulationError(
+            f"--plan must be bayes, most-certain, guaranteed or a .json plan file; got {which!r}"
+        )
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        reason = exc.strerror or exc
+        raise SimulationError(f"plan file {which!r} cannot be read ({reason})") from None
+    except json.JSONDecodeError as exc:
+        raise SimulationError(f"plan file {which!r} is not valid JSON ({exc.msg})") from None
+    try:
+        return plan_from_json(doc), path.name
+    except SimulationError as exc:
+        raise SimulationError(f"plan file {which!r}: {exc}") from None
+
+
+@app.command()
+def simulate(
+    part: PartArg,
+    which: Annotated[
+        str,
+        typer.Option(
+            "--plan", metavar="PLAN", help="bayes | most-certain | guaranteed | FILE.json"
+        ),
+    ] = "bayes",
+    engine: Annotated[
+        Engine, typer.Option(help="kinematic: the model's transfer functions; mujoco: physics.")
+    ] = Engine.kinematic,
+    trials: Annotated[
+        int | None,
+        typer.Option(min=1, help="Executions (default: 1,000,000 kinematic, 200 mujoco)."),
+    ] = None,
+    workers: Annotated[
+        int, typer.Option(min=1, help="Processes for mujoco trials (kinematic uses one).")
+    ] = 1,
+    offset: Annotated[
+        float,
+        typer.Option(
+            min=0,
+            metavar="MM",
+            help="mujoco: the part's centre is MM millimetres off the gripper centre along "
+            "the squeeze axis (random side each action).",
+        ),
+    ] = 0.0,
+    noise: Annotated[
+        float,
+        typer.Option(min=0, metavar="DEG", help="Gripper angle error: sigma or bound, degrees."),
+    ] = 0.0,
+    noise_kind: Annotated[
+        NoiseKind, typer.Option(help="Gripper error distribution.")
+    ] = NoiseKind.normal,
+    seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+    prior: Annotated[
+        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
+    ] = "uniform",
+    goal: Annotated[
+        GoalKind, typer.Option(help="single: one final orientation; symmetry: up to symmetry.")
+    ] = GoalKind.single,
+    push_grasp: Annotated[
+        bool,
+        typer.Option("--push-grasp", help="Plan with push-grasps as well as squeezes."),
+    ] = False,
+    units: Annotated[
+        str | None,
+        typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
+    ] = None,
+    as_json: JsonOpt = False,
+    fmt: FormatOpt = None,
+    element: ElementOpt = None,
+    layer: LayerOpt = None,
+    flatten_tol: FlattenTolOpt = None,
+) -> None:
+    """Execute a plan many times and compare the final orientations with the prediction."""
+    import math
+
+    from .execute import GripperNoise, simulate_kinematic
+
+    if engine is Engine.kinematic and offset > 0:
+        raise typer.BadParameter(
+            "applies to --engine mujoco only (the kinematic model has no positions)",
+            param_hint="--offset",
+        )
+    p = load_part(part, fmt, element, layer, flatten_tol)
+    actions: tuple[str, ...] = ("squeeze", "push-grasp") if push_grasp else ("squeeze",)
+    pb = Problem.build(p, parse_prior(prior), goal=Goal(goal.value), actions=actions)
+    option, label = simulated_plan(which, pb)
+    if "push-grasp" in option.kinds and "push-grasp" not in pb.transfers:
+        pb = Problem.build(p, pb.prior, goal=pb.goal, actions=("squeeze", "push-grasp"))
+    n = trials or (1_000_000 if engine is Engine.kinematic else 200)
+    err = GripperNoise(noise_kind.value, math.radians(noise))
+
+    def run(progress: Any) -> Any:
+        if engine is Engine.kinematic:
+            return simulate_kinematic(pb, option, n, err, rng=seed, progress=progress)
+        from .sim import simulate_mujoco
+        from .sim.scene import units_scale
+
+        scale = units_scale(units) if units is not None else None
+        return simulate_mujoco(
+            pb,
+            option,
+            n,
+            offset=offset / 1000.0,  # millimetres to metres
+            noise=err,
+            rng=seed,
+            workers=workers,
+            scale=scale,
+            progress=progress,
+        )
+
+    if sys.stderr.isatty():
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+        with Progress(
+            "[progress.description]{task.description}",
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+            transient=True,
+        ) as bar:
+            task = bar.add_task(f"{engine.value} trials", total=n)
+            res = run(lambda done, _total: bar.update(task, completed=done))
+    else:
+        res = run(None)
+    if as_json:
+        emit_json(report.simulate_json(res, p))
+    else:
+        title = f"{p.name}: {label} plan, prior {pb.prior.name}; "
+        typer.echo(report.simulate_table(res, title))
 
 
 # typer vendors click; its exception base is reached through a public subclass.
