@@ -62,12 +62,12 @@ def main() -> None:
     # 2. Same polygons, same run: each planner timed per polygon (CPU time), best of repeats.
     rng = np.random.default_rng(seed)
     parts = [random_polygon(rng) for _ in range(n)]
-    t_build = t_exact = t_classes = t_bfs = t_tree = math.inf
-    hard = []
-    for _ in range(args.repeat):
-        tb = te = tc = tf = tt = 0.0
-        hard = []
-        for p in parts:
+    times = np.full((5, args.repeat, n), np.inf)  # build, exact, classes, bfs, unmerged bfs
+    nodes = np.zeros(n, dtype=int)
+    over = np.zeros(n, dtype=bool)
+    fallback = np.zeros(n, dtype=int)
+    for rep_i in range(args.repeat):
+        for i, p in enumerate(parts):
             c0 = time.process_time()
             pb = Problem.build(p)
             c1 = time.process_time()
@@ -79,32 +79,37 @@ def main() -> None:
             c4 = time.process_time()
             search_bfs(pb, merge=False)
             c5 = time.process_time()
-            tb, te, tc, tf, tt = (
-                tb + c1 - c0,
-                te + c2 - c1,
-                tc + c3 - c2,
-                tf + c4 - c3,
-                tt + c5 - c4,
+            times[:, rep_i, i] = (c1 - c0, c2 - c1, c3 - c2, c4 - c3, c5 - c4)
+            nodes[i], over[i], fallback[i] = (
+                r.stats.nodes,
+                not r.stats.completed,
+                r.stats.fallback_nodes,
             )
-            if not r.stats.completed:
-                hard.append(r.stats.fallback_nodes)
-        t_build, t_exact = min(t_build, tb), min(t_exact, te)
-        t_classes, t_bfs, t_tree = min(t_classes, tc), min(t_bfs, tf), min(t_tree, tt)
-    print(f"same {n} polygons, cpu seconds (best of {args.repeat}):")
+    best = times.min(axis=1)  # (5, n) best of the repeats, per polygon
+    t_build, t_exact, t_classes, t_bfs, t_tree = best.sum(axis=1)
+    print(f"same {n} polygons, cpu seconds (per polygon best of {args.repeat}, summed):")
     print(f"  problem set-up (hull, squeeze function)  {t_build:.3f}")
     print(f"  exact planner                            {t_exact:.3f}")
     print(f"  breadth-first: action classes            {t_classes:.3f}")
     print(f"  breadth-first: search, merging           {t_bfs:.3f}")
     print(f"  breadth-first: search, no merging        {t_tree:.3f}")
-    ratio_plan = (t_classes + t_bfs) / t_exact
-    ratio_part = (t_build + t_classes + t_bfs) / (t_build + t_exact)
+    bfs_cost = best[2] + best[3]
     print(
-        f"  exact vs breadth-first (merging): {ratio_plan:.1f}x faster planning, "
-        f"{ratio_part:.1f}x from the part"
+        f"  exact vs breadth-first (merging): {bfs_cost.sum() / t_exact:.1f}x faster planning, "
+        f"{(t_build + bfs_cost.sum()) / (t_build + t_exact):.1f}x from the part"
     )
+    for label, mask in (
+        ("with 100 or more nodes", nodes >= 100),
+        ("that passed the 1000-node limit", over),
+    ):
+        if mask.any():
+            print(
+                f"  on the {mask.sum()} polygons {label}: exact "
+                f"{bfs_cost[mask].sum() / best[1][mask].sum():.1f}x faster"
+            )
     print(
-        f"  breadth-first: {len(hard)} polygons over 1000 nodes; "
-        f"most fallback nodes {max(hard, default=0)}"
+        f"  breadth-first: {over.sum()} polygons over 1000 nodes; "
+        f"most fallback nodes {fallback.max()}; median nodes {np.median(nodes):g}"
     )
 
     # 3. A 10,000-vertex ellipse of aspect 2.
