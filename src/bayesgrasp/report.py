@@ -7,7 +7,7 @@ not already know. JSON angles are radians (``*_rad``); tables show degrees.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,10 +17,15 @@ from .prior import Prior, UniformPrior
 from .problem import Problem
 from .transfer import TransferFunction
 
+if TYPE_CHECKING:
+    from .execute import SimulationResult
+
 __all__ = [
     "part_json",
     "plan_json",
     "plan_table",
+    "simulate_json",
+    "simulate_table",
     "squeeze_json",
     "squeeze_table",
     "transfer_json",
@@ -148,4 +153,77 @@ def plan_table(report: PlanReport) -> str:
     lines.append("B = Bayes plan (least expected cost), C = most certain plan")
     if report.nodes is not None:
         lines.append(f"breadth-first nodes generated: {report.nodes}")
+    return "\n".join(lines)
+
+
+def _simulated_rows(res: SimulationResult) -> list[int]:
+    """States worth a row: predicted or observed."""
+    return [i for i in range(len(res.orientations)) if res.predicted[i] > 0 or res.observed[i]]
+
+
+def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, Any]:
+    """The ``bayesgrasp.simulate/1`` document.
+
+    ``observed`` per orientation is the fraction of all trials (jammed trials end in none).
+    """
+    plan = {k: (_f(v) if isinstance(v, float) else v) for k, v in option_json(res.option).items()}
+    lo, hi = res.ci95
+    out: dict[str, Any] = {
+        "schema": "bayesgrasp.simulate/1",
+        "engine": res.engine,
+        "plan": plan,
+        "trials": res.trials,
+        "predicted_success": res.predicted_success,
+        "observed_success": res.observed_success,
+        "ci95": [lo, hi],
+        "p_value": res.p_value,
+        "jams": res.jams,
+        "final_jams": res.final_jams,
+        "near_boundary": res.near_boundary,
+        "boundary_margin_rad": res.boundary_margin,
+        "per_orientation": [
+            {
+                "orientation_rad": float(res.orientations[i]),
+                "predicted": float(res.predicted[i]),
+                "observed": int(res.observed[i]) / res.trials,
+                "count": int(res.observed[i]),
+                "goal": bool(res.goal[i]),
+            }
+            for i in _simulated_rows(res)
+        ],
+        "seconds": res.seconds,
+    }
+    if part is not None:
+        out["part"] = part_json(part)
+    return out
+
+
+def simulate_table(res: SimulationResult, title: str = "") -> str:
+    """Predicted against observed final orientations (degrees), success, jams, wall time."""
+    o = res.option
+    tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.2f} deg"
+    lo, hi = res.ci95
+    lines = [
+        f"{title}{res.engine} execution, {res.trials} trials",
+        f"plan: {_plan_text(o)} (first action at {math.degrees(o.first_angle):.2f} deg, "
+        f"{o.n_actions} action(s), tolerance {tol}); goal {math.degrees(o.final_orientation):.2f} "
+        "deg",
+        f"{'final (deg)':>11}  {'predicted':>9}  {'observed':>9}  {'count':>9}",
+    ]
+    for i in _simulated_rows(res):
+        mark = "  goal" if res.goal[i] else ""
+        lines.append(
+            f"{math.degrees(res.orientations[i]):11.2f}  {res.predicted[i]:9.4f}  "
+            f"{res.observed[i] / res.trials:9.4f}  {res.observed[i]:9d}{mark}"
+        )
+    rate = res.trials / res.seconds if res.seconds > 0 else math.inf
+    lines += [
+        f"success: predicted {res.predicted_success:.4f}, observed {res.observed_success:.4f}, "
+        f"95% interval [{lo:.4f}, {hi:.4f}]",
+        f"goodness of fit (chi-square over final orientations): p = {res.p_value:.3g}",
+        f"jams: {res.jams} ({res.final_jams} in the last action); near-boundary starts "
+        f"(within {math.degrees(res.boundary_margin):.1f} deg of a basin boundary): "
+        f"{res.near_boundary}",
+        f"wall time {res.seconds:.2f} s ({rate:.3g} trials/s)",
+    ]
     return "\n".join(lines)
