@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import itertools
+import json
 import math
 from collections import deque
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
 from numpy.testing import assert_allclose
 
-from bayesgrasp.errors import PlanningError
+from bayesgrasp.cli import main
+from bayesgrasp.errors import PartError, PlanningError
 from bayesgrasp.geometry import Part
 from bayesgrasp.planning import PlanReport, execute_plan, plan_bfs, plan_exact
 from bayesgrasp.planning.bfs import search_bfs
@@ -320,3 +325,40 @@ def test_bad_arguments(kwargs: dict[str, object], match: str) -> None:
     pb = Problem.build(Part.from_points(RECTANGLE))
     with pytest.raises(PlanningError, match=match):
         search_bfs(pb, **kwargs)  # type: ignore[arg-type]
+
+
+@settings(max_examples=40)
+@given(
+    pts=hnp.arrays(
+        np.float64, (7, 2), elements=st.floats(0, 1, allow_nan=False, allow_subnormal=False)
+    ),
+    beta=st.floats(-math.pi, math.pi),
+)
+def test_property_agreement_and_rotation_invariance(pts: np.ndarray, beta: float) -> None:
+    """Exact and breadth-first agree; turning the part changes no probability."""
+    assume(len(np.unique(np.round(pts, 3), axis=0)) >= 3)
+    try:
+        part = Part.from_points(pts)
+    except PartError:
+        assume(False)
+        return
+    assume(part.hull.area > 1e-3)
+    c, s = math.cos(beta), math.sin(beta)
+    turned = Part.from_points(pts @ np.array([[c, s], [-s, c]]))
+    a, b = search_bfs(Problem.build(part)), search_bfs(Problem.build(turned))
+    if a.stats.completed and b.stats.completed:
+        assert_allclose(probabilities(a.report), probabilities(b.report), atol=1e-7)
+        assert_allclose(
+            probabilities(a.report), probabilities(plan_exact(a.report.problem)), atol=1e-9
+        )
+    for opt in a.report.options:
+        assert 0.0 < opt.success_probability <= 0.5 + 1e-12
+
+
+def test_cli_plan_with_bfs(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["plan", "rectangle", "--method", "bfs", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["method"] == "bfs" and doc["nodes"] == 2
+    assert [round(o["expected_cost"], 1) for o in doc["options"]] == [6.3, 6.0]
+    assert main(["plan", "triangle", "--method", "bfs", "--max-squeezes", "2"]) == 0
+    assert "breadth-first nodes generated" in capsys.readouterr().out
