@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from ..geometry import Part
 from ._common import ReadOptions, fail, need, pick, polygon_part, read_text, shapely_polygons
 
@@ -29,7 +31,8 @@ def read_wkt(path: Path, options: ReadOptions) -> Part:
     shapely = need("shapely")
     text = read_text(path)
     try:
-        geom = shapely.from_wkt(text.strip())
+        with np.errstate(invalid="ignore"):  # NaN coordinates are reported below
+            geom = shapely.from_wkt(text.strip())
     except (shapely.errors.GEOSException, ValueError) as exc:
         raise fail(path, f"not valid WKT ({exc})") from None
     polygons = shapely_polygons(geom)
