@@ -199,6 +199,7 @@ class Problem:
     goal: Goal
     action_kinds: tuple[str, ...]
     _classes: dict[str, ActionClasses] = field(default_factory=dict, repr=False)
+    _memo: dict[str, int] = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(
@@ -256,8 +257,10 @@ class Problem:
 
     @property
     def goal_group(self) -> int:
-        """Number of orientations the goal counts as one."""
-        return self.goal.group_order(self.part.hull.symmetry_order)
+        """Number of orientations the goal counts as one (computed once)."""
+        if "goal_group" not in self._memo:
+            self._memo["goal_group"] = self.goal.group_order(self.part.hull.symmetry_order)
+        return self._memo["goal_group"]
 
     def classes(self, kind: str) -> ActionClasses:
         """The action classes of one action type (computed once)."""

@@ -14,29 +14,57 @@ is ``seq'``:
                  orientations S_{i+1} .. S_j span strictly less than L(seq')
 
 (the image of the arc is the closed arc [S_{i+1}, S_j]; it must fit inside an open arc of
-length ``L(seq')``). The last action alone collapses exactly one basin. ``L`` grows with the
-allowed arc, so for a fixed count of each action type only the order of the *first* action
-matters for cost; the rest takes the type that gives the widest arc.
+length ``L(seq')``; an arc reaching past a basin boundary takes the next stable orientation
+along, and the boundary itself, an unstable equilibrium, stays where it is). The last action
+alone collapses exactly one basin. ``L`` grows with the allowed arc, so for a fixed count of
+each action type only the type of the *first* action matters for cost; the rest take the
+order that gives the widest arc. Comparisons keep a margin of the angle tolerance: an image
+must span less than ``L(seq') - 2 tol``, so no plan relies on hitting an unstable equilibrium.
+
+Only arcs on the *front* matter: an arc is useless if another is at least as wide and spans
+no more. The front of a transfer function (at most one arc for each span, sorted by span,
+widths increasing) is computed once; the widest arc under a span limit is then a binary
+search.
 
 Success probability: the plan collapses an open arc of length ``L`` placed anywhere by the
 gripper angle of the first action, so ``p = max over placements of the prior mass of that
 arc`` (with a symmetry goal, of the arc and its copies ``2 pi / r`` apart). Under the uniform
-prior ``p = L / (2 pi)`` (times ``r``). Expected cost is ``CostModel.expected_cost``.
+prior ``p = L / (2 pi)`` (times ``r``). Expected cost is ``CostModel.expected_cost``. The
+search stops at the first length whose probability reaches the largest prior mass of an arc
+as long as the period (or ``2 pi / r``), which no plan can beat.
 
-Angles come from chaining the witness arcs: the image of one witness, of span ``w``, is placed
-in the middle of the next witness, of length ``L'``, so each relative rotation may err by
-``(L' - w) / 2`` without changing the outcome; the plan's tolerance is the least of these.
-The witnesses are chosen among the widest arcs as those of least span, which maximises every
-margin. Cost: O(K log K) per (count, type), K stable orientations.
+Angles come from a chain of *witness* arcs ``a_1, ..., a_k``, one per action, each an open arc
+between basin boundaries of that action's transfer function: ``a_1`` is the success arc (of
+length ``L``), ``a_k`` a single basin, and the image of ``a_m`` (its stable orientations, of
+span ``x_m``) is placed in the middle of ``a_{m+1}`` (of length ``W_{m+1}``). Relative rotation
+``m + 1`` may then err by ``(W_{m+1} - x_m) / 2`` and every orientation of the success arc still
+ends at the goal; the plan's tolerance is the least of these margins.
+
+The witnesses are not simply the widest arcs of each count: a wider ``a_{m+1}`` gives more
+margin before action ``m + 1`` but may have a larger image, leaving less before action
+``m + 2``. The chain is chosen to maximise the least margin (a bottleneck dynamic programme
+from the last action back): ``tau_m(x)``, the best least margin of actions ``m..k`` when an
+image of span ``x`` arrives before action ``m``, is
+``max over front arcs a of min((W(a) - x) / 2, tau_{m+1}(span(a)))``, a non-increasing
+staircase in ``x`` kept as the Pareto front of its (width, later margin) pairs. Under errors of
+at most ``t`` on every turn, the orientations that can arrive before an action fill the
+basins of an arc whose width exceeds the arriving span by ``2 t``; so no plan with this
+success arc has a larger tolerance than the chain's.
+
+Cost: O(K^2) once per action type for the front (K stable orientations; usually far fewer
+arcs survive), then O(log K) per (count, type) for the lengths and O(F log F) per action of
+each reported plan for its witnesses (F arcs on the front).
 """
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import PlanningError
 from ..problem import Problem
@@ -46,42 +74,187 @@ from .plan import PlanOption, PlanReport, PlanStep, choose_indices
 __all__ = ["plan_exact"]
 
 TWO_PI = 2.0 * math.pi
+FloatArray = NDArray[np.float64]
+_CHUNK = 1 << 20  # arcs enumerated at once (bounds memory for parts with many states)
 
 
 @dataclass(frozen=True, slots=True)
-class _Witness:
-    """Widest collapsible arc for a count of actions whose first action is ``kind``."""
+class _Arc:
+    """An open arc ``(lo, hi)`` of one action's frame and its image ``[s_first, s_last]``."""
 
-    width: float
     kind: str
-    lo: float  # arc (lo, hi) in the frame of this action, before it
+    lo: float
     hi: float
-    s_first: float  # its image: the stable orientations from s_first to s_last
+    s_first: float
     s_last: float
 
+    @property
+    def width(self) -> float:
+        return self.hi - self.lo
 
-def _widest(f: TransferFunction, limit: float, tol: float) -> _Witness:
-    """Widest boundary-to-boundary arc of ``f`` whose stable orientations span < ``limit``."""
+    @property
+    def span(self) -> float:
+        return self.s_last - self.s_first
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Front:
+    """The arcs of one transfer function that no other arc beats, as plain lists.
+
+    Sorted by ``span`` (of the image) increasing, with ``width`` strictly increasing: an
+    arc is dropped when another is at least as wide and spans no more. Fronts are short
+    (about K arcs for K stable orientations), so the planning below runs on lists.
+    """
+
+    arcs: list[_Arc]
+    span: list[float]
+    width: list[float]
+
+
+def _arc_front(f: TransferFunction, max_span: float) -> _Front:
+    """The front of the arcs of ``f`` whose image spans less than ``max_span``.
+
+    Of arcs equal in width and span the one of the first basin is kept.
+    """
     k = f.n_states
-    s = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
-    lo = f.basin_lo
-    hi = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
-    i = np.arange(k)
-    j = np.searchsorted(s, f.stable + (limit - 2.0 * tol), side="left") - 1
-    j = np.clip(j, i, i + k - 1)  # (K,) last basin of the arc starting at basin i
-    width = hi[j] - lo
-    span = s[j] - f.stable
-    best = width.max()
-    cand = np.flatnonzero(width >= best - tol)
-    m = int(cand[np.argmin(span[cand])])
-    jm = int(j[m])
-    return _Witness(float(best), f.kind, float(lo[m]), float(hi[jm]), float(s[m]), float(s[jm]))
+    s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
+    hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
+    i_all = np.arange(k)
+    # Last basin j of an arc starting at basin i: at most K basins, image span < max_span.
+    last = np.minimum(np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all + k - 1)
+    n_off = int(np.max(last - i_all)) + 1
+    rows = max(1, _CHUNK // n_off)
+    lo_l, width_l, first_l, span_l = [], [], [], []
+    for start in range(0, k, rows):
+        i = i_all[start : start + rows]
+        j = i[:, None] + np.arange(n_off)[None, :]  # (R, J) candidate last basins
+        ok = j <= last[i, None]
+        ii = np.broadcast_to(i[:, None], j.shape)[ok]
+        jj = j[ok]
+        lo = f.basin_lo[ii]
+        width = hi2[jj] - lo
+        span = s2[jj] - f.stable[ii]
+        keep = _front_index(span, width)
+        lo_l.append(lo[keep])
+        width_l.append(width[keep])
+        first_l.append(f.stable[ii][keep])
+        span_l.append(span[keep])
+    lo, width, first, span = (np.concatenate(x) for x in (lo_l, width_l, first_l, span_l))
+    keep = _front_index(span, width)
+    lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
+    arcs = [
+        _Arc(f.kind, a, a + w, s, s + x)
+        for a, w, s, x in zip(
+            lo.tolist(), width.tolist(), first.tolist(), span.tolist(), strict=True
+        )
+    ]
+    return _Front(arcs, span.tolist(), width.tolist())
 
 
-def _wrap(a: float) -> float:
-    """Angle in (-pi, pi]."""
-    r = math.remainder(a, TWO_PI)
-    return math.pi if r == -math.pi else r
+def _front_index(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
+    """Indices of the Pareto front (least ``cost``, most ``value``), by cost increasing.
+
+    On the front ``value`` strictly increases; of equal pairs the first index is kept.
+    """
+    order = np.lexsort((-value, cost))  # stable: equal pairs keep their index order
+    v = value[order]
+    best_before = np.maximum.accumulate(np.concatenate([[-np.inf], v[:-1]]))
+    return np.asarray(order[v > best_before], dtype=np.intp)
+
+
+def _widest(front: _Front, limit: float, tol: float) -> float:
+    """Width of the widest arc whose image spans less than ``limit - 2 tol``."""
+    n = bisect.bisect_left(front.span, limit - 2.0 * tol) - 1
+    if n < 0:  # pragma: no cover - every front holds a single basin (span 0)
+        raise PlanningError("internal error: no arc fits the limit")
+    return front.width[n]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _Staircase:
+    """``tau(x)`` of one action: the best least margin of it and the actions after it.
+
+    ``arcs`` are sorted by ``rest`` (the least margin of the later actions after that arc)
+    decreasing, with widths strictly increasing: the Pareto front of (width, rest). With
+    ``c = width - 2 rest`` (non-decreasing), ``tau(x)`` is attained at the first entry with
+    ``c >= x`` (value ``rest``) or at the one before it (value ``(width - x) / 2``).
+    """
+
+    arcs: list[_Arc]
+    rest: list[float]
+    c: list[float]
+    tol: float
+
+    def tau(self, x: float) -> tuple[float, int]:
+        """Best least margin for an image of span ``x`` (``-inf`` if none fits), its arc."""
+        r = bisect.bisect_left(self.c, x)
+        at = self.rest[r] if r < len(self.rest) else -math.inf
+        before = 0.5 * (self.arcs[r - 1].width - x) if r > 0 else -math.inf
+        value, pick = (at, r) if at >= before else (before, r - 1)
+        return (value if value > self.tol else -math.inf), pick
+
+
+def _staircase(front: _Front, after: _Staircase | None, tol: float) -> _Staircase:
+    """The staircase of an action whose arcs are ``front``, given the one of the next action."""
+    if after is None:  # the last action collapses one basin: only single basins count
+        pairs = [(math.inf, a) for a in front.arcs if a.span <= 0.0]
+    else:
+        pairs = [(after.tau(a.span)[0], a) for a in front.arcs]
+        pairs = [(r, a) for r, a in pairs if r > tol]
+    # Most rest first; of equal rest the widest (then the first) leads and the rest drop out.
+    order = sorted(range(len(pairs)), key=lambda n: (-pairs[n][0], -pairs[n][1].width, n))
+    arcs: list[_Arc] = []
+    rest: list[float] = []
+    for n in order:
+        r, a = pairs[n]
+        if not arcs or a.width > arcs[-1].width:
+            arcs.append(a)
+            rest.append(r)
+    return _Staircase(arcs, rest, [a.width - 2.0 * r for a, r in zip(arcs, rest, strict=True)], tol)
+
+
+@dataclass(slots=True)
+class _Planner:
+    """The fronts and staircases of one problem, computed on first use."""
+
+    problem: Problem
+    tol: float
+    max_span: float
+    fronts: dict[str, _Front]
+    stairs: dict[tuple[str, ...], _Staircase]
+
+    def front(self, kind: str) -> _Front:
+        """The arc front of one action type."""
+        if kind not in self.fronts:
+            self.fronts[kind] = _arc_front(self.problem.transfers[kind], self.max_span)
+        return self.fronts[kind]
+
+    def stair(self, kinds: tuple[str, ...]) -> _Staircase:
+        """The staircase of the first of ``kinds`` followed by the rest."""
+        if kinds not in self.stairs:
+            after = self.stair(kinds[1:]) if len(kinds) > 1 else None
+            self.stairs[kinds] = _staircase(self.front(kinds[0]), after, self.tol)
+        return self.stairs[kinds]
+
+    def witnesses(self, kinds: tuple[str, ...], length: float) -> tuple[list[_Arc], float | None]:
+        """The chain of witness arcs of largest least margin, and that margin.
+
+        ``length`` is the success arc's length; the first witness is an arc that wide.
+        """
+        front = self.front(kinds[0])
+        wide = front.arcs[bisect.bisect_left(front.width, length - self.tol) :]
+        if len(kinds) == 1:
+            return [next(a for a in wide if a.span <= 0.0)], None
+        stair = self.stair(kinds[1:])
+        rest = [stair.tau(a.span)[0] for a in wide]
+        best = max(rest)
+        if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
+            raise PlanningError("internal error: no witness chain for a plan the lengths allow")
+        chain = [wide[next(n for n, r in enumerate(rest) if r >= best - self.tol)]]
+        for m in range(1, len(kinds)):
+            stair = self.stair(kinds[m:])
+            chain.append(stair.arcs[stair.tau(chain[-1].span)[1]])
+        return chain, best
 
 
 def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
@@ -97,6 +270,13 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     Returns
     -------
     PlanReport
+        ``options[k - 1]`` is the best plan of ``k`` actions: the least expected cost of
+        those with ``k`` actions, except the last, the most certain one.
+
+    Raises
+    ------
+    PlanningError
+        If ``max_actions`` is less than 1.
 
     Examples
     --------
@@ -105,6 +285,8 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     >>> rep = plan_exact(Problem.build(rect))
     >>> [round(o.expected_cost, 1) for o in rep.options], rep.bayes
     ([6.3, 6.0], 1)
+    >>> [round(math.degrees(a), 2) for a in rep.options[1].alphas]
+    [-45.0]
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
@@ -112,13 +294,14 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     group = problem.goal_group
     prior = problem.prior
     kinds = problem.action_kinds
-    transfers = problem.transfers
-    cap = min(max(transfers[t].period for t in kinds), TWO_PI / group)
+    periods = [problem.transfers[t].period for t in kinds]
+    cap = min(max(periods), TWO_PI / group)  # no plan orients beyond the period
     p_best, _ = prior.max_arc_mass(cap, group)
+    planner = _Planner(problem, tol, max(periods) + tol, {}, {})
 
     counts_of = {t: i for i, t in enumerate(kinds)}
     zero = (0,) * len(kinds)
-    best: dict[tuple[int, ...], _Witness] = {}  # widest arc for each count of action types
+    best: dict[tuple[int, ...], tuple[float, str]] = {}  # widest arc, first type, per count
     options: list[PlanOption] = []
     level: list[tuple[int, ...]] = [zero]
     limit_hard = 4 * problem.part.hull.n_sides + 8
@@ -126,31 +309,31 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     while True:
         k += 1
         nxt: dict[tuple[int, ...], None] = {}
-        candidates: list[tuple[tuple[int, ...], _Witness]] = []
+        candidates: list[tuple[tuple[int, ...], str, float]] = []
         for rest in level:
             for t in kinds:
                 counts = list(rest)
                 counts[counts_of[t]] += 1
                 key = tuple(counts)
-                limit = best[rest].width if rest != zero else 3.0 * tol
-                w = _widest(transfers[t], limit, tol)
-                candidates.append((key, w))
+                limit = best[rest][0] if rest != zero else 3.0 * tol
+                width = _widest(planner.front(t), limit, tol)
+                candidates.append((key, t, width))
                 nxt[key] = None
-                if key not in best or w.width > best[key].width + tol:
-                    best[key] = w
+                if key not in best or width > best[key][0] + tol:
+                    best[key] = (width, t)
         scored = []
-        for key, w in candidates:
-            p, start = prior.max_arc_mass(min(w.width, cap), group, prefer=w.lo)
-            chain = _chain(best, key, w, counts_of)
-            cost = problem.cost.expected_cost(tuple(x.kind for x in chain), p)
-            scored.append((p, cost, key, chain, start))
+        for key, t, width in candidates:
+            p, _ = prior.max_arc_mass(min(width, cap), group)
+            order = _order(best, key, t, counts_of)
+            scored.append((p, problem.cost.expected_cost(order, p), order, width))
         top_p = max(s[0] for s in scored)
         done = top_p >= p_best - 1e-12 or (max_actions is not None and k >= max_actions)
         if done:  # the last level shows its most certain plan
             pick = min(scored, key=lambda s: (-round(s[0], 12), s[1]))
         else:
             pick = min(scored, key=lambda s: (s[1], -s[0]))
-        options.append(_option(pick[0], pick[1], pick[3], pick[4]))
+        p, cost, order, width = pick
+        options.append(_option(planner, order, width, min(width, cap), p, cost))
         if done:
             break
         if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
@@ -160,33 +343,70 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     return PlanReport(problem, tuple(options), bayes, most, "exact")
 
 
-def _chain(
-    best: dict[tuple[int, ...], _Witness],
+def _order(
+    best: dict[tuple[int, ...], tuple[float, str]],
     key: tuple[int, ...],
-    first: _Witness,
+    first: str,
     counts_of: dict[str, int],
-) -> list[_Witness]:
-    """Witness arcs of a plan, first action first."""
-    chain = [first]
+) -> tuple[str, ...]:
+    """Action types of a plan in order: the first, then the best order of the rest."""
+    kinds = [first]
     counts = list(key)
-    counts[counts_of[first.kind]] -= 1
+    counts[counts_of[first]] -= 1
     while any(counts):
-        w = best[tuple(counts)]
-        chain.append(w)
-        counts[counts_of[w.kind]] -= 1
-    return chain
+        kind = best[tuple(counts)][1]
+        kinds.append(kind)
+        counts[counts_of[kind]] -= 1
+    return tuple(kinds)
 
 
-def _option(p: float, cost: float, chain: list[_Witness], start: float) -> PlanOption:
-    """Turn a chain of witness arcs into concrete angles, margins and the final orientation."""
-    steps = [PlanStep(chain[0].kind, _wrap(start - chain[0].lo))]
-    margins = []
+def _option(
+    planner: _Planner,
+    kinds: tuple[str, ...],
+    width: float,
+    placed: float,
+    p: float,
+    cost: float,
+) -> PlanOption:
+    """Turn a plan's action types and success-arc width into angles, margin and goal.
+
+    ``placed`` is the length of arc the prior is placed on (``width`` capped at the period).
+    """
+    problem = planner.problem
+    chain, tolerance = planner.witnesses(kinds, width)
+    _, start = problem.prior.max_arc_mass(placed, problem.goal_group, prefer=chain[0].lo)
+    angles = [start - chain[0].lo]
     for prev, w in itertools.pairwise(chain):
         # Centre the image [s_first, s_last] of the previous arc inside this witness.
-        alpha = 0.5 * (prev.s_first + prev.s_last) - 0.5 * (w.lo + w.hi)
-        steps.append(PlanStep(w.kind, _wrap(alpha)))
-        margins.append(0.5 * (w.width - (prev.s_last - prev.s_first)))
-    final = math.fmod(chain[-1].s_first, TWO_PI)
-    tolerance = min(margins) if margins else None
-    arc = (start, start + chain[0].width)
-    return PlanOption(tuple(steps), final, p, cost, tolerance, arc)
+        angles.append(0.5 * (prev.s_first + prev.s_last) - 0.5 * (w.lo + w.hi))
+    steps, turned = _short_turns(kinds, angles)
+    final = math.fmod(chain[-1].s_first + turned + TWO_PI, TWO_PI)
+    return PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + chain[0].width))
+
+
+def _short_turns(kinds: tuple[str, ...], angles: list[float]) -> tuple[list[PlanStep], float]:
+    """Steps with each squeeze's gripper angle in ``(-pi/2, pi/2]``, and the final frame's turn.
+
+    A squeeze gripper turned by pi is the same gripper with its jaws swapped: the part then
+    lies pi further round in its frame, and stays pi further round after the squeeze
+    (``s(theta + pi) = s(theta) + pi``). So a squeeze angle may change by pi if the next
+    angle changes by pi too (or, after the last action, the final orientation). A push-grasp
+    has a pushing side, so its angle keeps whatever it receives.
+    """
+    steps = []
+    carry = 0.0  # how much further round the part lies in the current frame
+    for kind, angle in zip(kinds, angles, strict=True):
+        a = _wrap(angle + carry)
+        carry = 0.0
+        if kind == "squeeze":
+            short = _wrap(2.0 * a) / 2.0  # in (-pi/2, pi/2]
+            carry = a - short  # 0 or +-pi
+            a = short
+        steps.append(PlanStep(kind, a))
+    return steps, carry
+
+
+def _wrap(a: float) -> float:
+    """Angle in (-pi, pi]."""
+    r = math.remainder(a, TWO_PI)
+    return math.pi if r == -math.pi else r
