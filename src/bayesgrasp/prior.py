@@ -270,7 +270,9 @@ class SamplePrior(Prior):
             raise PriorError(f"sample `angles` must be numbers; {exc}") from None
         if len(a) == 0 or not np.all(np.isfinite(a)):
             raise PriorError(f"a sample prior needs at least one finite angle; got {len(a)}")
-        a = np.sort(np.mod(a, TWO_PI))
+        a = np.mod(a, TWO_PI)
+        a[a >= TWO_PI] = 0.0  # np.mod(-1e-20, 2 pi) rounds to 2 pi, the same angle as 0
+        a = np.sort(a)
         a.setflags(write=False)
         object.__setattr__(self, "angles", a)
 
@@ -304,7 +306,13 @@ class SamplePrior(Prior):
         i = int(np.argmax(counts))
         slack = length - (ext[last[i]] - folded[i])
         start = float(folded[i] - slack / 2)
-        pref_mass = float(self.arc_mass(prefer, length, group))
+        # The open arc at ``prefer`` leaves out the atoms exactly at its start (copies too).
+        starts = np.mod(prefer + period * np.arange(group), TWO_PI)
+        starts[starts >= TWO_PI] = 0.0
+        at_start = np.searchsorted(self.angles, starts, side="right") - np.searchsorted(
+            self.angles, starts, side="left"
+        )
+        pref_mass = float(self.arc_mass(prefer, length, group)) - float(at_start.sum()) / n
         if pref_mass >= counts[i] / n - tol:
             return pref_mass, float(prefer)
         return float(counts[i] / n), start
