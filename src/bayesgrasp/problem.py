@@ -76,8 +76,29 @@ class CostModel:
             value = getattr(self, name)
             if value is None:
                 continue
-            if not isinstance(value, int | float) or not math.isfinite(value) or value < 0:
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not math.isfinite(value)
+                or value < 0
+            ):
                 raise CostError(f"cost `{name}` must be a finite number >= 0; got {value!r}")
+
+    def check_positive(self, kinds: tuple[str, ...]) -> None:
+        """Raise :class:`CostError` if every plan made of these action types costs nothing.
+
+        Expected costs could not rank such plans.
+        """
+        costs = [self.verify, self.retry] + [self.action_cost(k) for k in kinds]
+        if "squeeze" in kinds and self.first_squeeze is not None:
+            costs.append(self.first_squeeze)
+        if not any(c > 0 for c in costs):
+            names = ", ".join(
+                ["`verify`", "`retry`"]
+                + (["`squeeze`", "`first_squeeze`"] if "squeeze" in kinds else [])
+                + (["`push_grasp`"] if "push-grasp" in kinds else [])
+            )
+            raise CostError(f"at least one of the costs {names} must be positive; got all zero")
 
     def action_cost(self, kind: str, first: bool = False) -> float:
         """Cost of one action of the given kind."""
@@ -236,14 +257,10 @@ class Problem:
                 raise PlanningError(
                     f"unknown action type {kind!r}; expected 'squeeze' or 'push-grasp'"
                 )
-        return cls(
-            part,
-            prior or UniformPrior(),
-            transfers,
-            cost or CostModel(),
-            goal or Goal(),
-            tuple(dict.fromkeys(actions)),
-        )
+        kinds = tuple(dict.fromkeys(actions))
+        cost = cost or CostModel()
+        cost.check_positive(kinds)
+        return cls(part, prior or UniformPrior(), transfers, cost, goal or Goal(), kinds)
 
     @property
     def states(self) -> TransferFunction:

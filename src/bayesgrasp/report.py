@@ -138,17 +138,20 @@ def plan_table(report: PlanReport) -> str:
     lines = [
         f"{pb.part.name}: {pb.part.hull.n_sides} sides, {pb.n_states} stable orientations, "
         f"prior {pb.prior.name}, goal {pb.goal.kind}, method {report.method}",
-        f"first squeeze at {math.degrees(report.bayes_plan.first_angle):.2f} deg (world frame); "
-        "alpha = gripper turn before each further squeeze",
-        f"{'k':>3}  {'alphas (deg)':<34} {'final (deg)':>11} {'P(success)':>10} "
-        f"{'E[cost]':>8} {'tol (deg)':>9}",
+        "first: gripper angle of the first squeeze (world frame); "
+        "alphas: gripper turn before each further squeeze",
+        "(relative to the previous squeeze); final: the part's orientation in the last gripper "
+        "frame",
+        f"{'k':>3} {'first (deg)':>11}  {'alphas (deg)':<34} {'final (deg)':>11} "
+        f"{'P(success)':>10} {'E[cost]':>8} {'tol (deg)':>9}",
     ]
     for i, o in enumerate(report.options):
         marks = ("B" if i == report.bayes else " ") + ("C" if i == report.most_certain else " ")
         tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f}"
         lines.append(
-            f"{o.n_actions:>3}  {_plan_text(o):<34} {math.degrees(o.final_orientation):11.2f} "
-            f"{o.success_probability:10.4f} {o.expected_cost:8.3f} {tol:>9} {marks}"
+            f"{o.n_actions:>3} {math.degrees(o.first_angle):11.2f}  {_plan_text(o):<34} "
+            f"{math.degrees(o.final_orientation):11.2f} {o.success_probability:10.4f} "
+            f"{o.expected_cost:8.3f} {tol:>9} {marks}".rstrip()
         )
     lines.append("B = Bayes plan (least expected cost), C = most certain plan")
     if report.nodes is not None:
