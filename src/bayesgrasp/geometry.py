@@ -13,8 +13,10 @@ rotation of the part *as given* relative to the gripper frame.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -52,17 +54,41 @@ def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
     (3, 2)
     """
     try:
-        arr = np.array(points, dtype=np.float64)
+        raw = np.asarray(points)
     except (TypeError, ValueError) as exc:
         raise PartError(
             f"`{what}` must be numbers of shape (N, 2); could not read them: {exc}"
         ) from None
+    if raw.dtype.kind not in "iuf":
+        _check_real(raw, what)
+    arr = np.array(raw, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise PartError(f"`{what}` must have shape (N, 2); got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
         raise PartError(f"`{what}` must be finite; point {bad} is {arr[bad].tolist()}")
     return arr
+
+
+_KIND_NAMES = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes"}
+
+
+def _check_real(raw: NDArray[Any], what: str) -> None:
+    """Refuse arrays of anything but real numbers (text, booleans, complex, None ...).
+
+    ``np.array(["1", "2"], dtype=float)`` would quietly parse text and booleans would become
+    0 and 1; coordinates must be numbers.
+    """
+    if raw.dtype.kind == "O":
+        for x in raw.flat:
+            if isinstance(x, bool | np.bool_) or not isinstance(x, numbers.Real):
+                raise PartError(
+                    f"`{what}` must be numbers of shape (N, 2); got a {type(x).__name__} "
+                    f"({x!r:.40})"
+                )
+        return
+    name = _KIND_NAMES.get(raw.dtype.kind, f"values of type {raw.dtype}")
+    raise PartError(f"`{what}` must be numbers of shape (N, 2); got {name}")
 
 
 def polygon_area_centroid(vertices: FloatArray) -> tuple[float, FloatArray]:
@@ -85,16 +111,21 @@ def polygon_area_centroid(vertices: FloatArray) -> tuple[float, FloatArray]:
     >>> a, c.tolist()
     (2.0, [1.0, 0.5])
     """
-    # Shift to the first vertex: keeps the cross products well conditioned far from the origin.
+    # Shift to the first vertex: keeps the cross products well conditioned far from the origin;
+    # and scale to unit size: the products neither overflow nor underflow (1e150 or 1e-150).
     origin = vertices[0]
     p = vertices - origin
-    q = np.roll(p, -1, axis=0)
-    cross = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]  # (N,)
-    area = 0.5 * float(cross.sum())
-    if area == 0.0:
+    scale = float(np.max(np.abs(p)))
+    if not 0.0 < scale < math.inf:
         return 0.0, vertices.mean(axis=0)
-    centroid = ((p + q) * cross[:, None]).sum(axis=0) / (6.0 * area)
-    return area, centroid + origin
+    p = p / scale
+    q = np.concatenate((p[1:], p[:1]))
+    cross = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]  # (N,)
+    unit_area = 0.5 * float(cross.sum())
+    if unit_area == 0.0:
+        return 0.0, vertices.mean(axis=0)
+    centroid = ((p + q) * cross[:, None]).sum(axis=0) * (scale / (6.0 * unit_area))
+    return unit_area * scale * scale, centroid + origin
 
 
 def _hull_indices(points: FloatArray) -> NDArray[np.intp]:
@@ -179,15 +210,45 @@ class ConvexPolygon:
 
     def __post_init__(self) -> None:
         v = as_points(self.vertices)
+        n = len(v)
+        what = "`vertices` must be a counter-clockwise convex polygon"
+        if n < 3:
+            raise PartError(f"{what} of at least 3 vertices; got {n}")
         area, centroid = polygon_area_centroid(v)
-        if len(v) < 3 or area <= 0:
-            raise PartError("`vertices` must be a counter-clockwise convex polygon")
+        size = float(np.max(np.hypot(*(v - centroid).T)))
+        e = np.concatenate((v[1:], v[:1])) - v  # (N, 2) edge i runs from vertex i to i + 1
+        elen = np.hypot(e[:, 0], e[:, 1])
+        short = np.flatnonzero(elen <= self.tol.length_for(size))
+        if len(short):
+            raise PartError(f"{what}; vertices {short[0]} and {(short[0] + 1) % n} coincide")
+        en = np.concatenate((e[1:], e[:1]))  # (N, 2) the edge after each edge
+        cross = e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0]
+        right = np.flatnonzero(cross < -self.tol.angle * elen * np.roll(elen, -1))
+        if len(right):
+            raise PartError(f"{what}; it turns clockwise at vertex {(right[0] + 1) % n}")
+        turns = float(np.sum(np.arctan2(cross, np.sum(e * en, axis=1)))) / (2.0 * math.pi)
+        if abs(turns - 1.0) > 1e-6:
+            raise PartError(f"{what}; it winds {turns:.3g} times around")
+        self._set(v, area, centroid, size)
+
+    def _set(self, v: FloatArray, area: float, centroid: FloatArray, size: float) -> None:
         v.setflags(write=False)
         centroid.setflags(write=False)
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "area", area)
         object.__setattr__(self, "centroid", centroid)
-        object.__setattr__(self, "size", float(np.max(np.hypot(*(v - centroid).T))))
+        object.__setattr__(self, "size", size)
+
+    @classmethod
+    def _trusted(
+        cls, v: FloatArray, tol: Tolerance, area: float, centroid: FloatArray
+    ) -> ConvexPolygon:
+        """A polygon known to be convex and counter-clockwise (from a hull or a rotation)."""
+        poly = object.__new__(cls)
+        object.__setattr__(poly, "tol", tol)
+        d = v - centroid
+        poly._set(v, area, centroid, math.sqrt(float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2))))
+        return poly
 
     @classmethod
     def from_points(cls, points: ArrayLike, tol: Tolerance = DEFAULT_TOLERANCE) -> ConvexPolygon:
@@ -218,18 +279,25 @@ class ConvexPolygon:
         pts = as_points(points)
         extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
         eps = tol.length_for(extent)
-        if len(pts) >= 1:
-            distinct = np.unique(np.round((pts - pts.min(axis=0)) / max(eps, 1e-300)), axis=0)
-        if len(pts) < 3 or extent == 0.0 or len(distinct) < 3:
-            raise PartError(
-                f"a part needs at least 3 distinct points; got {len(pts)} point(s) "
-                f"with {len(distinct) if len(pts) else 0} distinct"
-            )
-        hull = pts[_hull_indices(pts)]
-        hull = _drop_near_collinear(hull, eps) if len(hull) >= 3 else hull
-        if len(hull) < 3 or polygon_area_centroid(hull)[0] <= eps * extent:
+        hull = pts[_hull_indices(pts)] if len(pts) >= 3 and extent > 0.0 else pts[:0]
+        if len(hull) > 3:
+            hull = _drop_near_collinear(hull, eps)
+        area = 0.0
+        if len(hull) >= 3:
+            area, centroid = polygon_area_centroid(hull)
+        if len(hull) < 3 or area <= eps * extent:
+            # Tell "too few points" from "collinear" only on failure (np.unique is slow).
+            distinct = 0
+            if len(pts):
+                grid = np.round((pts - pts.min(axis=0)) / max(eps, 1e-300))
+                distinct = len(np.unique(grid, axis=0))
+            if distinct < 3:
+                raise PartError(
+                    f"a part needs at least 3 distinct points; got {len(pts)} point(s) "
+                    f"with {distinct} distinct"
+                )
             raise PartError("the part's points are all collinear; a part needs a non-zero area")
-        return cls(hull, tol)
+        return cls._trusted(hull, tol, area, centroid)
 
     @property
     def n_sides(self) -> int:
@@ -249,7 +317,9 @@ class ConvexPolygon:
         """
         c, s = math.cos(angle), math.sin(angle)
         rot = np.array([[c, -s], [s, c]])
-        return ConvexPolygon(self.vertices @ rot.T, self.tol)
+        return ConvexPolygon._trusted(
+            self.vertices @ rot.T, self.tol, self.area, rot @ self.centroid
+        )
 
     @property
     def symmetry_order(self) -> int:
@@ -266,8 +336,9 @@ class ConvexPolygon:
         v = self.vertices - self.centroid
         n = len(v)
         eps = self.tol.symmetry_for(self.size)
+        radii = np.hypot(v[:, 0], v[:, 1])  # (N,) a rotation about the centroid keeps them
         for r in range(n, 1, -1):
-            if n % r:
+            if n % r or np.max(np.abs(np.roll(radii, -n // r) - radii)) > eps:
                 continue
             a = 2.0 * math.pi / r
             c, s = math.cos(a), math.sin(a)

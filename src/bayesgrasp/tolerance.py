@@ -27,7 +27,8 @@ class Tolerance:
     symmetry : float
         A rotation maps the part onto itself when every vertex lands within
         ``symmetry * size`` of a vertex; looser than ``length`` because symmetric parts
-        often come from rounded coordinates.
+        often come from rounded coordinates (7 significant digits move a vertex of a part
+        drawn a few sizes from the origin by up to about ``2e-6 * size``).
     probability : float
         Probabilities closer than this are equal (ties between plans).
 
@@ -39,7 +40,7 @@ class Tolerance:
 
     length: float = 1e-10
     angle: float = 1e-9
-    symmetry: float = 1e-6
+    symmetry: float = 1e-5
     probability: float = 1e-12
 
     def length_for(self, size: float) -> float:
