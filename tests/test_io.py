@@ -658,6 +658,70 @@ def test_dxf_rational_spline_and_block_reference(tmp_path: Path) -> None:
     assert_allclose(p.center_of_mass, [110, 60], atol=1e-9)
 
 
+def test_dxf_polylines_2d_3d_and_closed_spline(tmp_path: Path) -> None:
+    doc, msp = new_dxf()
+    b = math.tan(math.pi / 8)
+    # An old-style 2D POLYLINE whose last vertex repeats the first (closed without the flag).
+    msp.add_polyline2d(
+        [
+            (5, 0, 0, 0, 0),
+            (35, 0, 0, 0, b),
+            (40, 5, 0, 0, 0),
+            (40, 20, 0, 0, 0),
+            (5, 20, 0, 0, 0),
+            (5, 0, 0, 0, 0),
+        ],
+        format="xyseb",
+    )
+    p = read_part(save(doc, tmp_path, "poly2d.dxf"), tolerance=0.01)
+    corner = p.outline[(p.outline[:, 0] > 35 + 1e-9) & (p.outline[:, 1] < 5 - 1e-9)]
+    assert len(corner) >= 2
+    assert_allclose(np.hypot(corner[:, 0] - 35, corner[:, 1] - 5), 5, atol=1e-12)
+
+    doc, msp = new_dxf()
+    msp.add_polyline3d([(0, 0, 1), (4, 0, 2), (4, 3, 3), (0, 3, 4)], close=True)
+    p = read_part(save(doc, tmp_path, "poly3d.dxf"))
+    assert_allclose(p.center_of_mass, [2, 1.5], atol=1e-12)  # projected on xy
+
+    doc, msp = new_dxf()
+    spline = msp.add_spline()  # a periodic ("closed") spline: unclamped knots
+    spline.set_closed([(0, 0, 0), (10, -2, 0), (14, 6, 0), (6, 12, 0), (-3, 7, 0)], degree=3)
+    tol = 0.01
+    p = read_part(save(doc, tmp_path, "closed_spline.dxf"), tolerance=tol)
+    bs = spline.construction_tool()
+    lo, hi = bs.knots()[bs.degree], bs.knots()[bs.count]  # the curve's valid domain
+    dense = np.array([[v.x, v.y] for v in bs.points(np.linspace(lo, hi, 20001))])
+    assert ring_distance(dense, p.outline).max() <= tol * (1 + 1e-9)
+    assert ring_distance(p.outline, dense).max() <= 1e-4  # no points off the curve
+
+
+@pytest.mark.parametrize(
+    ("order", "knots", "weights"),
+    [
+        (4, [0, 1, 2, 3, 4, 5, 6, 7, 8, 9], None),
+        (3, [0, 1, 2, 3, 4, 5, 6, 7, 8], [1, 2, 1, 3, 1, 2]),
+        (4, [0, 0.5, 2, 3, 3, 5, 6, 7, 9.5, 10], None),
+        (4, [0, 0, 0, 0, 1, 2, 3, 4, 4.5, 6], [1, 1, 0.5, 2, 1, 1]),
+    ],
+)
+def test_unclamped_splines_are_restricted_to_their_domain(
+    order: int, knots: list[float], weights: list[float] | None
+) -> None:
+    from ezdxf.math import BSpline
+
+    from bayesgrasp.io.dxf import _clamped
+
+    pts = [(0, 0, 0), (5, 8, 0), (10, 0, 0), (15, 5, 0), (20, 0, 0), (25, 3, 0)]
+    bs = BSpline(pts, order=order, knots=knots, weights=weights)
+    clamped = _clamped(bs)
+    assert clamped.is_clamped
+    lo, hi = knots[order - 1], knots[len(pts)]
+    u0, u1 = clamped.knots()[0], clamped.max_t
+    ref = np.array([list(v) for v in bs.points(np.linspace(lo, hi, 301))])
+    got = np.array([list(v) for v in clamped.points(np.linspace(u0, u1, 301))])
+    assert_allclose(got, ref, atol=1e-12)
+
+
 def two_squares(tmp_path: Path, layers: tuple[str, str]) -> Path:
     doc, msp = new_dxf()
     msp.add_lwpolyline(

@@ -141,18 +141,67 @@ def _polyline_curves(
     return curves
 
 
+def _insert_knot(
+    ctrl: FloatArray, knots: list[float], degree: int, t: float
+) -> tuple[FloatArray, list[float]]:
+    """Boehm's knot insertion: the same curve with one more knot at ``t`` (any dimension)."""
+    # The span holding t (knots[k] <= t < knots[k + 1]); the domain's end uses the last span.
+    k = min(int(np.searchsorted(knots, t, side="right")) - 1, len(ctrl) - 1)
+    new = np.empty((len(ctrl) + 1, ctrl.shape[1]))
+    new[: k - degree + 1] = ctrl[: k - degree + 1]
+    for i in range(k - degree + 1, k + 1):
+        alpha = (t - knots[i]) / (knots[i + degree] - knots[i])
+        new[i] = (1.0 - alpha) * ctrl[i - 1] + alpha * ctrl[i]
+    new[k + 1 :] = ctrl[k:]
+    return new, [*knots[: k + 1], t, *knots[k + 1 :]]
+
+
+def _clamped(bs: Any) -> Any:
+    """The B-spline restricted to its valid domain ``[knots[p], knots[n]]``, clamped.
+
+    An unclamped spline (a periodic "closed" spline) is only defined between those knots;
+    evaluating it outside gives points that are not on the drawn curve. Inserting each end
+    knot up to multiplicity ``p`` and dropping the control points outside makes the same
+    curve with clamped ends (rational splines in homogeneous coordinates).
+    """
+    from ezdxf.math import BSpline
+
+    p = bs.degree
+    knots = [float(k) for k in bs.knots()]
+    n = bs.count
+    a, b = knots[p], knots[n]
+    weights = np.asarray(bs.weights(), dtype=np.float64) if bs.is_rational else np.ones(n)
+    pts = np.array([[v[0], v[1]] for v in bs.control_points], dtype=np.float64)
+    ctrl = np.column_stack([pts * weights[:, None], weights])  # (n, 3) homogeneous
+    for t in (a, b):
+        while sum(1 for k in knots if math.isclose(k, t, rel_tol=0, abs_tol=1e-12)) < p:
+            ctrl, knots = _insert_knot(ctrl, knots, p, t)
+    at_a = [i for i, k in enumerate(knots) if math.isclose(k, a, rel_tol=0, abs_tol=1e-12)]
+    at_b = [i for i, k in enumerate(knots) if math.isclose(k, b, rel_tol=0, abs_tol=1e-12)]
+    first = at_a[0] + len(at_a) - p - 1  # control points whose support meets [a, b]
+    last = at_b[0] - 1
+    sub = ctrl[first : last + 1]
+    sub_knots = [a] * (p + 1) + knots[at_a[-1] + 1 : at_b[0]] + [b] * (p + 1)
+    w = sub[:, 2]
+    xyz = [(x / wi, y / wi, 0.0) for (x, y, _), wi in zip(sub, w, strict=True)]
+    if bs.is_rational:
+        return BSpline(xyz, order=p + 1, knots=sub_knots, weights=list(w))
+    return BSpline(xyz, order=p + 1, knots=sub_knots)
+
+
 def _spline_curves(entity: Any) -> list[Curve]:
     bs = entity.construction_tool()
+    if not bs.is_clamped:
+        bs = _clamped(bs)
+    if not bs.is_rational:
+        return [
+            Bezier(np.array([[v[0], v[1]] for v in piece], dtype=np.float64))
+            for piece in bs.bezier_decomposition()
+        ]
     ctrl = np.array([[v[0], v[1]] for v in bs.control_points], dtype=np.float64)
-    if bs.is_rational or not bs.is_clamped:
-        first = _xy(bs.point(bs.max_t * 0.0))
-        last = _xy(bs.point(bs.max_t))
-        box = np.array([ctrl.min(axis=0), ctrl.max(axis=0)])
-        return [Adaptive(lambda tol: ((v[0], v[1]) for v in bs.flattening(tol)), first, last, box)]
-    return [
-        Bezier(np.array([[v[0], v[1]] for v in piece], dtype=np.float64))
-        for piece in bs.bezier_decomposition()
-    ]
+    first, last = _xy(bs.point(0.0)), _xy(bs.point(bs.max_t))
+    box = np.array([ctrl.min(axis=0), ctrl.max(axis=0)])  # weights > 0: convex hull property
+    return [Adaptive(lambda tol: ((v[0], v[1]) for v in bs.flattening(tol)), first, last, box)]
 
 
 def _entity_curves(entity: Any) -> tuple[list[Curve], bool] | None:
