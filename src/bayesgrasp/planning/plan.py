@@ -34,17 +34,22 @@ class PlanOption:
     Attributes
     ----------
     steps : tuple of PlanStep
-        ``steps[0].alpha`` is the world gripper angle of the first action.
+        ``steps[0].alpha`` is the world gripper angle of the first action; ``steps[i].alpha``
+        (i >= 1) the turn of the gripper relative to the previous action (the exact planner
+        gives squeeze turns in ``(-pi/2, pi/2]``: a gripper turned by pi is the same gripper).
     final_orientation : float
-        The goal orientation of the part in the frame of the last action (radians).
+        The goal orientation of the part in the frame of the last action (radians, in
+        ``[0, 2 pi)``).
     success_probability : float
         Probability that the part ends at the goal (or, for a symmetry goal, one of its
         symmetric copies).
     expected_cost : float
         Expected cost of repeating the plan until verification succeeds.
     tolerance : float or None
-        Largest error on every relative rotation ``alpha_2..alpha_k`` (together) that keeps
-        the success probability; ``None`` for a single action.
+        Every relative turn ``alpha_2..alpha_k`` may be off by less than this, all at once and
+        with any signs, and every orientation of ``success_arc`` still ends at the goal
+        (the exact planner: the largest such margin of any plan with this probability).
+        ``None`` for a single action.
     success_arc : tuple of float
         An open arc ``(lo, hi)`` of initial world orientations that the plan sends to the goal.
     """
