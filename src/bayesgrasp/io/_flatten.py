@@ -9,7 +9,7 @@ from ``P(t)`` to its chord is at most ``h**2 / 8 * max |P''|`` (linear interpola
 - Elliptic arcs ``P(t) = c + M cos t + m sin t`` (circles, arcs, bulges, SVG arcs, DXF
   ellipses): ``|P''| <= sigma``, the largest singular value of ``[M m]`` (the major radius).
 - Bezier curves of degree ``d``: ``|B''| <= d (d - 1) max_i |P_i - 2 P_{i+1} + P_{i+2}|``.
-- Curves given only as a sampler (rational or unclamped DXF splines) are flattened by
+- Curves given only as a sampler (rational DXF splines) are flattened by
   ezdxf's adaptive subdivision, which checks the distance at the middle of each chord.
 
 The number of points of a curve is known before it is sampled, so a curve that would
@@ -260,7 +260,7 @@ class Bezier(Curve):
 class Adaptive(Curve):
     """A curve known through a sampler ``flatten(tol) -> iterable of (x, y)``.
 
-    Used for curves whose derivatives the readers do not bound (rational or unclamped
+    Used for curves whose derivatives the readers do not bound (rational
     splines); the sampler is ezdxf's adaptive subdivision.
     """
 
