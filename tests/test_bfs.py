@@ -309,7 +309,7 @@ def test_report_fields() -> None:
     assert [round(o.expected_cost, 1) for o in rep.options] == [6.3, 6.0]
     assert rep.options[0].tolerance is None
     assert rep.options[1].tolerance is not None and rep.options[1].tolerance > 0
-    assert all(-math.pi < s.alpha <= math.pi for o in rep.options for s in o.steps)
+    assert all(-math.pi / 2 < s.alpha <= math.pi / 2 for o in rep.options for s in o.steps)
 
 
 @pytest.mark.parametrize(

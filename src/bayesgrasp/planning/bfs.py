@@ -41,10 +41,11 @@ Choices the seed leaves open, and what this module does:
   expected cost wins; at the final depth the highest probability, then the least cost
   (as :func:`~bayesgrasp.planning.exact.plan_exact` does). With one action kind that
   is just the highest probability at every depth.
-- *Tolerance.* Each action is the midpoint of its class interval; the reported tolerance is
-  the *class margin*: half the width of the narrowest chosen class. Within it every state,
-  not only the goal's, goes where the plan says, so it is a lower bound on the exact
-  planner's tolerance.
+- *Angles and tolerance.* Each action is the midpoint of its class interval; a squeeze
+  angle is turned by pi into ``(-pi/2, pi/2]`` when needed (the same gripper; the final
+  orientation follows). The reported tolerance is the *class margin*: half the width of
+  the narrowest chosen class. Within it every state, not only the goal's, goes where the
+  plan says, so it is a lower bound on the exact planner's tolerance.
 """
 
 from __future__ import annotations
@@ -592,19 +593,40 @@ def _option(s: _Search, v: int, k: int) -> PlanOption:
         dist = s.children(dist, ti_pad)[a]
         mapping = s.classes[ti_pad].transfer[a][mapping]
         path.append((ti_pad, a))
-    steps = [PlanStep(root.kind, _wrap(root.angle))]
+    raw = [(root.kind, root.angle)]
     margins = []
     for ti, a in path:
         cl = s.classes[ti]
-        steps.append(PlanStep(s.kinds[ti], _wrap(float(cl.mid[a]))))
+        raw.append((s.kinds[ti], float(cl.mid[a])))
         margins.append(0.5 * float(cl.hi[a] - cl.lo[a]))
+    steps, turned = _short_turns(raw)
     p = float(s.goal_prob(dist))
     goal = s.goal_state(dist)
-    final = float(s.problem.states.stable[goal])
+    final = math.fmod(float(s.problem.states.stable[goal]) + turned + TWO_PI, TWO_PI)
     kinds = tuple(st.kind for st in steps)
     c = s.problem.cost.expected_cost(kinds, p)
     arc = _success_arc(s.problem, root, mapping, goal)
     return PlanOption(tuple(steps), final, p, c, min(margins) if margins else None, arc)
+
+
+def _short_turns(raw: list[tuple[str, float]]) -> tuple[list[PlanStep], float]:
+    """Steps with every squeeze angle in ``(-pi/2, pi/2]``, and the turn of the final frame.
+
+    A squeeze gripper turned by pi is the same gripper: the part then lies pi further round
+    in its frame, before and after the squeeze (``s(theta + pi) = s(theta) + pi``), which the
+    next angle absorbs (or, after the last action, the final orientation). A push-grasp has a
+    pushing side: its angle absorbs what it receives and keeps it.
+    """
+    steps = []
+    carry = 0.0  # how much further round the part lies in the current frame
+    for kind, angle in raw:
+        a = _wrap(angle + carry)
+        carry = 0.0
+        if kind == "squeeze":
+            short = _wrap(2.0 * a) / 2.0
+            carry, a = a - short, short
+        steps.append(PlanStep(kind, a))
+    return steps, carry
 
 
 def _success_arc(
