@@ -1,0 +1,145 @@
+"""Settings of the physics check, each with its default and the reason for it.
+
+The defaults reproduce the frictionless squeeze model in MuJoCo 4.0.0; they come from the
+feasibility runs recorded in ``physics-notes.md`` (shared with the project) and from the
+measurements of this module's tests and benchmark (README, "Simulation").
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from ..errors import BayesGraspError
+
+__all__ = ["SimParams"]
+
+
+class SimParamsError(BayesGraspError, ValueError):
+    """A physics setting out of range."""
+
+
+@dataclass(frozen=True, slots=True)
+class SimParams:
+    """Physical and numerical settings of a MuJoCo squeeze (SI units: m, kg, s, N, rad).
+
+    Attributes
+    ----------
+    timestep : float
+        1 ms: the notes found 1-2 ms accurate and 0.5 ms with stiff contacts unstable.
+    integrator : str
+        ``implicitfast``: stable with the jaws' joint damping at this timestep.
+    solver : str
+        ``Newton``: the jaws settle; PGS with few iterations left 0.2-degree errors and
+        jaws that never settled (notes).
+    cone : str
+        ``elliptic`` friction cones for the table contact (pyramidal also worked).
+    solref_timeconst : float
+        Contact time constant, 4 ms (at least twice the timestep, as MuJoCo advises); the
+        notes used it.
+    table_friction : float
+        Sliding friction of the part on the table, 0.2 (a plastic part on a smooth metal
+        plate). The notes' 6 g triangle agreed at 0.2 and 0.5, but 5 cm random polygons
+        (10-15 g) stalled at 0.5 where the squeeze's couple ``jaw_force * |d'(theta)|`` is
+        small: 246/277 single squeezes agreed at 0.5, 270/277 at 0.2 (this module's
+        measurement). The jaws are frictionless whatever this is.
+    thickness : float
+        The hull is extruded 1 cm: thin enough that the part does not tip, thick enough for
+        robust side contacts.
+    density : float
+        1000 kg/m^3 (a plastic part): a 4 cm triangle weighs 6 g, so table friction is
+        about 0.012 N, well below the jaw force.
+    jaw_thickness : float
+        4 mm plates.
+    jaw_length : float
+        16 cm plates (along y), or four times the part's size if that is longer: the part
+        never slides off a jaw's end.
+    jaw_mass : float
+        0.1 kg per jaw (notes).
+    jaw_damping : float
+        Slide-joint damping, 20 N s/m: with the force limit, caps a free jaw at 2.5 cm/s and
+        damps the contact (notes).
+    jaw_kp : float
+        Position gain, 400 N/m (the notes used 100 and 400). The force limit, not the gain,
+        sets the squeeze force; once a jaw is blocked its force ramps up at
+        ``jaw_kp * jaw_speed``, so 400 N/m reaches 0.5 N 0.125 s after contact (100 N/m: 0.5 s,
+        squeezes a third longer, the same agreement).
+    jaw_force : float
+        Force limit of each jaw, 0.5 N (notes): 40 times the table friction of a 6 g part,
+        low enough for quasi-static motion and shallow contact penetration (2 N gave the
+        same agreement with four times the orientation error, 0.12 degrees). A squeeze ends
+        only once both jaws push with this force.
+    jaw_speed : float
+        The jaw targets close at 1 cm/s (notes; 5 cm/s also agreed): slow enough to be
+        quasi-static as the model assumes.
+    clearance : float
+        Each jaw starts 3 mm outside the part's extent: short idle travel.
+    settle_speed : float
+        A squeeze ends when both jaws move slower than 0.1 mm/s ...
+    settle_time : float
+        ... for 0.1 s (notes).
+    max_time : float
+        An action that has not settled 2 s (simulated) after its jaws could have crossed
+        the whole opening at ``jaw_speed`` counts as a jam; a squeeze takes about 1 s.
+    check_every : int
+        Steps between two checks of the settling test and updates of the jaw targets (10:
+        the Python loop costs little, the targets move 0.1 mm between updates).
+    jam_tol : float
+        A part that stops farther than 1 degree from every stable orientation jammed (the
+        notes measured a median error of 0.011 degrees when it does not).
+    push_distance : float
+        For a push-grasp, the pushing (-x) jaw travels this far beyond first contact before
+        the other jaw closes; 0 means twice the part's size (enough for the part to turn
+        to a stable push orientation, which needs a travel of the order of its size).
+
+    Examples
+    --------
+    >>> SimParams().jaw_force
+    0.5
+    >>> SimParams(jaw_speed=0.05).jaw_speed
+    0.05
+    """
+
+    timestep: float = 0.001
+    integrator: str = "implicitfast"
+    solver: str = "Newton"
+    cone: str = "elliptic"
+    solref_timeconst: float = 0.004
+    table_friction: float = 0.2
+    thickness: float = 0.01
+    density: float = 1000.0
+    jaw_thickness: float = 0.004
+    jaw_length: float = 0.16
+    jaw_mass: float = 0.1
+    jaw_damping: float = 20.0
+    jaw_kp: float = 400.0
+    jaw_force: float = 0.5
+    jaw_speed: float = 0.01
+    clearance: float = 0.003
+    settle_speed: float = 1e-4
+    settle_time: float = 0.1
+    max_time: float = 2.0
+    check_every: int = 10
+    jam_tol: float = math.radians(1.0)
+    push_distance: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, str):
+                continue
+            nonneg = f.name in ("push_distance", "table_friction")
+            if not math.isfinite(value) or value < 0 or (value == 0 and not nonneg):
+                want = ">= 0" if nonneg else "> 0"
+                raise SimParamsError(
+                    f"simulation setting `{f.name}` must be a finite number {want}; got {value!r}"
+                )
+        if self.integrator not in ("Euler", "RK4", "implicit", "implicitfast"):
+            raise SimParamsError(
+                "`integrator` must be Euler, RK4, implicit or implicitfast; "
+                f"got {self.integrator!r}"
+            )
+        if self.solver not in ("PGS", "CG", "Newton"):
+            raise SimParamsError(f"`solver` must be PGS, CG or Newton; got {self.solver!r}")
+        if self.cone not in ("pyramidal", "elliptic"):
+            raise SimParamsError(f"`cone` must be pyramidal or elliptic; got {self.cone!r}")
