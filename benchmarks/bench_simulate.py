@@ -1,0 +1,91 @@
+"""Speed of plan execution: kinematic Monte Carlo and MuJoCo physics.
+
+Prints:
+- kinematic plan executions per second (one core; numpy), for plans of 1 to 3 squeezes;
+- MuJoCo squeezes per second in one process (and simulated seconds per squeeze);
+- wall time of 500 trials of a 3-squeeze plan with 2 worker processes (target: < 60 s).
+
+The machine's load average is printed too: on a shared machine the figures move with it.
+
+Usage: ``.venv/bin/python benchmarks/bench_simulate.py [--quick]``
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+from bayesgrasp.execute import simulate_kinematic
+from bayesgrasp.planning import plan_exact
+from bayesgrasp.problem import Problem
+from bayesgrasp.shapes import load
+
+
+def load_note() -> str:
+    try:
+        one, five, _ = os.getloadavg()
+    except OSError:  # pragma: no cover - not on every platform
+        return "load average unknown"
+    return f"load average {one:.2f} (1 min), {five:.2f} (5 min) on {os.cpu_count()} cores"
+
+
+def bench_kinematic(trials: int) -> None:
+    print(f"kinematic Monte Carlo, {trials:,} executions a run, best of 3 ({load_note()})")
+    pb = Problem.build(load("triangle"))
+    for opt in plan_exact(pb).options:
+        best = math.inf
+        for rep in range(3):
+            t0 = time.perf_counter()
+            simulate_kinematic(pb, opt, trials, rng=rep)
+            best = min(best, time.perf_counter() - t0)
+        print(
+            f"  triangle, {opt.n_actions} squeeze(s): {trials / best:,.0f} executions/s "
+            f"({best:.3f} s, including sampling and the summary)"
+        )
+
+
+def bench_mujoco(squeezes: int, trials: int) -> None:
+    try:
+        from bayesgrasp.sim import Squeezer, simulate_mujoco
+    except ImportError:  # pragma: no cover
+        print("MuJoCo not installed (extra `sim`): skipped")
+        return
+    part = load("triangle")
+    sq = Squeezer(part, 0.001)
+    rng = np.random.default_rng(0)
+    starts = rng.uniform(0, 2 * math.pi, squeezes)
+    t0 = time.perf_counter()
+    sim_time = 0.0
+    for th in starts:
+        sim_time += sq.act(float(th)).sim_time
+    dt = time.perf_counter() - t0
+    print(f"MuJoCo, one process ({load_note()})")
+    print(
+        f"  {squeezes} squeezes of the triangle: {squeezes / dt:.1f} squeezes/s "
+        f"({1000 * dt / squeezes:.1f} ms each, {sim_time / squeezes:.2f} s simulated each, "
+        f"timestep {sq.params.timestep * 1000:g} ms)"
+    )
+    pb = Problem.build(part)
+    plan = next(o for o in plan_exact(pb).options if o.n_actions == 3)
+    t0 = time.perf_counter()
+    res = simulate_mujoco(pb, plan, trials, rng=1, workers=2)
+    dt = time.perf_counter() - t0
+    print(f"  {trials} trials of a 3-squeeze plan, 2 workers: {dt:.1f} s wall ({load_note()})")
+    print(
+        f"    predicted success {res.predicted_success:.3f}, observed "
+        f"{res.observed_success:.3f}, jams {res.jams}, near-boundary {res.near_boundary}"
+    )
+
+
+def main() -> None:
+    quick = "--quick" in sys.argv
+    bench_kinematic(200_000 if quick else 2_000_000)
+    bench_mujoco(20 if quick else 100, 50 if quick else 500)
+
+
+if __name__ == "__main__":
+    main()
