@@ -252,7 +252,7 @@ class Problem:
             if kind == "push-grasp":
                 from .push import push_grasp_function
 
-                transfers[kind] = push_grasp_function(part)
+                transfers[kind] = push_grasp_function(part, transfers["squeeze"])
             elif kind != "squeeze":
                 raise PlanningError(
                     f"unknown action type {kind!r}; expected 'squeeze' or 'push-grasp'"

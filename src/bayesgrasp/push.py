@@ -217,6 +217,18 @@ def radius_function(part: Part | ConvexPolygon) -> RadiusFunction:
     return RadiusFunction(poly, com, *arrays)
 
 
+def _basins(minima: FloatArray, maxima: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Sorted minima in ``[0, 2 pi)`` and the maxima just below and above each.
+
+    Both arrays are sorted in ``[0, 2 pi)`` and alternate (as transfer_from_extrema builds
+    them).
+    """
+    k = np.searchsorted(maxima, minima)  # (K,) index of the first maximum above
+    hi = np.where(k < len(maxima), maxima[k % len(maxima)], maxima[0] + TWO_PI)
+    lo = np.where(k > 0, maxima[k - 1], maxima[-1] - TWO_PI)
+    return minima, lo, hi
+
+
 def push_function(part: Part | ConvexPolygon | RadiusFunction) -> TransferFunction:
     """The push function: descend the radius function (period ``2 pi``).
 
@@ -270,19 +282,20 @@ def push_grasp_function(
     True
     """
     poly, _ = _hull_and_com(part)
-    push = push_function(part)
+    r = radius_function(part)
+    p_stable, p_lo, p_hi = _basins(r.minima, r.maxima)
     s = squeeze if squeeze is not None else squeeze_function(poly)
-    idx = s.state_index(push.stable)  # squeeze basin holding each push-stable orientation
+    idx = s.state_index(p_stable)  # squeeze basin holding each push-stable orientation
     image = s.stable[idx]  # (K,) in [0, 2 pi)
     # Lift the images next to their push orientations: a non-decreasing sequence whose
     # wrap-around step is 2 pi less (s moves a part by less than pi).
-    lifted = push.stable + (np.mod(image - push.stable + math.pi, TWO_PI) - math.pi)
+    lifted = p_stable + (np.mod(image - p_stable + math.pi, TWO_PI) - math.pi)
     prev = np.roll(lifted, 1)
     prev[0] -= TWO_PI
     first = np.flatnonzero(np.abs(lifted - prev) > s.angle_tol)  # (G,) groups' first basins
     last = np.append(first[1:], first[0] + len(lifted)) - 1
-    lo_ext = np.concatenate([push.basin_lo, push.basin_lo + TWO_PI])
-    hi_ext = np.concatenate([push.basin_hi, push.basin_hi + TWO_PI])
+    lo_ext = np.concatenate([p_lo, p_lo + TWO_PI])
+    hi_ext = np.concatenate([p_hi, p_hi + TWO_PI])
     lo, hi, img = lo_ext[first], hi_ext[last], lifted[first]
     # The image need not lie in its own basin (the squeeze may carry the part past the
     # push's unstable equilibria). Index states by image in [0, 2 pi) and shift each basin
