@@ -723,3 +723,42 @@ def test_plans_invariant_under_similarity(
         assert abs(turn) < 1e-6
         # The moved plan, replayed on the moved part, orients its own success arc.
         assert replay(moved_pb, o1, arc_grid(o1, 201)).all()
+
+
+# --------------------------------------------------------------------------------------
+# Parts with many stable orientations
+# --------------------------------------------------------------------------------------
+
+
+def noisy_circle(rng: np.random.Generator, n: int, noise: float) -> Part:
+    a = np.sort(rng.uniform(0.0, TWO_PI, n))
+    r = 1.0 + noise * rng.uniform(size=n)
+    return Part.from_points(np.column_stack([r * np.cos(a), r * np.sin(a)]))
+
+
+def test_many_states_plans_replay(rng: np.random.Generator) -> None:
+    pb = Problem.build(noisy_circle(rng, 600, 1e-3))
+    rep = plan_exact(pb)
+    assert pb.n_states > 100 and len(rep.options) > 20
+    probs = [o.success_probability for o in rep.options]
+    assert np.all(np.diff(probs) > 0) and probs[-1] == pytest.approx(0.5, abs=1e-12)
+    theta = uniform_grid(1 << 14)
+    for o in rep.options[1::7]:
+        assert o.tolerance is not None
+        for sign in (1.0, -1.0):
+            errors = 0.999 * o.tolerance * sign * np.ones(o.n_actions - 1)
+            assert replay(pb, o, arc_grid(o, 501), errors).all()
+        frac = replay(pb, o, theta).mean()
+        assert_allclose(frac, o.success_probability, atol=3.0 / len(theta))
+
+
+def test_arc_enumeration_in_chunks_changes_nothing(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import bayesgrasp.planning.exact as exact
+
+    pb = Problem.build(noisy_circle(rng, 200, 1e-2))
+    whole = plan_exact(pb)
+    monkeypatch.setattr(exact, "_CHUNK", 50)
+    chunked = plan_exact(Problem.build(pb.part))
+    assert chunked.options == whole.options

@@ -99,16 +99,26 @@ class _Arc:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class _Front:
-    """The arcs of one transfer function that no other arc beats, as plain lists.
+    """The arcs of one transfer function that no other arc beats.
 
     Sorted by ``span`` (of the image) increasing, with ``width`` strictly increasing: an
-    arc is dropped when another is at least as wide and spans no more. Fronts are short
-    (about K arcs for K stable orientations), so the planning below runs on lists.
+    arc is dropped when another is at least as wide and spans no more. Arc ``n`` is the
+    open arc ``(lo[n], lo[n] + width[n])`` with image ``[s_first[n], s_first[n] + span[n]]``.
+    The lists repeat the arrays for the scalar binary searches of the planner.
     """
 
-    arcs: list[_Arc]
-    span: list[float]
-    width: list[float]
+    kind: str
+    lo: FloatArray
+    width: FloatArray
+    s_first: FloatArray
+    span: FloatArray
+    span_list: list[float]
+    width_list: list[float]
+
+    def arc(self, n: int) -> _Arc:
+        """Arc ``n`` as plain floats."""
+        lo, s = float(self.lo[n]), float(self.s_first[n])
+        return _Arc(self.kind, lo, lo + self.width_list[n], s, s + self.span_list[n])
 
 
 def _arc_front(f: TransferFunction, max_span: float) -> _Front:
@@ -124,7 +134,7 @@ def _arc_front(f: TransferFunction, max_span: float) -> _Front:
     last = np.minimum(np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all + k - 1)
     n_off = int(np.max(last - i_all)) + 1
     rows = max(1, _CHUNK // n_off)
-    lo_l, width_l, first_l, span_l = [], [], [], []
+    parts: list[tuple[FloatArray, ...]] = []
     for start in range(0, k, rows):
         i = i_all[start : start + rows]
         j = i[:, None] + np.arange(n_off)[None, :]  # (R, J) candidate last basins
@@ -135,20 +145,11 @@ def _arc_front(f: TransferFunction, max_span: float) -> _Front:
         width = hi2[jj] - lo
         span = s2[jj] - f.stable[ii]
         keep = _front_index(span, width)
-        lo_l.append(lo[keep])
-        width_l.append(width[keep])
-        first_l.append(f.stable[ii][keep])
-        span_l.append(span[keep])
-    lo, width, first, span = (np.concatenate(x) for x in (lo_l, width_l, first_l, span_l))
+        parts.append((lo[keep], width[keep], f.stable[ii][keep], span[keep]))
+    lo, width, first, span = (np.concatenate(x) for x in zip(*parts, strict=True))
     keep = _front_index(span, width)
     lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
-    arcs = [
-        _Arc(f.kind, a, a + w, s, s + x)
-        for a, w, s, x in zip(
-            lo.tolist(), width.tolist(), first.tolist(), span.tolist(), strict=True
-        )
-    ]
-    return _Front(arcs, span.tolist(), width.tolist())
+    return _Front(f.kind, lo, width, first, span, span.tolist(), width.tolist())
 
 
 def _front_index(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
@@ -156,61 +157,73 @@ def _front_index(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
 
     On the front ``value`` strictly increases; of equal pairs the first index is kept.
     """
-    order = np.lexsort((-value, cost))  # stable: equal pairs keep their index order
+    order = np.argsort(cost, kind="stable")
     v = value[order]
     best_before = np.maximum.accumulate(np.concatenate([[-np.inf], v[:-1]]))
-    return np.asarray(order[v > best_before], dtype=np.intp)
+    kept = order[v > best_before]  # value increases; cost non-decreasing
+    # Of entries with equal cost only the last (the most value) is on the front.
+    c = cost[kept]
+    return np.asarray(kept[np.append(c[1:] != c[:-1], True)], dtype=np.intp)
 
 
 def _widest(front: _Front, limit: float, tol: float) -> float:
     """Width of the widest arc whose image spans less than ``limit - 2 tol``."""
-    n = bisect.bisect_left(front.span, limit - 2.0 * tol) - 1
+    n = bisect.bisect_left(front.span_list, limit - 2.0 * tol) - 1
     if n < 0:  # pragma: no cover - every front holds a single basin (span 0)
         raise PlanningError("internal error: no arc fits the limit")
-    return front.width[n]
+    return front.width_list[n]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class _Staircase:
     """``tau(x)`` of one action: the best least margin of it and the actions after it.
 
-    ``arcs`` are sorted by ``rest`` (the least margin of the later actions after that arc)
-    decreasing, with widths strictly increasing: the Pareto front of (width, rest). With
-    ``c = width - 2 rest`` (non-decreasing), ``tau(x)`` is attained at the first entry with
-    ``c >= x`` (value ``rest``) or at the one before it (value ``(width - x) / 2``).
+    Entry ``r`` is arc ``index[r]`` of ``front``, with ``rest[r]`` the least margin of the
+    later actions after that arc. Entries are sorted by ``rest`` decreasing, with widths
+    strictly increasing: the Pareto front of (width, rest). With ``c = width - 2 rest``
+    (non-decreasing), ``tau(x)`` is attained at the first entry with ``c >= x`` (value
+    ``rest``) or at the one before it (value ``(width - x) / 2``).
     """
 
-    arcs: list[_Arc]
-    rest: list[float]
-    c: list[float]
+    front: _Front
+    index: NDArray[np.intp]
+    rest: FloatArray
+    width: FloatArray
+    c: FloatArray
+    c_list: list[float]
     tol: float
 
-    def tau(self, x: float) -> tuple[float, int]:
-        """Best least margin for an image of span ``x`` (``-inf`` if none fits), its arc."""
-        r = bisect.bisect_left(self.c, x)
-        at = self.rest[r] if r < len(self.rest) else -math.inf
-        before = 0.5 * (self.arcs[r - 1].width - x) if r > 0 else -math.inf
-        value, pick = (at, r) if at >= before else (before, r - 1)
-        return (value if value > self.tol else -math.inf), pick
+    def tau(self, x: FloatArray) -> FloatArray:
+        """Best least margin for images of spans ``x`` (``-inf`` where none fits)."""
+        n = len(self.rest)
+        r = np.searchsorted(self.c, x, side="left")  # (M,) first entry with c >= x
+        at = np.where(r < n, self.rest[np.minimum(r, n - 1)], -np.inf)
+        before = np.where(r > 0, 0.5 * (self.width[np.maximum(r - 1, 0)] - x), -np.inf)
+        value = np.maximum(at, before)
+        return np.asarray(np.where(value > self.tol, value, -np.inf), dtype=np.float64)
+
+    def pick(self, x: float) -> _Arc:
+        """The arc that attains ``tau(x)`` for one span ``x``."""
+        r = bisect.bisect_left(self.c_list, x)
+        at = float(self.rest[r]) if r < len(self.c_list) else -math.inf
+        before = 0.5 * (float(self.width[r - 1]) - x) if r > 0 else -math.inf
+        return self.front.arc(int(self.index[r if at >= before else r - 1]))
 
 
 def _staircase(front: _Front, after: _Staircase | None, tol: float) -> _Staircase:
     """The staircase of an action whose arcs are ``front``, given the one of the next action."""
     if after is None:  # the last action collapses one basin: only single basins count
-        pairs = [(math.inf, a) for a in front.arcs if a.span <= 0.0]
+        index = np.flatnonzero(front.span <= 0.0)
+        rest = np.full(len(index), np.inf)
     else:
-        pairs = [(after.tau(a.span)[0], a) for a in front.arcs]
-        pairs = [(r, a) for r, a in pairs if r > tol]
-    # Most rest first; of equal rest the widest (then the first) leads and the rest drop out.
-    order = sorted(range(len(pairs)), key=lambda n: (-pairs[n][0], -pairs[n][1].width, n))
-    arcs: list[_Arc] = []
-    rest: list[float] = []
-    for n in order:
-        r, a = pairs[n]
-        if not arcs or a.width > arcs[-1].width:
-            arcs.append(a)
-            rest.append(r)
-    return _Staircase(arcs, rest, [a.width - 2.0 * r for a, r in zip(arcs, rest, strict=True)], tol)
+        rest = after.tau(front.span)
+        index = np.flatnonzero(rest > tol)
+        rest = rest[index]
+    keep = _front_index(-rest, front.width[index])  # most rest first, widths increasing
+    index, rest = index[keep], rest[keep]
+    width = front.width[index]
+    c = width - 2.0 * rest
+    return _Staircase(front, index, rest, width, c, c.tolist(), tol)
 
 
 @dataclass(slots=True)
@@ -221,7 +234,9 @@ class _Planner:
     tol: float
     max_span: float
     fronts: dict[str, _Front]
-    stairs: dict[tuple[str, ...], _Staircase]
+    # Staircase of an action type followed by the actions of staircase ``next_id`` (-1:
+    # none), with its own id: a suffix of a plan is found in O(1) from the next one.
+    stairs: dict[tuple[str, int], tuple[int, _Staircase]]
 
     def front(self, kind: str) -> _Front:
         """The arc front of one action type."""
@@ -229,12 +244,18 @@ class _Planner:
             self.fronts[kind] = _arc_front(self.problem.transfers[kind], self.max_span)
         return self.fronts[kind]
 
-    def stair(self, kinds: tuple[str, ...]) -> _Staircase:
-        """The staircase of the first of ``kinds`` followed by the rest."""
-        if kinds not in self.stairs:
-            after = self.stair(kinds[1:]) if len(kinds) > 1 else None
-            self.stairs[kinds] = _staircase(self.front(kinds[0]), after, self.tol)
-        return self.stairs[kinds]
+    def staircases(self, kinds: tuple[str, ...]) -> list[_Staircase]:
+        """The staircase of ``kinds[m:]`` for each ``m``."""
+        out: list[_Staircase] = []
+        next_id, after = -1, None
+        for kind in reversed(kinds):
+            key = (kind, next_id)
+            if key not in self.stairs:
+                stair = _staircase(self.front(kind), after, self.tol)
+                self.stairs[key] = (len(self.stairs), stair)
+            next_id, after = self.stairs[key]
+            out.append(after)
+        return out[::-1]
 
     def witnesses(self, kinds: tuple[str, ...], length: float) -> tuple[list[_Arc], float | None]:
         """The chain of witness arcs of largest least margin, and that margin.
@@ -242,18 +263,17 @@ class _Planner:
         ``length`` is the success arc's length; the first witness is an arc that wide.
         """
         front = self.front(kinds[0])
-        wide = front.arcs[bisect.bisect_left(front.width, length - self.tol) :]
+        wide = bisect.bisect_left(front.width_list, length - self.tol)  # arcs wide..end
         if len(kinds) == 1:
-            return [next(a for a in wide if a.span <= 0.0)], None
-        stair = self.stair(kinds[1:])
-        rest = [stair.tau(a.span)[0] for a in wide]
-        best = max(rest)
+            return [front.arc(wide + int(np.flatnonzero(front.span[wide:] <= 0.0)[0]))], None
+        stairs = self.staircases(kinds[1:])
+        rest = stairs[0].tau(front.span[wide:])
+        best = float(rest.max())
         if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
             raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-        chain = [wide[next(n for n, r in enumerate(rest) if r >= best - self.tol)]]
-        for m in range(1, len(kinds)):
-            stair = self.stair(kinds[m:])
-            chain.append(stair.arcs[stair.tau(chain[-1].span)[1]])
+        chain = [front.arc(wide + int(np.flatnonzero(rest >= best - self.tol)[0]))]
+        for stair in stairs:
+            chain.append(stair.pick(chain[-1].span))
         return chain, best
 
 
@@ -271,7 +291,10 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     -------
     PlanReport
         ``options[k - 1]`` is the best plan of ``k`` actions: the least expected cost of
-        those with ``k`` actions, except the last, the most certain one.
+        those with ``k`` actions, except the last, the most certain one. When action types
+        cost differently (squeezes and push-grasps), one more option may follow: the
+        cheapest plan with at least as many actions as the most certain one, if it costs
+        less than every other option (it is then the Bayes plan).
 
     Raises
     ------
@@ -305,6 +328,15 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     options: list[PlanOption] = []
     level: list[tuple[int, ...]] = [zero]
     limit_hard = 4 * problem.part.hull.n_sides + 8
+    first_kind = min(kinds, key=lambda t: problem.cost.action_cost(t, first=True))
+    next_kind = min(kinds, key=lambda t: problem.cost.action_cost(t))
+
+    def cheap_kinds(n: int) -> tuple[str, ...]:
+        """The action types of the cheapest attempt of ``n`` actions."""
+        return (first_kind,) + (next_kind,) * (n - 1)
+
+    certain_at: int | None = None  # the length of the most certain plan, once found
+    extra: tuple[float, float, tuple[str, ...], float] | None = None
     k = 0
     while True:
         k += 1
@@ -326,19 +358,39 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
             p, _ = prior.max_arc_mass(min(width, cap), group)
             order = _order(best, key, t, counts_of)
             scored.append((p, problem.cost.expected_cost(order, p), order, width))
-        top_p = max(s[0] for s in scored)
-        done = top_p >= p_best - 1e-12 or (max_actions is not None and k >= max_actions)
-        if done:  # the last level shows its most certain plan
-            pick = min(scored, key=lambda s: (-round(s[0], 12), s[1]))
-        else:
-            pick = min(scored, key=lambda s: (s[1], -s[0]))
-        p, cost, order, width = pick
-        options.append(_option(planner, order, width, min(width, cap), p, cost))
-        if done:
-            break
+        cheapest = min(scored, key=lambda s: (s[1], -s[0]))
+        if certain_at is None:
+            top_p = max(s[0] for s in scored)
+            done = top_p >= p_best - 1e-12 or (max_actions is not None and k >= max_actions)
+            # The last level shows its most certain plan.
+            pick = min(scored, key=lambda s: (-round(s[0], 12), s[1])) if done else cheapest
+            p, cost, order, width = pick
+            options.append(_option(planner, order, width, min(width, cap), p, cost))
+            if done:
+                certain_at = k
+        if certain_at is not None:
+            # With action types of different costs a plan as long as the most certain one,
+            # or longer, may cost less (less certain, or cheaper actions): keep the cheapest
+            # such plan, and search on while the cheapest attempt of one more action at the
+            # highest probability could still beat the best so far.
+            bound = min(o.expected_cost for o in options)
+            if extra is not None:
+                bound = min(bound, extra[1])
+            if cheapest[1] < bound * (1.0 - 1e-12):
+                extra = cheapest
+                bound = cheapest[1]
+            if (
+                len(kinds) == 1
+                or (max_actions is not None and k >= max_actions)
+                or problem.cost.expected_cost(cheap_kinds(k + 1), p_best) >= bound * (1 - 1e-12)
+            ):
+                break
         if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
             raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
         level = list(nxt)
+    if extra is not None:
+        p, cost, order, width = extra
+        options.append(_option(planner, order, width, min(width, cap), p, cost))
     bayes, most = choose_indices(tuple(options))
     return PlanReport(problem, tuple(options), bayes, most, "exact")
 
