@@ -22,11 +22,16 @@ __all__ = [
     "ReadOptions",
     "Ring",
     "assemble_part",
+    "check_count",
     "chordal_tolerance",
     "fail",
     "flatten_rings",
+    "need",
+    "pick",
+    "polygon_part",
     "read_bytes",
     "read_text",
+    "shapely_polygons",
 ]
 
 log = logging.getLogger("bayesgrasp.io")
