@@ -645,9 +645,10 @@ def synthetic_transfer(rng: np.random.Generator, k: int) -> TransferFunction:
     return transfer_from_extrema("push-grasp", cuts[0::2], cuts[1::2], 1e-9, 1e-6)
 
 
-@pytest.mark.parametrize("push_cost", [0.5, 1.0, 3.0])
+@pytest.mark.parametrize("push_cost", [0.2, 1.0, 3.0])
 def test_two_action_types_against_brute_force(rng: np.random.Generator, push_cost: float) -> None:
-    for _ in range(6):
+    longest = 4
+    for _ in range(5):
         part = random_part(rng, 7)
         squeeze = squeeze_function(part.hull)
         push = synthetic_transfer(rng, int(rng.integers(2, 5)))
@@ -660,25 +661,42 @@ def test_two_action_types_against_brute_force(rng: np.random.Generator, push_cos
             Goal(),
             ("squeeze", "push-grasp"),
         )
-        rep = plan_exact(pb, max_actions=3)
-        sets = collapsible_sets(pb.transfers, len(rep.options))
+        rep = plan_exact(pb, max_actions=longest)
+        sets = collapsible_sets(pb.transfers, longest)
         masses = {kind: f.widths / TWO_PI for kind, f in pb.transfers.items()}
-        for k, o in enumerate(rep.options, start=1):
-            # The best probability of each order of action types.
-            brute = {seq: float(best_mass(s, masses[seq[0]])) for seq, s in sets[k - 1].items()}
-            p_top = max(brute.values())
-            c_top = min(cost.expected_cost(seq, p) for seq, p in brute.items())
-            assert_allclose(brute[o.kinds], o.success_probability, atol=1e-12)
-            if k == len(rep.options):  # the last plan is the most certain of its length
-                assert_allclose(o.success_probability, p_top, atol=1e-12)
-            else:  # the others the cheapest
-                assert_allclose(o.expected_cost, c_top, rtol=1e-12)
+        # The best probability of each order of action types, for each length.
+        brute = [
+            {seq: float(best_mass(s, masses[seq[0]])) for seq, s in level.items()} for level in sets
+        ]
+        p_top = [max(b.values()) for b in brute]
+        c_top = [min(cost.expected_cost(seq, p) for seq, p in b.items()) for b in brute]
+        m = rep.most_certain
+        assert [o.n_actions for o in rep.options[: m + 1]] == list(range(1, m + 2))
+        for i, o in enumerate(rep.options):
+            k = o.n_actions
+            assert_allclose(brute[k - 1][o.kinds], o.success_probability, atol=1e-12)
+            if i < m:  # below the most certain length: the cheapest plan of each length
+                assert_allclose(o.expected_cost, c_top[k - 1], rtol=1e-12)
+            elif i == m:  # the most certain plan
+                assert_allclose(o.success_probability, p_top[k - 1], atol=1e-12)
             theta = np.linspace(0.0, TWO_PI, 20_001)
             assert_allclose(replay(pb, o, theta).mean(), o.success_probability, atol=1e-3)
             assert replay(pb, o, arc_grid(o)).all()
             if o.tolerance is not None:
                 for sign in error_patterns(k - 1, rng):
                     assert replay(pb, o, arc_grid(o), 0.999 * o.tolerance * sign).all()
+        # At the most certain length or longer, a cheaper plan (cheap actions, or less
+        # certain) is reported after the most certain one, and only if it beats them all.
+        cheapest_long = min(c_top[m:])
+        costs = [o.expected_cost for o in rep.options[: m + 1]]
+        if len(rep.options) > m + 1:
+            assert len(rep.options) == m + 2
+            extra = rep.options[-1]
+            assert_allclose(extra.expected_cost, cheapest_long, rtol=1e-12)
+            assert extra.expected_cost < min(costs)
+            assert rep.bayes == m + 1
+        else:
+            assert cheapest_long >= min(costs) * (1 - 1e-12)
 
 
 # --------------------------------------------------------------------------------------
