@@ -7,7 +7,8 @@ Prints:
 
 The machine's load average is printed too: on a shared machine the figures move with it.
 
-Usage: ``.venv/bin/python benchmarks/bench_simulate.py [--quick]``
+Usage: ``.venv/bin/python benchmarks/bench_simulate.py [--quick] [--study]``; ``--study``
+prints the README's table of predicted against MuJoCo success for the catalogue instead.
 """
 
 from __future__ import annotations
@@ -81,8 +82,47 @@ def bench_mujoco(squeezes: int, trials: int) -> None:
     )
 
 
+def study(trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
+    """The README's table: predicted against MuJoCo success of the catalogue's Bayes plans."""
+    from bayesgrasp.execute import SimulationResult
+    from bayesgrasp.shapes import names
+    from bayesgrasp.sim import simulate_mujoco
+
+    def cell(r: SimulationResult) -> str:
+        lo, hi = r.ci95
+        return f"{r.observed_success:.3f} [{lo:.3f}, {hi:.3f}] ({r.jams}/{r.near_boundary})"
+
+    print(f"Study: {trials} trials a cell, seed 1, {workers} workers ({load_note()})")
+    print(
+        "| part | plan | predicted | MuJoCo, centred | "
+        f"MuJoCo, {offset_mm:g} mm off centre |\n|---|---|---|---|---|"
+    )
+    t_all = time.perf_counter()
+    for name in names():
+        part = load(name)
+        for actions, label in ((("squeeze",), "squeezes"), (("squeeze", "push-grasp"), "push")):
+            pb = Problem.build(part, actions=actions)
+            plan = plan_exact(pb).bayes_plan
+            if label == "push" and "push-grasp" not in plan.kinds:
+                print(f"| {name} | push-grasps | (the Bayes plan uses squeezes only) | | |")
+                continue
+            kinds = "+".join("P" if k == "push-grasp" else "S" for k in plan.kinds)
+            row = [name, f"Bayes, {kinds}", f"{plan.success_probability:.3f}"]
+            for off in (0.0, offset_mm / 1000.0):
+                r = simulate_mujoco(pb, plan, trials, offset=off, rng=1, workers=workers)
+                row.append(cell(r))
+            print("| " + " | ".join(row) + " |", flush=True)
+    print(
+        f"({time.perf_counter() - t_all:.0f} s; cells: observed success [95% Wilson interval]"
+        " (jams/near-boundary trials))"
+    )
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
+    if "--study" in sys.argv:
+        study(60 if quick else 300)
+        return
     bench_kinematic(200_000 if quick else 2_000_000)
     bench_mujoco(20 if quick else 100, 50 if quick else 500)
 

@@ -6,13 +6,15 @@ MuJoCo is imported only inside the functions that run it; without it they raise
 
 from .engine import ActionOutcome, Squeezer, require_mujoco, simulate_mujoco
 from .params import SimParams
-from .scene import part_inertia, scene_xml, units_scale
+from .scene import Prism, part_inertia, prism, scene_xml, units_scale
 
 __all__ = [
     "ActionOutcome",
+    "Prism",
     "SimParams",
     "Squeezer",
     "part_inertia",
+    "prism",
     "require_mujoco",
     "scene_xml",
     "simulate_mujoco",

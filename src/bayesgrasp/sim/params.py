@@ -65,10 +65,15 @@ class SimParams:
         ``jaw_kp * jaw_speed``, so 400 N/m reaches 0.5 N 0.125 s after contact (100 N/m: 0.5 s,
         squeezes a third longer, the same agreement).
     jaw_force : float
-        Force limit of each jaw, 0.5 N (notes): 40 times the table friction of a 6 g part,
-        low enough for quasi-static motion and shallow contact penetration (2 N gave the
-        same agreement with four times the orientation error, 0.12 degrees). A squeeze ends
-        only once both jaws push with this force.
+        Least force limit of each jaw, 0.5 N (notes): 40 times the table friction of a 6 g
+        part, low enough for quasi-static motion and shallow contact penetration (2 N gave
+        the same agreement with four times the orientation error, 0.12 degrees). A squeeze
+        ends only once both jaws push with the full force.
+    force_ratio : float
+        A heavier part gets ``force_ratio`` times its table friction ``mu m g`` instead
+        (:meth:`squeeze_force`), 20: parts up to 13 g keep the measured 0.5 N, and a large
+        part is squeezed as firmly relative to its friction (the couple that turns it,
+        ``force * |d'(theta)|``, must beat the friction's moment).
     jaw_speed : float
         The jaw targets close at 1 cm/s (notes; 5 cm/s also agreed): slow enough to be
         quasi-static as the model assumes.
@@ -114,6 +119,7 @@ class SimParams:
     jaw_damping: float = 20.0
     jaw_kp: float = 400.0
     jaw_force: float = 0.5
+    force_ratio: float = 20.0
     jaw_speed: float = 0.01
     clearance: float = 0.003
     settle_speed: float = 1e-4
@@ -122,6 +128,16 @@ class SimParams:
     check_every: int = 10
     jam_tol: float = math.radians(1.0)
     push_distance: float = 0.0
+
+    def squeeze_force(self, mass: float) -> float:
+        """Force limit of each jaw for a part of the given mass (kg).
+
+        Examples
+        --------
+        >>> SimParams().squeeze_force(0.006), round(SimParams().squeeze_force(0.1), 3)
+        (0.5, 3.924)
+        """
+        return max(self.jaw_force, self.force_ratio * self.table_friction * mass * 9.81)
 
     def __post_init__(self) -> None:
         for f in fields(self):

@@ -9,12 +9,14 @@ coordinates are not rotated). Contacts:
 - part-jaw: frictionless. The jaw geoms have ``condim="1"`` *and* ``priority="1"``: with
   equal priority MuJoCo takes the larger friction of the two geoms, so without the priority
   the jaws grip (physics notes: 137/183 agreement instead of 183/183);
-- jaw-table: none (contact bit masks), the jaws hover 1 mm above the table.
+- jaw-table: none (contact bit masks), the jaws hover 1 mm above the table (less under
+  a thin part).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -23,7 +25,7 @@ from ..errors import PartError
 from ..geometry import Part
 from .params import SimParams
 
-__all__ = ["part_inertia", "scene_xml", "units_scale"]
+__all__ = ["Prism", "part_inertia", "prism", "scene_xml", "units_scale"]
 
 FloatArray = NDArray[np.float64]
 
@@ -97,6 +99,59 @@ def part_inertia(
     return mass, out
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class Prism:
+    """The part as a body: hull in the body frame (metres), thickness, mass, jaw force.
+
+    Attributes
+    ----------
+    vertices : ndarray of shape (N, 2)
+        Hull vertices relative to the centre of mass (the body frame's origin).
+    thickness : float
+        ``SimParams.thickness``, or half the part's least width if that is smaller (a prism
+        taller than it is wide would tip over between the jaws).
+    mass : float
+    inertia : ndarray of shape (3,)
+        Diagonal inertia about the centre of mass.
+    size : float
+        Largest distance of a vertex from the centre of mass.
+    force : float
+        Each jaw's force limit (:meth:`SimParams.squeeze_force`).
+    """
+
+    vertices: FloatArray
+    thickness: float
+    mass: float
+    inertia: FloatArray
+    size: float
+    force: float
+
+
+def prism(part: Part, scale: float, params: SimParams | None = None) -> Prism:
+    """The extruded hull of a part, in metres, with its mass properties.
+
+    Examples
+    --------
+    >>> body = prism(Part.from_points([(0, 0), (40, 0), (10, 30)]), 0.001)
+    >>> round(body.mass, 6), body.thickness, body.force
+    (0.006, 0.01, 0.5)
+    """
+    if not (math.isfinite(scale) and scale > 0):
+        raise PartError(f"`scale` must be a finite number > 0 (metres per unit); got {scale!r}")
+    sp = params or SimParams()
+    com = np.asarray(part.center_of_mass, dtype=np.float64) * scale
+    rel = part.hull.vertices * scale - com  # (N, 2) body frame
+    # Least width of the hull: the smallest extent over its edge normals.
+    e = np.roll(rel, -1, axis=0) - rel
+    nrm = np.column_stack([e[:, 1], -e[:, 0]]) / np.hypot(e[:, 0], e[:, 1])[:, None]
+    proj = rel @ nrm.T  # (N, N) projections on each edge normal
+    width = float(np.min(proj.max(axis=0) - proj.min(axis=0)))
+    h = min(sp.thickness, 0.5 * width)
+    mass, inertia = part_inertia(rel, np.zeros(2), h, sp.density)
+    size = float(np.max(np.hypot(rel[:, 0], rel[:, 1])))
+    return Prism(rel, h, mass, inertia, size, sp.squeeze_force(mass))
+
+
 def _fmt(values: FloatArray | list[float]) -> str:
     return " ".join(f"{float(v):.9g}" for v in np.ravel(values))
 
@@ -123,22 +178,18 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
     >>> 'priority="1"' in xml and 'condim="1"' in xml
     True
     """
-    if not (math.isfinite(scale) and scale > 0):
-        raise PartError(f"`scale` must be a finite number > 0 (metres per unit); got {scale!r}")
     sp = params or SimParams()
-    com = np.asarray(part.center_of_mass, dtype=np.float64) * scale
-    hull = part.hull.vertices * scale
-    rel = hull - com  # (N, 2) in the body frame (origin at the centre of mass)
-    h = sp.thickness
-    prism = np.concatenate(
+    body = prism(part, scale, sp)
+    rel, h, size, force = body.vertices, body.thickness, body.size, body.force
+    mass, inertia = body.mass, body.inertia
+    pts = np.concatenate(
         [np.column_stack([rel, np.zeros(len(rel))]), np.column_stack([rel, np.full(len(rel), h)])]
     )
-    mass, inertia = part_inertia(rel, np.zeros(2), h, sp.density)
-    size = float(np.max(np.hypot(rel[:, 0], rel[:, 1])))
     jaw_half = 0.5 * max(sp.jaw_length, 4.0 * size)
     t = sp.jaw_thickness
-    jaw_h = 0.5 * (h + 0.004)  # half-height: from 1 mm above the table to 3 mm above the part
-    jaw_z = 0.001 + jaw_h
+    gap = min(0.001, 0.25 * h)  # the jaws hover this far above the table
+    jaw_h = 0.5 * (h - gap + 0.003)  # half-height: up to 3 mm above the part
+    jaw_z = gap + jaw_h
     tc = sp.solref_timeconst
     fr = sp.table_friction
     return f"""<mujoco model="bayesgrasp-squeeze">
@@ -149,7 +200,7 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
     <geom solref="{tc:.9g} 1"/>
   </default>
   <asset>
-    <mesh name="part" vertex="{_fmt(prism)}"/>
+    <mesh name="part" vertex="{_fmt(pts)}"/>
   </asset>
   <worldbody>
     <geom name="table" type="plane" size="1 1 0.01" contype="1" conaffinity="1"
@@ -173,9 +224,9 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
   </worldbody>
   <actuator>
     <position name="jaw_neg" joint="jaw_neg" kp="{sp.jaw_kp:.9g}"
-              forcerange="{-sp.jaw_force:.9g} {sp.jaw_force:.9g}"/>
+              forcerange="{-force:.9g} {force:.9g}"/>
     <position name="jaw_pos" joint="jaw_pos" kp="{sp.jaw_kp:.9g}"
-              forcerange="{-sp.jaw_force:.9g} {sp.jaw_force:.9g}"/>
+              forcerange="{-force:.9g} {force:.9g}"/>
   </actuator>
 </mujoco>
 """
