@@ -252,3 +252,39 @@ def test_widest_arc_single_basin_and_full_circle() -> None:
     assert one.width == pytest.approx(math.pi - 2 * math.atan(1 / 3), abs=1e-12)
     full = widest_arc(s, 10.0, 1e-9)
     assert full.width == pytest.approx(TWO_PI, abs=1e-12)
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    from bayesgrasp.cli import main
+
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_guaranteed_json(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    code, out, err = run(capsys, "plan", "triangle", "--guaranteed", "--json")
+    assert code == 0 and err == ""
+    doc = json.loads(out)
+    assert doc["schema"] == "bayesgrasp.plan/2"
+    g = plan_guaranteed(Problem.build(load("triangle")))
+    sure = doc["guaranteed"]
+    assert sure["squeezes"] == g.n_actions
+    assert [s["type"] for s in sure["steps"]] == ["squeeze"] * g.n_actions
+    assert_allclose([s["alpha_rad"] for s in sure["steps"]], [s.alpha for s in g.option.steps])
+    assert sure["period_rad"] == pytest.approx(math.pi)
+    assert sure["final_orientation_rad"] == pytest.approx(g.option.final_orientation)
+    assert sure["tolerance_rad"] == pytest.approx(g.option.tolerance)
+    assert set(doc["options"][0]) <= set(sure)  # an option of the same form
+    # Without --guaranteed (squeezes only) the document stays plan/1.
+    code, out, _ = run(capsys, "plan", "triangle", "--json")
+    assert json.loads(out)["schema"] == "bayesgrasp.plan/1" and "guaranteed" not in out
+
+
+def test_cli_guaranteed_table(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "plan", "rectangle", "--guaranteed")
+    assert code == 0 and err == ""
+    assert "guaranteed plan: 2 action(s) S(+0.00) S(-45.00)" in out
+    assert "modulo 180 deg" in out

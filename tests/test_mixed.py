@@ -175,3 +175,48 @@ def test_steps_name_their_kind_and_json_has_them(rng: np.random.Generator) -> No
         assert [s["type"] for s in d["steps"]] == list(o.kinds)
         assert_allclose([s["alpha_rad"] for s in d["steps"]], [s.alpha for s in o.steps])
         assert len(d["steps"]) == o.n_actions
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    from bayesgrasp.cli import main
+
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_actions_and_push_grasp_cost(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from bayesgrasp.shapes import load
+
+    args = ("plan", "triangle", "--actions", "squeeze,push-grasp", "--push-grasp-cost", "2")
+    code, out, err = run(capsys, *args, "--json")
+    assert code == 0 and err == ""
+    doc = json.loads(out)
+    assert doc["schema"] == "bayesgrasp.plan/2"
+    rep = plan_exact(Problem.build(load("triangle"), cost=CostModel(push_grasp=2.0), actions=MIXED))
+    assert [o["expected_cost"] for o in doc["options"]] == pytest.approx(
+        [o.expected_cost for o in rep.options]
+    )
+    assert [[s["type"] for s in o["steps"]] for o in doc["options"]] == [
+        list(o.kinds) for o in rep.options
+    ]
+    assert (doc["bayes"], doc["most_certain"]) == (rep.bayes, rep.most_certain)
+    code, out, err = run(capsys, *args)
+    assert code == 0 and " P(" in out
+
+
+@pytest.mark.parametrize(
+    ("actions", "message"),
+    [("squeeze,pull", "unknown action type 'pull'"), (",", "at least one action type")],
+)
+def test_cli_bad_actions(capsys: pytest.CaptureFixture[str], actions: str, message: str) -> None:
+    code, out, err = run(capsys, "plan", "triangle", "--actions", actions)
+    assert code == 2 and out == ""
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_negative_push_grasp_cost(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "plan", "triangle", "--push-grasp-cost", "-1")
+    assert code == 2 and out == "" and "push-grasp-cost" in err

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -286,3 +287,64 @@ def test_push_invariant_under_scaling_and_vertex_order(points: np.ndarray, k: fl
     assert f.n_states == h.n_states
     assert_allclose(circ(f.stable, h.stable), 0.0, atol=1e-7)
     assert_allclose(circ(f.boundaries, h.boundaries), 0.0, atol=1e-7)
+
+
+# --------------------------------------------------------------------------------------
+# The `bayesgrasp push` command
+# --------------------------------------------------------------------------------------
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    from bayesgrasp.cli import main
+
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_push_table(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "push", "triangle")
+    assert code == 0 and err == ""
+    assert "push period 360 deg" in out and "push-grasp period 360 deg" in out
+    assert "edge flat against the pushing jaw" in out
+    from bayesgrasp.shapes import load
+
+    part = load("triangle")
+    f = push_function(part)
+    for s in np.degrees(f.stable):
+        assert f"{s:12.3f}" in out
+
+
+def test_cli_push_json(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    import json
+
+    pts = [[0, 0], [4, 0], [0, 1]]
+    path = tmp_path / "wedge.json"
+    path.write_text(json.dumps({"name": "wedge", "vertices": pts, "center_of_mass": [1, 0.3]}))
+    code, out, err = run(capsys, "push", str(path), "--json")
+    assert code == 0 and err == ""
+    doc = json.loads(out)
+    assert doc["schema"] == "bayesgrasp.push/1"
+    part = Part.from_points(pts, center_of_mass=(1, 0.3))
+    r, f, g = radius_function(part), push_function(part), push_grasp_function(part)
+    assert doc["center_of_mass"] == [1.0, 0.3]
+    assert_allclose(doc["stable_orientations_rad"], f.stable, atol=1e-15)
+    assert_allclose(doc["basins_rad"], np.stack([f.basin_lo, f.basin_hi], 1), atol=1e-15)
+    assert_allclose(sum(doc["probabilities"]), 1.0, atol=1e-12)
+    assert doc["period_rad"] == pytest.approx(TWO_PI)
+    assert_allclose(doc["push_grasp"]["stable_orientations_rad"], g.stable, atol=1e-15)
+    v = part.hull.vertices
+    for (a, b), s in zip(doc["stable_edges"], f.stable, strict=True):
+        assert b == (a + 1) % len(v)
+        assert a in r.stable_edges.tolist()
+        # That edge is flat against the pushing jaw: both ends leftmost at orientation s.
+        x, _ = rotate((v - part.center_of_mass)[None], np.array([[s]]))
+        assert_allclose(x[0, 0, [a, b]], [x.min()] * 2, atol=1e-12)
+
+
+def test_cli_push_rejects_bad_input(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text('{"vertices": [[0, 0], [1, 0], [0, 1]], "center_of_mass": [5, 5]}')
+    code, out, err = run(capsys, "push", str(path))
+    assert code == 2 and out == ""
+    assert "center_of_mass" in err and len(err.strip().splitlines()) == 1

@@ -180,6 +180,23 @@ def plan(
     max_squeezes: Annotated[
         int | None, typer.Option(min=1, help="Longest plan to consider.")
     ] = None,
+    actions: Annotated[
+        str,
+        typer.Option(
+            metavar="KINDS",
+            help="Action types a plan may use, comma-separated: squeeze, push-grasp "
+            "(the pushing jaw is on the gripper's -x side).",
+        ),
+    ] = "squeeze",
+    push_grasp_cost: Annotated[float, typer.Option(min=0, help="Cost of a push-grasp.")] = 1.0,
+    guaranteed: Annotated[
+        bool,
+        typer.Option(
+            "--guaranteed",
+            help="Also give the shortest plan that orients every initial orientation "
+            "(up to the transfer functions' period).",
+        ),
+    ] = False,
     as_json: JsonOpt = False,
     fmt: FormatOpt = None,
     element: ElementOpt = None,
@@ -206,6 +223,8 @@ def plan(
         first_squeeze_cost,
         retry_cost,
         goal,
+        actions=tuple(a.strip() for a in actions.split(",") if a.strip()),
+        push_grasp_cost=push_grasp_cost,
     )
     if method is Method.bfs:
         from .planning.bfs import plan_bfs
@@ -213,10 +232,21 @@ def plan(
         rep = plan_bfs(pb, max_actions=max_squeezes)
     else:
         rep = plan_exact(pb, max_actions=max_squeezes)
+    sure = None
+    if guaranteed:
+        from .planning.guaranteed import plan_guaranteed
+
+        sure = plan_guaranteed(pb)
     if as_json:
-        emit_json(report.plan_json(rep))
+        plan2 = guaranteed or "push-grasp" in pb.action_kinds
+        doc = report.plan_json(rep, "bayesgrasp.plan/2" if plan2 else "bayesgrasp.plan/1")
+        if sure is not None:
+            doc["guaranteed"] = report.guaranteed_json(sure)
+        emit_json(doc)
     else:
         typer.echo(report.plan_table(rep))
+        if sure is not None:
+            typer.echo(report.guaranteed_text(sure))
     if plot_file is not None:
         from .plotting import plan_figure
 
@@ -332,6 +362,35 @@ def plot(
     else:
         for f in files:
             typer.echo(str(f))
+
+
+@app.command()
+def push(
+    part: PartArg,
+    prior: Annotated[
+        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
+    ] = "uniform",
+    as_json: JsonOpt = False,
+    fmt: FormatOpt = None,
+    element: ElementOpt = None,
+    layer: LayerOpt = None,
+    flatten_tol: FlattenTolOpt = None,
+) -> None:
+    """Stable orientations of a push and a push-grasp, their basins and probabilities.
+
+    The push turns the part down its radius function about the centre of mass until an edge
+    lies flat against the pushing jaw (on the gripper's -x side); the table names that edge.
+    """
+    from .push import push_function, push_grasp_function, radius_function
+
+    p = load_part(part, fmt, element, layer, flatten_tol)
+    pr = parse_prior(prior)
+    r = radius_function(p)
+    f, g = push_function(r), push_grasp_function(p)
+    if as_json:
+        emit_json(report.push_json(p, r, f, g, pr))
+    else:
+        typer.echo(report.push_table(p, r, f, g, pr))
 
 
 @app.command()

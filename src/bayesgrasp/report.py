@@ -12,18 +12,24 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .geometry import Part
+from .planning.guaranteed import GuaranteedPlan
 from .planning.plan import PlanOption, PlanReport
 from .prior import Prior, UniformPrior
 from .problem import Problem
+from .push import RadiusFunction
 from .transfer import TransferFunction
 
 if TYPE_CHECKING:
     from .execute import SimulationResult
 
 __all__ = [
+    "guaranteed_json",
+    "guaranteed_text",
     "part_json",
     "plan_json",
     "plan_table",
+    "push_json",
+    "push_table",
     "simulate_json",
     "simulate_table",
     "squeeze_json",
@@ -110,7 +116,9 @@ def plan_json(report: PlanReport, schema: str = "bayesgrasp.plan/1") -> dict[str
         "part": part_json(pb.part),
         "method": report.method,
         "stable_orientations_rad": pb.states.stable.tolist(),
-        "stable_probabilities": pb.state_distribution(bayes.first_angle).tolist(),
+        "stable_probabilities": pb.state_distribution(
+            bayes.first_angle, bayes.steps[0].kind
+        ).tolist(),
         "period_rad": float(pb.states.period),
         "first_squeeze_rad": bayes.first_angle,
         "options": [option_json(o) for o in report.options],
@@ -120,6 +128,79 @@ def plan_json(report: PlanReport, schema: str = "bayesgrasp.plan/1") -> dict[str
     if report.nodes is not None:
         out["nodes"] = report.nodes
     return out
+
+
+def guaranteed_json(g: GuaranteedPlan) -> dict[str, Any]:
+    """The ``"guaranteed"`` option of ``bayesgrasp.plan/2``: an option plus its period."""
+    return {**option_json(g.option), "period_rad": float(g.period)}
+
+
+def guaranteed_text(g: GuaranteedPlan) -> str:
+    """One paragraph: the guaranteed plan's steps, period, final orientation and tolerance."""
+    o = g.option
+    steps = " ".join(
+        f"{'S' if s.kind == 'squeeze' else 'P'}({math.degrees(s.alpha):+.2f})" for s in o.steps
+    )
+    tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f} deg"
+    return (
+        f"guaranteed plan: {o.n_actions} action(s) {steps}\n"
+        "  (S = squeeze, P = push-grasp; the first angle in the world frame, then turns)\n"
+        f"  sends every orientation to {math.degrees(o.final_orientation):.2f} deg modulo "
+        f"{math.degrees(g.period):.4g} deg; tolerance {tol}\n"
+        f"  for the goal: P(success) {o.success_probability:.4f}, "
+        f"E[cost] {o.expected_cost:.3f}"
+    )
+
+
+def _stable_edges(radius: RadiusFunction, push: TransferFunction) -> list[int]:
+    """The hull edge flat against the pushing jaw in each of the push's stable orientations."""
+    gap = np.abs(np.mod(push.stable[:, None] - radius.minima[None, :] + math.pi, 2 * math.pi))
+    return [int(radius.stable_edges[k]) for k in np.argmin(np.abs(gap - math.pi), axis=1)]
+
+
+def push_json(
+    part: Part,
+    radius: RadiusFunction,
+    push: TransferFunction,
+    push_grasp: TransferFunction,
+    prior: Prior | None = None,
+) -> dict[str, Any]:
+    """The ``bayesgrasp.push/1`` document: the push function and the push-grasp function."""
+    pr = prior or UniformPrior()
+    n = part.hull.n_sides
+    edges = _stable_edges(radius, push)
+    return {
+        "schema": "bayesgrasp.push/1",
+        "part": part_json(part),
+        "center_of_mass": radius.center_of_mass.tolist(),
+        **transfer_json(push, pr),
+        "stable_edges": [[e, (e + 1) % n] for e in edges],
+        "push_grasp": transfer_json(push_grasp, pr),
+    }
+
+
+def push_table(
+    part: Part,
+    radius: RadiusFunction,
+    push: TransferFunction,
+    push_grasp: TransferFunction,
+    prior: Prior | None = None,
+) -> str:
+    """The push function's table with each stable edge, then the push-grasp function's."""
+    v = part.hull.vertices
+    n = part.hull.n_sides
+    c = radius.center_of_mass
+    edges = _stable_edges(radius, push)
+    lines = [
+        squeeze_table(part, push, prior),
+        f"centre of mass ({c[0]:.6g}, {c[1]:.6g}); the pushing jaw is on the gripper's -x side",
+        "edge flat against the pushing jaw in each stable orientation:",
+    ]
+    for i, e in enumerate(edges):
+        a, b = v[e], v[(e + 1) % n]
+        lines.append(f"{i:>5}  ({a[0]:.6g}, {a[1]:.6g}) - ({b[0]:.6g}, {b[1]:.6g})")
+    lines += ["", "push-grasp (push, then squeeze):", squeeze_table(part, push_grasp, prior)]
+    return "\n".join(lines)
 
 
 def _plan_text(o: PlanOption) -> str:
