@@ -24,7 +24,15 @@ from .errors import (
 )
 from .geometry import ConvexPolygon, Part
 from .io import read_part, resolve_part
-from .planning import PlanOption, PlanReport, PlanStep, execute_plan, plan_exact
+from .planning import (
+    GuaranteedPlan,
+    PlanOption,
+    PlanReport,
+    PlanStep,
+    execute_plan,
+    plan_exact,
+    plan_guaranteed,
+)
 from .prior import (
     DensityPrior,
     HistogramPrior,
@@ -35,6 +43,7 @@ from .prior import (
     von_mises,
 )
 from .problem import CostModel, Goal, Problem
+from .push import RadiusFunction, push_function, push_grasp_function, radius_function
 from .tolerance import DEFAULT_TOLERANCE, Tolerance
 from .transfer import TransferFunction, squeeze_function
 
@@ -49,6 +58,7 @@ __all__ = [
     "DensityPrior",
     "DiameterFunction",
     "Goal",
+    "GuaranteedPlan",
     "HistogramPrior",
     "MissingExtraError",
     "Part",
@@ -61,6 +71,7 @@ __all__ = [
     "Prior",
     "PriorError",
     "Problem",
+    "RadiusFunction",
     "SamplePrior",
     "Tolerance",
     "TransferFunction",
@@ -69,6 +80,10 @@ __all__ = [
     "execute_plan",
     "parse_prior",
     "plan_exact",
+    "plan_guaranteed",
+    "push_function",
+    "push_grasp_function",
+    "radius_function",
     "read_part",
     "resolve_part",
     "squeeze_function",

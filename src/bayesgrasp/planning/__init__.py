@@ -2,6 +2,16 @@
 
 from .bfs import plan_bfs
 from .exact import plan_exact
+from .guaranteed import GuaranteedPlan, plan_guaranteed
 from .plan import PlanOption, PlanReport, PlanStep, execute_plan
 
-__all__ = ["PlanOption", "PlanReport", "PlanStep", "execute_plan", "plan_bfs", "plan_exact"]
+__all__ = [
+    "GuaranteedPlan",
+    "PlanOption",
+    "PlanReport",
+    "PlanStep",
+    "execute_plan",
+    "plan_bfs",
+    "plan_exact",
+    "plan_guaranteed",
+]
