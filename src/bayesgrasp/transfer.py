@@ -15,8 +15,9 @@ the part's symmetry: ``s(theta + T) = s(theta) + T`` for the period ``T`` (pi, o
 
 from __future__ import annotations
 
+import bisect
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -119,21 +120,44 @@ def detect_period(stable: FloatArray, boundaries: FloatArray, tol: float) -> flo
     >>> round(float(np.degrees(T)), 9)
     120.0
     """
+    st = np.asarray(stable, dtype=np.float64).tolist()
+    bd = np.asarray(boundaries, dtype=np.float64).tolist()
+    return TWO_PI / _period_count(st, bd, len(st), 1, tol)
+
+
+def _period_count(stable: list[float], bounds: list[float], top: int, base: int, tol: float) -> int:
+    """Largest ``m <= top``, a multiple of ``base`` dividing ``K``, whose shift maps both lists.
+
+    Returns ``base`` when no larger ``m`` works. Plain Python: ``K`` is small, and numpy's
+    cost per call would be most of the work.
+    """
     k = len(stable)
-    for m in range(k, 1, -1):
-        if k % m:
+    first = stable[0]
+    for m in range(top, base, -1):
+        if k % m or m % base:
             continue
-        step = k // m
-        t = TWO_PI / m
-        ok = True
-        for pts in (stable, boundaries):
-            diff = np.mod(np.roll(pts, -step) - pts - t + math.pi, TWO_PI) - math.pi
-            if np.max(np.abs(diff)) > tol:
-                ok = False
-                break
-        if ok:
-            return t
-    return TWO_PI
+        step, t = k // m, TWO_PI / m
+        # Cheap test on one point first: most m fail there.
+        if abs((stable[step] - first - t + math.pi) % TWO_PI - math.pi) > tol:
+            continue
+        if _shifts_onto_itself(stable, step, t, tol) and _shifts_onto_itself(bounds, step, t, tol):
+            return m
+    return base
+
+
+def _shifts_onto_itself(points: list[float], step: int, shift: float, tol: float) -> bool:
+    """Whether point ``i + step`` lies ``shift`` after point ``i`` (cyclically), for all i."""
+    k, pi = len(points), math.pi
+    return all(
+        abs((points[(i + step) % k] - points[i] - shift + pi) % TWO_PI - pi) <= tol
+        for i in range(k)
+    )
+
+
+def _wrap(x: float) -> float:
+    """``x`` reduced to ``[0, 2 pi)`` (``%`` can round a tiny negative to ``2 pi``)."""
+    out = x % TWO_PI
+    return 0.0 if out >= TWO_PI else out
 
 
 def transfer_from_extrema(
@@ -149,20 +173,36 @@ def transfer_from_extrema(
     angle_tol, period_tol : float
         Angle equality, and the looser tolerance of the period test.
     """
-    stable = np.sort(np.mod(minima, TWO_PI))
-    bounds = np.sort(np.mod(maxima, TWO_PI))
-    if len(stable) != len(bounds) or len(stable) == 0:  # pragma: no cover - a bug
+    stable = sorted(_wrap(x) for x in np.asarray(minima, dtype=np.float64).tolist())
+    bounds = sorted(_wrap(x) for x in np.asarray(maxima, dtype=np.float64).tolist())
+    return _from_sorted(kind, stable, bounds, angle_tol, period_tol)
+
+
+def _from_sorted(
+    kind: str, stable: list[float], bounds: list[float], angle_tol: float, period_tol: float
+) -> TransferFunction:
+    """:func:`transfer_from_extrema` for sorted lists in ``[0, 2 pi)``."""
+    n = len(stable)
+    if n != len(bounds) or n == 0:  # pragma: no cover - a bug
         raise BayesGraspError("internal error: stable orientations and boundaries differ")
-    # The boundary above each stable orientation (wrapping past 2 pi).
-    k = np.searchsorted(bounds, stable, side="right")
-    hi = np.where(k < len(bounds), bounds[k % len(bounds)], bounds[0] + TWO_PI)
-    lo = np.where(k > 0, bounds[k - 1], bounds[-1] - TWO_PI)
-    if len(np.unique(k % len(bounds))) != len(stable):  # pragma: no cover - a bug
-        raise BayesGraspError("internal error: extrema of the transfer function do not alternate")
-    for arr in (stable, lo, hi):
+    # The boundary above each stable orientation (wrapping past 2 pi). They alternate when
+    # that index counts up by one: 0, 1, ..., K - 1 or 1, 2, ..., K.
+    k0 = bisect.bisect_right(bounds, stable[0])
+    if k0 > 1 or any(bisect.bisect_right(bounds, x) != k0 + i for i, x in enumerate(stable)):
+        raise BayesGraspError(  # pragma: no cover - a bug
+            "internal error: extrema of the transfer function do not alternate"
+        )
+    if k0 == 0:  # stable[i] lies between bounds[i - 1] and bounds[i]
+        lo = [bounds[-1] - TWO_PI, *bounds[:-1]]
+        hi = bounds
+    else:  # stable[i] lies between bounds[i] and bounds[i + 1]
+        lo = bounds
+        hi = [*bounds[1:], bounds[0] + TWO_PI]
+    arrays = [np.array(x, dtype=np.float64) for x in (stable, lo, hi)]
+    for arr in arrays:
         arr.setflags(write=False)
-    period = detect_period(stable, bounds, period_tol)
-    return TransferFunction(kind, stable, lo, hi, period, angle_tol)
+    period = TWO_PI / _period_count(stable, bounds, n, 1, period_tol)
+    return TransferFunction(kind, arrays[0], arrays[1], arrays[2], period, angle_tol)
 
 
 def squeeze_function(
@@ -189,7 +229,27 @@ def squeeze_function(
     """
     d = part if isinstance(part, DiameterFunction) else diameter_function(part)
     poly = d.polygon
-    period_tol = poly.tol.symmetry
-    minima = np.concatenate([d.minima, d.minima + math.pi])
-    maxima = np.concatenate([d.maxima, d.maxima + math.pi])
-    return transfer_from_extrema("squeeze", minima, maxima, poly.tol.angle, period_tol)
+    half = d.minima.tolist(), d.maxima.tolist()  # in [0, pi)
+    stable, bounds = ([*x, *(_wrap(a + math.pi) for a in x)] for x in half)
+    stable.sort()
+    bounds.sort()
+    f = _from_sorted("squeeze", stable, bounds, poly.tol.angle, poly.tol.symmetry)
+    k, m_strict = len(stable), round(TWO_PI / f.period)
+    if k > m_strict:
+        # Rounded coordinates can leave an r-fold symmetric part's extrema periodic only to
+        # about 1e-5 rad, beyond the strict test. A finer period is accepted when shifting
+        # by it keeps every extremum within a quarter of the closest gap of its partner
+        # (their order is kept) and the vertex test finds the matching symmetry order.
+        both = sorted(stable + bounds)
+        loose = 0.25 * min(b - a for a, b in zip(both, [*both[1:], both[0] + TWO_PI], strict=True))
+        top = k
+        while top > m_strict:
+            m = _period_count(stable, bounds, top, m_strict, loose)
+            if m == m_strict:
+                break
+            r = poly.symmetry_order
+            if r * (1 + r % 2) == m:
+                f = replace(f, period=TWO_PI / m)
+                break
+            top = m - 1
+    return f
