@@ -11,6 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
+from bayesgrasp import geometry
 from bayesgrasp.errors import BayesGraspError, PartError
 from bayesgrasp.geometry import ConvexPolygon, Part, as_points, polygon_area_centroid
 from bayesgrasp.tolerance import Tolerance
@@ -157,7 +158,7 @@ def test_hull_of_a_square_with_extra_points() -> None:
 def test_hull_matches_scipy(rng: np.random.Generator) -> None:
     spatial = pytest.importorskip("scipy.spatial")
     for _ in range(200):
-        n = int(rng.integers(3, 60))
+        n = int(rng.integers(3, 300))  # both the plain-Python (<= 64) and the numpy path
         pts = rng.normal(size=(n, 2)) * rng.uniform(0.1, 10.0, size=2)
         poly = ConvexPolygon.from_points(pts)
         ref = pts[spatial.ConvexHull(pts).vertices]  # counter-clockwise in 2-D
@@ -402,3 +403,28 @@ def test_part_center_of_mass() -> None:
         Part.from_points(SQUARE, center_of_mass=(0.5, 0.5, 0.5))
     with pytest.raises(PartError, match="`center_of_mass` must be numbers"):
         Part.from_points(SQUARE, center_of_mass=("a", 0.5))
+
+
+@given(pts=st.one_of(convex_points(), lattice_points(max_size=60, bound=5)))
+def test_plain_python_and_numpy_hulls_agree(pts: np.ndarray) -> None:
+    extent = float(np.max(np.ptp(pts, axis=0)))
+    eps = Tolerance().length_for(extent)
+    xs, ys, area, cx, cy = geometry._hull_python(pts, eps)
+    hull = pts[geometry._hull_indices(pts)]
+    if len(hull) > 3:
+        hull = geometry._drop_near_collinear(hull, eps)
+    assert_array_equal(np.array([xs, ys]).T.reshape(-1, 2), hull)
+    if len(hull) >= 3:
+        ref_area, ref_centroid = polygon_area_centroid(hull)
+        assert_allclose(area, ref_area, rtol=1e-12, atol=1e-300)
+        assert_allclose([cx, cy], ref_centroid, rtol=1e-12, atol=1e-12 * extent)
+
+
+def test_many_points(rng: np.random.Generator) -> None:
+    t = rng.uniform(0, 2 * math.pi, 5000)
+    ring = np.column_stack([3 * np.cos(t), np.sin(t)])
+    inside = rng.uniform(-1, 1, (5000, 2)) * [2.0, 0.6]
+    poly = ConvexPolygon.from_points(np.vstack([inside, ring]))
+    assert poly.n_sides > 4000
+    assert_allclose(poly.area, 3 * math.pi, rtol=1e-4)
+    assert_allclose(poly.centroid, [0, 0], atol=1e-3)

@@ -135,12 +135,16 @@ def _hull_indices(points: FloatArray) -> NDArray[np.intp]:
     """
     order = np.lexsort((points[:, 1], points[:, 0]))
     pts = points[order]
+    chain = _monotone_chain(pts[:, 0].tolist(), pts[:, 1].tolist())
+    return order[np.array(chain, dtype=np.intp)]
 
-    def half(idx: NDArray[np.intp]) -> list[int]:
+
+def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
+    """Counter-clockwise hull of points sorted by x then y: indices, starting at the first."""
+
+    def half(idx: range) -> list[int]:
         chain: list[int] = []
-        xs = pts[:, 0].tolist()
-        ys = pts[:, 1].tolist()
-        for k in idx.tolist():
+        for k in idx:
             while len(chain) >= 2:
                 a, b = chain[-2], chain[-1]
                 cross = (xs[b] - xs[a]) * (ys[k] - ys[a]) - (ys[b] - ys[a]) * (xs[k] - xs[a])
@@ -150,10 +154,72 @@ def _hull_indices(points: FloatArray) -> NDArray[np.intp]:
             chain.append(k)
         return chain
 
-    n = len(pts)
-    lower = half(np.arange(n))
-    upper = half(np.arange(n - 1, -1, -1))
-    return order[np.array(lower[:-1] + upper[:-1], dtype=np.intp)]
+    n = len(xs)
+    return half(range(n))[:-1] + half(range(n - 1, -1, -1))[:-1]
+
+
+def _hull_python(
+    pts: FloatArray, eps: float
+) -> tuple[list[float], list[float], float, float, float]:
+    """Hull, area and centroid of a few points in plain Python.
+
+    For a few points numpy's cost per call is larger than the work. The steps are those of
+    ``_hull_indices``, ``_drop_near_collinear`` and ``polygon_area_centroid``.
+
+    Returns
+    -------
+    xs, ys : list of float
+        Hull vertices, counter-clockwise from the lowest leftmost point.
+    area, cx, cy : float
+        Area and centroid (area 0 when degenerate).
+    """
+    px, py = pts[:, 0].tolist(), pts[:, 1].tolist()
+    order = sorted(range(len(px)), key=lambda i: (px[i], py[i]))  # stable, as np.lexsort
+    sx, sy = [px[i] for i in order], [py[i] for i in order]
+    chain = _monotone_chain(sx, sy)
+    xs, ys = [sx[i] for i in chain], [sy[i] for i in chain]
+    while len(xs) > 3:  # _drop_near_collinear, step for step
+        n = len(xs)
+        bad = []
+        for i in range(n):
+            ax, ay, bx, by = xs[i - 1], ys[i - 1], xs[(i + 1) % n], ys[(i + 1) % n]
+            ux, uy = bx - ax, by - ay
+            cross = ux * (ys[i] - ay) - uy * (xs[i] - ax)
+            bad.append(abs(cross) <= eps * math.hypot(ux, uy))
+        if not any(bad):
+            break
+        drop, run_start = [], 0
+        for i in range(n):
+            if not bad[i]:
+                run_start = i + 1
+            drop.append(bad[i] and (i - run_start) % 2 == 0)
+        if drop[0] and drop[-1]:
+            drop[-1] = False
+        kept = n - sum(drop)
+        if kept < 3:
+            for i in [i for i in range(n) if drop[i]][: 3 - kept]:
+                drop[i] = False
+        xs = [x for x, d in zip(xs, drop, strict=True) if not d]
+        ys = [y for y, d in zip(ys, drop, strict=True) if not d]
+    if len(xs) < 3:
+        return xs, ys, 0.0, 0.0, 0.0
+    ox, oy = xs[0], ys[0]
+    scale = max(max(abs(x - ox) for x in xs), max(abs(y - oy) for y in ys))
+    if not 0.0 < scale < math.inf:
+        return xs, ys, 0.0, 0.0, 0.0
+    qx, qy = [(x - ox) / scale for x in xs], [(y - oy) / scale for y in ys]
+    n = len(qx)
+    twice, cx, cy = 0.0, 0.0, 0.0
+    for i in range(n):
+        j = (i + 1) % n
+        c = qx[i] * qy[j] - qx[j] * qy[i]
+        twice += c
+        cx += (qx[i] + qx[j]) * c
+        cy += (qy[i] + qy[j]) * c
+    if twice == 0.0:
+        return xs, ys, 0.0, 0.0, 0.0
+    unit = scale / (3.0 * twice)
+    return xs, ys, 0.5 * twice * scale * scale, cx * unit + ox, cy * unit + oy
 
 
 def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
@@ -180,6 +246,10 @@ def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
             keep[np.flatnonzero(drop)[: 3 - keep.sum()]] = True
         v = v[keep]
     return v
+
+
+# Up to this many points, ConvexPolygon.from_points works on Python floats (faster there).
+_SMALL = 64
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -241,13 +311,20 @@ class ConvexPolygon:
 
     @classmethod
     def _trusted(
-        cls, v: FloatArray, tol: Tolerance, area: float, centroid: FloatArray
+        cls,
+        v: FloatArray,
+        tol: Tolerance,
+        area: float,
+        centroid: FloatArray,
+        size: float | None = None,
     ) -> ConvexPolygon:
         """A polygon known to be convex and counter-clockwise (from a hull or a rotation)."""
         poly = object.__new__(cls)
         object.__setattr__(poly, "tol", tol)
-        d = v - centroid
-        poly._set(v, area, centroid, math.sqrt(float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2))))
+        if size is None:
+            d = v - centroid
+            size = math.sqrt(float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2)))
+        poly._set(v, area, centroid, size)
         return poly
 
     @classmethod
@@ -279,12 +356,19 @@ class ConvexPolygon:
         pts = as_points(points)
         extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
         eps = tol.length_for(extent)
-        hull = pts[_hull_indices(pts)] if len(pts) >= 3 and extent > 0.0 else pts[:0]
-        if len(hull) > 3:
-            hull = _drop_near_collinear(hull, eps)
         area = 0.0
-        if len(hull) >= 3:
-            area, centroid = polygon_area_centroid(hull)
+        if len(pts) < 3 or extent == 0.0:
+            hull = pts[:0]
+        elif len(pts) <= _SMALL:
+            xs, ys, area, cx, cy = _hull_python(pts, eps)
+            hull = np.array([xs, ys], dtype=np.float64).T.copy()
+            centroid = np.array([cx, cy])
+        else:
+            hull = pts[_hull_indices(pts)]
+            if len(hull) > 3:
+                hull = _drop_near_collinear(hull, eps)
+            if len(hull) >= 3:
+                area, centroid = polygon_area_centroid(hull)
         if len(hull) < 3 or area <= eps * extent:
             # Tell "too few points" from "collinear" only on failure (np.unique is slow).
             distinct = 0
@@ -297,6 +381,11 @@ class ConvexPolygon:
                     f"with {distinct} distinct"
                 )
             raise PartError("the part's points are all collinear; a part needs a non-zero area")
+        if len(pts) <= _SMALL:
+            size = math.sqrt(
+                max((x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True))
+            )
+            return cls._trusted(hull, tol, area, centroid, size)
         return cls._trusted(hull, tol, area, centroid)
 
     @property
@@ -337,14 +426,18 @@ class ConvexPolygon:
         n = len(v)
         eps = self.tol.symmetry_for(self.size)
         radii = np.hypot(v[:, 0], v[:, 1])  # (N,) a rotation about the centroid keeps them
-        for r in range(n, 1, -1):
-            if n % r or np.max(np.abs(np.roll(radii, -n // r) - radii)) > eps:
+        small = [r for r in range(2, math.isqrt(n) + 1) if n % r == 0]
+        for r in sorted({n, *small, *(n // r for r in small)} - {1}, reverse=True):
+            # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r. Test the
+            # distances from the centroid first (cheap, and enough to reject most parts).
+            step = n // r
+            if np.max(np.abs(radii[step:] - radii[:-step])) > eps:
                 continue
             a = 2.0 * math.pi / r
             c, s = math.cos(a), math.sin(a)
             turned = v @ np.array([[c, s], [-s, c]])  # (N, 2) rotated counter-clockwise
-            # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r.
-            if np.all(np.hypot(*(turned - np.roll(v, -n // r, axis=0)).T) <= eps):
+            miss = turned - np.concatenate((v[step:], v[:step]))
+            if np.all(np.hypot(miss[:, 0], miss[:, 1]) <= eps):
                 return r
         return 1
 
