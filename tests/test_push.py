@@ -348,3 +348,24 @@ def test_cli_push_rejects_bad_input(capsys: pytest.CaptureFixture[str], tmp_path
     code, out, err = run(capsys, "push", str(path))
     assert code == 2 and out == ""
     assert "center_of_mass" in err and len(err.strip().splitlines()) == 1
+
+
+def test_extreme_centres_of_mass(rng: np.random.Generator) -> None:
+    """Centres of mass near the hull's boundary: down to a single stable push orientation
+    (a roly-poly part), and the push-grasp is still s o p with basins tiling the circle."""
+    single = 0
+    for _ in range(400):
+        pts = rng.random((int(rng.integers(3, 12)), 2))
+        com = rng.dirichlet(np.full(len(pts), 0.05)) @ pts
+        try:
+            part = Part.from_points(pts, center_of_mass=com)
+        except PartError:  # on the hull's boundary within tolerance
+            continue
+        f, g = push_function(part), push_grasp_function(part)
+        s = squeeze_function(part.hull)
+        th = rng.uniform(0, TWO_PI, 100)
+        assert_allclose(circ(g(th), s(f(th))), 0.0, atol=1e-12)
+        assert_allclose(g.basin_hi[-1] - g.basin_lo[0], TWO_PI, atol=1e-12)
+        assert_allclose(f.widths.sum(), TWO_PI, atol=1e-12)
+        single += f.n_states == 1
+    assert single > 0
