@@ -218,7 +218,10 @@ def squeeze_function(
     -------
     TransferFunction
         Stable orientations are the minima of ``d`` over ``[0, 2 pi)``; basins run between
-        consecutive maxima.
+        consecutive maxima. The period is the smallest shift ``2 pi / m`` that maps them
+        onto themselves (to ``tol.symmetry`` radians): ``pi``, or ``2 pi / (r (1 + r mod 2))``
+        for an r-fold symmetric part, also when rounded coordinates make the extrema
+        periodic only to about 1e-5 rad (the vertex test of ``symmetry_order`` decides).
 
     Examples
     --------
