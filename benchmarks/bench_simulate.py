@@ -7,8 +7,9 @@ Prints:
 
 The machine's load average is printed too: on a shared machine the figures move with it.
 
-Usage: ``.venv/bin/python benchmarks/bench_simulate.py [--quick] [--study]``; ``--study``
-prints the README's table of predicted against MuJoCo success for the catalogue instead.
+Usage: ``.venv/bin/python benchmarks/bench_simulate.py [--quick] [--study | --agreement]``;
+``--study`` prints the README's table of predicted against MuJoCo success for the catalogue
+instead, ``--agreement`` the README's table of single squeezes against the model.
 """
 
 from __future__ import annotations
@@ -118,10 +119,81 @@ def study(trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
     )
 
 
+def agreement(n: int) -> None:
+    """Single actions from random yaws away from basin boundaries: model against MuJoCo."""
+    from bayesgrasp.execute import boundary_distance
+    from bayesgrasp.geometry import Part
+    from bayesgrasp.sim import Squeezer
+    from bayesgrasp.transfer import TransferFunction, squeeze_function
+
+    try:
+        from bayesgrasp.push import push_function, push_grasp_function
+    except ImportError:  # pragma: no cover
+        push_function = push_grasp_function = None  # type: ignore[assignment]
+
+    margin = math.radians(2.5)
+    rng0 = np.random.default_rng(5)
+    randoms = [Part.from_points(rng0.random((10, 2)) * 0.05, name=f"r{i}") for i in range(8)]
+    quad = Part.from_points([(0, 0), (50, 0), (40, 30), (5, 35)], name="quad", units="mm")
+
+    def run(
+        parts: list[Part], f_of: object, offset: float = 0.0, push: bool = False, count: int = n
+    ) -> str:
+        agree = total = stalls = 0
+        errs: list[float] = []
+        for part in parts:
+            fs: list[TransferFunction] = f_of(part)  # type: ignore[operator]
+            starts = np.random.default_rng(4).uniform(0, 2 * math.pi, 4 * count)
+            away = np.ones(len(starts), bool)
+            for f in fs:
+                away &= boundary_distance(f.boundaries, starts) >= margin
+            starts = starts[away][:count]
+            sq = Squeezer(part, 0.001 if part.units == "mm" else 1.0)
+            stable = squeeze_function(part.hull).stable
+            for th in starts:
+                out = sq.act(float(th), offset, push)
+                err = abs(math.remainder(out.end - float(fs[0](th)), 2 * math.pi))
+                off_stable = np.min(np.abs(np.remainder(out.end - stable + math.pi, 2 * math.pi)
+                                           - math.pi))  # fmt: skip
+                total += 1
+                if err < math.radians(1.0) and out.settled:
+                    agree += 1
+                    errs.append(err)
+                elif off_stable > math.radians(1.0) or not out.settled:
+                    stalls += 1
+        med = f"{math.degrees(float(np.median(errs))):.3f} deg" if errs else "-"
+        return f"{agree}/{total} (median error {med}; of the rest, {stalls} stalled)"
+
+    def sq_f(p: Part) -> list[TransferFunction]:
+        return [squeeze_function(p.hull)]
+
+    print(f"single actions, starts >= 2.5 deg from basin boundaries ({load_note()})")
+    tri, rect = load("triangle"), load("rectangle")
+    print("  triangle, centred:", run([tri], sq_f))
+    print("  rectangle, centred:", run([rect], sq_f))
+    print("  8 random 10-gons, 5 cm:", run(randoms, sq_f, count=max(10, n // 3)))
+    print("  quadrilateral (0,0),(50,0),(40,30),(5,35) mm:", run([quad], sq_f))
+    for off in (0.005, 0.010):
+        print(f"  triangle, {off * 1000:g} mm off centre:", run([tri], sq_f, off))
+        print(f"  rectangle, {off * 1000:g} mm off centre:", run([rect], sq_f, off))
+    if push_grasp_function is not None:
+
+        def pg_f(p: Part) -> list[TransferFunction]:
+            return [push_grasp_function(p), push_function(p)]
+
+        print(
+            "  push-grasps, triangle and 4 random 10-gons:",
+            run([tri, *randoms[:4]], pg_f, push=True, count=max(10, n // 4)),
+        )
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
     if "--study" in sys.argv:
         study(60 if quick else 300)
+        return
+    if "--agreement" in sys.argv:
+        agreement(20 if quick else 100)
         return
     bench_kinematic(200_000 if quick else 2_000_000)
     bench_mujoco(20 if quick else 100, 50 if quick else 500)

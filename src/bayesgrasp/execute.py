@@ -378,6 +378,8 @@ class SimulationResult:
         Wall time of the trials.
     final : ndarray of shape (trials,)
         Each trial's final orientation (radians, gripper frame of the last action).
+    jammed_trials, near_trials : ndarray of shape (trials,) of bool
+        Which trials jammed, and which started an action near a basin boundary.
     """
 
     engine: str
@@ -393,6 +395,8 @@ class SimulationResult:
     boundary_margin: float
     seconds: float
     final: FloatArray = field(repr=False)
+    jammed_trials: BoolArray = field(repr=False, default_factory=lambda: np.zeros(0, bool))
+    near_trials: BoolArray = field(repr=False, default_factory=lambda: np.zeros(0, bool))
 
     @property
     def successes(self) -> int:
@@ -469,6 +473,8 @@ def summarize(
     idx, err = _nearest_stable(states.stable, final)  # (T,), (T,)
     final_jam = err > jam_tol
     observed = np.bincount(idx[~final_jam], minlength=problem.n_states).astype(np.intp)
+    jam_all = np.asarray(jammed, dtype=bool) | final_jam
+    near_all = np.asarray(near, dtype=bool)
     return SimulationResult(
         engine=engine,
         option=option,
@@ -477,12 +483,14 @@ def summarize(
         predicted=predicted_distribution(problem, option.steps),
         observed=observed,
         goal=goal_states(problem, option.final_orientation),
-        jams=int(np.count_nonzero(np.asarray(jammed) | final_jam)),
+        jams=int(np.count_nonzero(jam_all)),
         final_jams=int(np.count_nonzero(final_jam)),
-        near_boundary=int(np.count_nonzero(near)),
+        near_boundary=int(np.count_nonzero(near_all)),
         boundary_margin=boundary_margin,
         seconds=seconds,
         final=final,
+        jammed_trials=jam_all,
+        near_trials=near_all,
     )
 
 
