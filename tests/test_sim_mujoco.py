@@ -233,3 +233,32 @@ def test_cli_simulate_mujoco_json(capsys: pytest.CaptureFixture[str]) -> None:
     assert 0 <= lo <= doc["observed_success"] <= hi <= 1
     assert isinstance(doc["jams"], int) and isinstance(doc["near_boundary"], int)
     assert doc["seconds"] > 0
+
+
+@needs_mujoco
+def test_parts_outside_the_checked_sizes_are_refused() -> None:
+    from bayesgrasp.execute import SimulationError
+    from bayesgrasp.sim import simulate_mujoco
+
+    pb = Problem.build(Part.from_points([(0, 0), (40, 0), (10, 30)]))  # no units: metres
+    with pytest.raises(SimulationError, match=r"measures 50\.8 m across at 1 m per unit.*units"):
+        simulate_mujoco(pb, plan_exact(pb).bayes_plan, 1)
+
+
+@pytest.mark.physics
+@needs_mujoco
+def test_cli_units_option_scales_the_part(
+    capsys: pytest.CaptureFixture[str], tmp_path: object
+) -> None:
+    from pathlib import Path
+
+    f = Path(str(tmp_path)) / "tri.csv"
+    f.write_text("x,y\n0,0\n40,0\n10,30\n")
+    code = main(["simulate", str(f), "--engine", "mujoco", "--trials", "2"])
+    out, err = capsys.readouterr()
+    assert code == 2
+    assert "50.8 m across" in err
+    code = main(["simulate", str(f), "--engine", "mujoco", "--trials", "2", "--units", "mm"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "mujoco execution, 2 trials" in out
