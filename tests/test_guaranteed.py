@@ -98,6 +98,8 @@ def test_lengths_equal_exact_most_certain_on_random_polygons(rng: np.random.Gene
         assert g.period == pytest.approx(math.pi, abs=1e-12)
         assert collapsed(pb, g, theta).max() < 1e-9
         assert g.option.success_probability == pytest.approx(0.5, abs=1e-12)
+        # Squeeze angles are shown short: a squeeze gripper turned by pi is the same gripper.
+        assert all(-math.pi / 2 < s.alpha <= math.pi / 2 for s in g.option.steps)
 
 
 @pytest.mark.parametrize("name", names())

@@ -242,17 +242,27 @@ def _option(problem: Problem, chain: list[Arc], period: float) -> PlanOption:
     p, start = problem.prior.max_arc_mass(
         min(first.width, period), problem.goal_group, prefer=first.lo
     )
-    steps = [PlanStep(first.kind, _wrap(start - first.lo))]
+    angles = [start - first.lo]
     for prev, arc in itertools.pairwise(chain):
         # Centre the previous image in this arc: each angle may then err by the margin.
-        steps.append(
-            PlanStep(arc.kind, _wrap(0.5 * (prev.s_first + prev.s_last - arc.lo - arc.hi)))
-        )
+        angles.append(0.5 * (prev.s_first + prev.s_last - arc.lo - arc.hi))
+    # A squeeze gripper turned by pi is the same gripper (jaws swapped): show each squeeze
+    # angle in (-pi/2, pi/2] and carry the pi to the next angle (or the final orientation),
+    # as the exact planner does. A push-grasp has a pushing side: its angle stays in (-pi, pi].
+    steps = []
+    carry = 0.0
+    for arc, angle in zip(chain, angles, strict=True):
+        a = _wrap(angle + carry)
+        carry = 0.0
+        if arc.kind == "squeeze":
+            short = _wrap(2.0 * a) / 2.0
+            carry, a = a - short, short
+        steps.append(PlanStep(arc.kind, a))
     margin = _margin(chain)
     kinds = tuple(a.kind for a in chain)
     return PlanOption(
         tuple(steps),
-        math.fmod(chain[-1].s_first, TWO_PI),
+        math.fmod(chain[-1].s_first + carry + TWO_PI, TWO_PI),
         p,
         problem.cost.expected_cost(kinds, p),
         None if math.isinf(margin) else margin,
