@@ -224,7 +224,7 @@ def test_tolerance_scales_with_the_part() -> None:
         assert ConvexPolygon.from_points(pts).n_sides == 5
 
 
-@pytest.mark.parametrize("scale", [1e-150, 1e-100, 1e-30, 1e-9, 1e9, 1e30, 1e100, 1e150])
+@pytest.mark.parametrize("scale", [1e-140, 1e-100, 1e-30, 1e-9, 1e9, 1e30, 1e100, 1e149])
 def test_huge_and_tiny_coordinates(scale: float, rng: np.random.Generator) -> None:
     pts = rng.random((10, 2))
     ref = ConvexPolygon.from_points(pts)
@@ -234,6 +234,20 @@ def test_huge_and_tiny_coordinates(scale: float, rng: np.random.Generator) -> No
     assert_allclose(poly.centroid / scale, ref.centroid, rtol=1e-12)
     assert_allclose(poly.size / scale, ref.size, rtol=1e-12)
     assert poly.symmetry_order == 1
+
+
+@pytest.mark.parametrize(
+    ("scale", "message"), [(1e200, "at most 1e"), (1e-200, "cannot be resolved")]
+)
+def test_coordinates_beyond_the_float_range_are_refused(scale: float, message: str) -> None:
+    # Areas are products of coordinates: these would overflow or underflow to a wrong answer.
+    with pytest.raises(PartError, match=message):
+        ConvexPolygon.from_points(np.array(SQUARE) * scale)
+
+
+def test_booleans_mixed_with_numbers_are_refused() -> None:
+    with pytest.raises(PartError, match="got a bool"):
+        ConvexPolygon.from_points([[True, 0], [1, 0], [0, 1]])
 
 
 def test_a_part_far_from_the_origin(rng: np.random.Generator) -> None:

@@ -55,12 +55,18 @@ def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
     """
     try:
         raw = np.asarray(points)
+        items = None
+        if not isinstance(points, np.ndarray) and raw.dtype.kind in "iuf":
+            # Lists mixing booleans and numbers become numbers in numpy: look at the items.
+            items = np.asarray(points, dtype=object)
     except (TypeError, ValueError) as exc:
         raise PartError(
             f"`{what}` must be numbers of shape (N, 2); could not read them: {exc}"
         ) from None
     if raw.dtype.kind not in "iuf":
         _check_real(raw, what)
+    elif items is not None and items.ndim == 2:
+        _check_real(items, what)
     arr = np.array(raw, dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise PartError(f"`{what}` must have shape (N, 2); got shape {arr.shape}")
@@ -89,6 +95,25 @@ def _check_real(raw: NDArray[Any], what: str) -> None:
         return
     name = _KIND_NAMES.get(raw.dtype.kind, f"values of type {raw.dtype}")
     raise PartError(f"`{what}` must be numbers of shape (N, 2); got {name}")
+
+
+# Areas are products of two coordinates: beyond these magnitudes they overflow or underflow.
+_MAX_COORD = 1e150
+_MIN_EXTENT = 1e-150
+
+
+def _check_magnitude(pts: FloatArray, extent: float) -> None:
+    """Refuse coordinates whose products overflow, or parts too small to tell from a point."""
+    if len(pts) and float(np.max(np.abs(pts))) > _MAX_COORD:
+        raise PartError(
+            f"`vertices` must be at most {_MAX_COORD:g} in absolute value; "
+            f"got {float(np.max(np.abs(pts))):g} (rescale the part's units)"
+        )
+    if 0.0 < extent < _MIN_EXTENT:
+        raise PartError(
+            f"the part is {extent:g} across; parts smaller than {_MIN_EXTENT:g} cannot be "
+            "resolved (rescale the part's units)"
+        )
 
 
 def polygon_area_centroid(vertices: FloatArray) -> tuple[float, FloatArray]:
@@ -355,6 +380,7 @@ class ConvexPolygon:
         """
         pts = as_points(points)
         extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
+        _check_magnitude(pts, extent)
         eps = tol.length_for(extent)
         area = 0.0
         if len(pts) < 3 or extent == 0.0:

@@ -100,7 +100,9 @@ def read_csv(path: Path, options: ReadOptions) -> Part:
             raise fail(path, f"row {n} is not two numbers: {','.join(row)!r}") from None
         if not all(math.isfinite(v) for v in pts[-1]):
             raise fail(path, f"row {n} is not finite: {','.join(row)!r}")
+    if not pts:
+        raise fail(path, "no points found; expected one x,y row per point")
     try:
-        return Part.from_points(pts or [[]], name=path.stem)
+        return Part.from_points(pts, name=path.stem)
     except PartError as exc:
         raise fail(path, str(exc)) from None
