@@ -16,6 +16,7 @@ from bayesgrasp.planning.plan import PlanStep
 from bayesgrasp.prior import von_mises
 from bayesgrasp.problem import Goal, Problem
 from bayesgrasp.shapes import load, names
+from bayesgrasp.transfer import TransferFunction
 
 TWO_PI = 2.0 * math.pi
 SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
@@ -290,3 +291,31 @@ def test_cli_guaranteed_table(capsys: pytest.CaptureFixture[str]) -> None:
     assert code == 0 and err == ""
     assert "guaranteed plan: 2 action(s) S(+0.00) S(-45.00)" in out
     assert "modulo 180 deg" in out
+
+
+def widest_by_pairs(f: TransferFunction, limit: float, tol: float) -> tuple[float, float]:
+    """(width, span) of the widest arc by trying every (first basin, number of basins)."""
+    k = f.n_states
+    s = np.concatenate([f.stable, f.stable + TWO_PI])
+    hi = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
+    best = (-1.0, 0.0)
+    for i in range(k):
+        for m in range(k):
+            span = s[i + m] - s[i]
+            if m and span >= limit - 2 * tol:
+                break
+            width = hi[i + m] - f.basin_lo[i]
+            if width > best[0] + tol or (width >= best[0] - tol and span < best[1]):
+                best = (max(width, best[0]), span)
+    return best
+
+
+def test_widest_arc_against_all_pairs(rng: np.random.Generator) -> None:
+    for part in random_parts(rng, 60):
+        for f in Problem.build(part, actions=("squeeze", "push-grasp")).transfers.values():
+            for limit in [0.0, *rng.uniform(0, TWO_PI + 0.5, 6)]:
+                arc = widest_arc(f, limit, 1e-9)
+                width, span = widest_by_pairs(f, limit, 1e-9)
+                assert arc.width == pytest.approx(width, abs=1e-9)
+                assert arc.span == pytest.approx(span, abs=1e-9)
+                assert arc.span < limit - 2e-9 or arc.span == 0.0

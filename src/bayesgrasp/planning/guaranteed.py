@@ -25,8 +25,14 @@ cost; the plan returned is the cheapest of the shortest (the width of an arc col
 with given counts of each type does not depend on their order after the first action, the
 argument of :mod:`bayesgrasp.planning.exact`).
 
-This module enumerates every pair of boundaries (O(K^2) per step, K stable orientations)
-instead of the exact planner's binary search, so the two can check each other.
+Cost: O(K log K) per (count of each type, first type) with K stable orientations, memory
+O(K). The exact planner computes the same lengths another way (Pareto fronts of arcs and
+staircases), so the two check each other; the tests add a search over sets of states.
+
+The plan's angles centre each image in the next arc, so each turn may err by half the room
+left (the plan's tolerance). The arcs are the widest ones, of least span among equals; the
+exact planner instead chooses the chain that maximises the least margin, so its most certain
+plan of the same length may have a larger tolerance.
 """
 
 from __future__ import annotations
@@ -99,8 +105,10 @@ class GuaranteedPlan:
 def widest_arc(f: TransferFunction, limit: float, tol: float) -> Arc:
     """Widest boundary-to-boundary arc of ``f`` whose image spans less than ``limit``.
 
-    Every pair (first basin ``i``, number of basins ``m``) is tried; among the widest arcs
-    the one of least span is returned (it leaves the most room to the next action).
+    For each first basin ``i`` the arc runs to the last basin whose stable orientation lies
+    within the limit of ``S_i`` (a binary search, O(K log K) in all, memory O(K)); among the
+    widest arcs the one of least span is returned (it leaves the most room to the next
+    action).
 
     Parameters
     ----------
@@ -128,17 +136,17 @@ def widest_arc(f: TransferFunction, limit: float, tol: float) -> Arc:
     k = f.n_states
     s = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
     hi = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
-    i = np.arange(k)[:, None]  # (K, 1) first basin
-    m = np.arange(k)[None, :]  # (1, K) further basins
-    span = s[i + m] - s[i]  # (K, K)
-    width = hi[i + m] - f.basin_lo[i]  # (K, K)
-    ok = (span < limit - 2.0 * tol) | (m == 0)
-    w = np.where(ok, width, -np.inf)
-    best = float(w.max())
-    cand = np.argwhere(w >= best - tol)  # (C, 2)
-    spans = span[cand[:, 0], cand[:, 1]]
-    bi, bm = (int(x) for x in cand[int(np.argmin(spans))])
-    return Arc(f.kind, float(f.basin_lo[bi]), float(hi[bi + bm]), float(s[bi]), float(s[bi + bm]))
+    i = np.arange(k)  # (K,) first basin of each arc
+    # (K,) last basin: the last stable orientation below S_i + limit - 2 tol, at least i
+    # (one basin, image a point), at most i + K - 1 (the whole circle).
+    j = np.searchsorted(s, f.stable + (limit - 2.0 * tol), side="left") - 1
+    j = np.clip(j, i, i + k - 1)
+    width = hi[j] - f.basin_lo  # (K,)
+    span = s[j] - f.stable  # (K,)
+    cand = np.flatnonzero(width >= width.max() - tol)
+    b = int(cand[np.argmin(span[cand])])
+    jb = int(j[b])
+    return Arc(f.kind, float(f.basin_lo[b]), float(hi[jb]), float(s[b]), float(s[jb]))
 
 
 def _wrap(a: float) -> float:
