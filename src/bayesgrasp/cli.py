@@ -407,6 +407,18 @@ def demo() -> None:
 
 
 @app.command()
+def table1(as_json: JsonOpt = False) -> None:
+    """The seed's Table 1: our expected cost per plan length beside the printed numbers."""
+    from .table1 import table1_json, table1_rows, table1_text
+
+    rows = table1_rows()
+    if as_json:
+        emit_json(table1_json(rows))
+    else:
+        typer.echo(table1_text(rows))
+
+
+@app.command()
 def study(
     polygons: Annotated[
         int, typer.Option(min=1, help="How many random polygons (the seed: 2000).")
