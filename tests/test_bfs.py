@@ -61,15 +61,25 @@ def assert_agree(problem: Problem) -> bool:
     if not res.stats.completed:
         return False
     exact = plan_exact(problem)
-    assert len(res.report.options) == len(exact.options)
-    assert_allclose(probabilities(res.report), probabilities(exact), atol=1e-9, rtol=0)
+    n = len(res.report.options)
+    # The search stops at the most certain depth (the seed's rule). With action types of
+    # different costs the exact planner may add one longer, cheaper plan after that depth,
+    # which then is its Bayes plan; the per-depth rows must agree all the same.
+    assert len(exact.options) in (n, n + 1)
+    head = exact.options[:n]
+    assert_allclose(probabilities(res.report), [o.success_probability for o in head], atol=1e-9)
     assert_allclose(
         [o.expected_cost for o in res.report.options],
-        [o.expected_cost for o in exact.options],
+        [o.expected_cost for o in head],
         rtol=1e-9,
     )
-    assert res.report.bayes == exact.bayes
     assert res.report.most_certain == exact.most_certain
+    if len(exact.options) == n:
+        assert res.report.bayes == exact.bayes
+    else:
+        assert len(problem.action_kinds) > 1
+        assert exact.bayes == n
+        assert exact.bayes_plan.expected_cost < res.report.bayes_plan.expected_cost
     return True
 
 

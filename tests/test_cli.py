@@ -245,7 +245,7 @@ def test_plan_json_schema(capsys: pytest.CaptureFixture[str]) -> None:
             assert d["tolerance_rad"] is None
         else:
             assert d["tolerance_rad"] == pytest.approx(o.tolerance, abs=1e-12)
-    assert (doc["bayes"], doc["most_certain"]) == (rep.bayes, rep.most_certain) == (1, 2)
+    assert (doc["bayes"], doc["most_certain"]) == (rep.bayes, rep.most_certain) == (2, 2)
     # Top-level fields follow the Bayes plan.
     assert doc["first_squeeze_rad"] == opts[rep.bayes]["first_squeeze_rad"]
     assert_allclose(doc["stable_probabilities"], pb.state_distribution(0.0), atol=1e-12)

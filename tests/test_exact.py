@@ -601,12 +601,17 @@ def test_cost_formula_and_bayes_plan_change() -> None:
         assert_allclose(costs_of(rep), expect, rtol=1e-12)
         assert [o.success_probability for o in rep.options] == list(ps)
         assert rep.bayes == int(np.flatnonzero(expect <= expect.min() * (1 + 1e-12))[0])
-    # The seed's triangle ties 8.0 / 8.0: the tie goes to fewer squeezes.
-    assert_allclose(costs_of(base)[1:], [8.0, 8.0], rtol=1e-12)
-    assert base.bayes == 1 and base.most_certain == 2
-    # A retry overhead makes the less certain plan dearer; a free verification the cheaper.
-    assert plan_exact(Problem.build(tri, cost=CostModel(retry=1.0))).bayes == 2
-    assert plan_exact(Problem.build(tri, cost=CostModel(verify=0.0))).bayes == 0
+    # The seed's triangle row, 10.8 8.7 8.0: the most certain plan is the Bayes plan.
+    assert_allclose(costs_of(base), [10.8, 8.7, 8.0], atol=0.05)
+    assert base.bayes == 2 and base.most_certain == 2
+    # A free verification makes shorter plans relatively cheaper: k / p_k.
+    free = plan_exact(Problem.build(tri, cost=CostModel(verify=0.0)))
+    assert free.bayes == int(np.argmin(k / ps)) and free.bayes < 2
+    # Ties go to fewer squeezes: a cost model making plans 2 and 3 equal picks 2.
+    tie = CostModel(squeeze=1.0, verify=(3 * ps[1] - 2 * ps[2]) / (ps[2] - ps[1]))
+    tied = plan_exact(Problem.build(tri, cost=tie))
+    assert_allclose(costs_of(tied)[1], costs_of(tied)[2], rtol=1e-9)
+    assert tied.bayes == 1
     # A free first squeeze makes the one-squeeze plan the Bayes plan of the rectangle.
     rect = load("rectangle")
     assert plan_exact(Problem.build(rect)).bayes == 1
