@@ -395,15 +395,20 @@ def push(
 
 @app.command()
 def demo() -> None:
-    """The main job: the squeeze analysis of every catalogue part, then the example's plans."""
+    """The main job: the seed's Table 1, then the example part analysed and planned."""
     from .shapes import load
+    from .table1 import table1_rows, table1_text
 
-    for name in catalogue_names():
-        p = load(name)
-        typer.echo(report.squeeze_table(p, squeeze_function(p.hull)))
-        typer.echo("")
-    if "example" in catalogue_names():
-        typer.echo(report.plan_table(plan_exact(Problem.build(load("example")))))
+    typer.echo(table1_text(table1_rows()))
+    typer.echo("")
+    example = load("example")
+    typer.echo(report.squeeze_table(example, squeeze_function(example.hull)))
+    typer.echo("")
+    typer.echo(report.plan_table(plan_exact(Problem.build(example))))
+    typer.echo("")
+    typer.echo("With push-grasps (cost 1) as well as squeezes, the same part:")
+    mixed = Problem.build(example, actions=("squeeze", "push-grasp"))
+    typer.echo(report.plan_table(plan_exact(mixed)))
 
 
 @app.command()

@@ -203,34 +203,44 @@ def push_table(
     return "\n".join(lines)
 
 
-def _plan_text(o: PlanOption) -> str:
-    alphas = ", ".join(f"{math.degrees(a):+.2f}" for a in o.alphas)
-    kinds = {s.kind for s in o.steps}
-    if kinds != {"squeeze"}:
-        return " ".join(
-            f"{'S' if s.kind == 'squeeze' else 'P'}({math.degrees(s.alpha):+.2f})" for s in o.steps
-        )
-    return f"[{alphas}]" if alphas else "-"
+def _plan_text(o: PlanOption, mixed: bool) -> str:
+    """The relative turns in degrees; with push-grasps each step is tagged S or P."""
+    if not mixed:
+        alphas = ", ".join(f"{math.degrees(a):+.2f}" for a in o.alphas)
+        return f"[{alphas}]" if alphas else "-"
+    tag = {"squeeze": "S", "push-grasp": "P"}
+    first = tag[o.steps[0].kind]
+    rest = [f"{tag[s.kind]}{math.degrees(s.alpha):+.2f}" for s in o.steps[1:]]
+    return " ".join([first, *rest])
 
 
 def plan_table(report: PlanReport) -> str:
     """One row per plan length: angles (degrees), success probability, expected cost."""
     pb = report.problem
+    mixed = len(pb.action_kinds) > 1
+    action = "action" if mixed else "squeeze"
+    texts = [_plan_text(o, mixed) for o in report.options]
+    width = max(34, *(len(t) for t in texts))
+    head = "steps (deg)" if mixed else "alphas (deg)"
     lines = [
         f"{pb.part.name}: {pb.part.hull.n_sides} sides, {pb.n_states} stable orientations, "
         f"prior {pb.prior.name}, goal {pb.goal.kind}, method {report.method}",
-        "first: gripper angle of the first squeeze (world frame); "
-        "alphas: gripper turn before each further squeeze",
-        "(relative to the previous squeeze); final: the part's orientation in the last gripper "
-        "frame",
-        f"{'k':>3} {'first (deg)':>11}  {'alphas (deg)':<34} {'final (deg)':>11} "
-        f"{'P(success)':>10} {'E[cost]':>8} {'tol (deg)':>9}",
+        f"first: gripper angle of the first {action} (world frame); "
+        f"alphas: gripper turn before each further {action}",
+        f"(relative to the previous {action}); final: the part's orientation in the last "
+        "gripper frame",
     ]
-    for i, o in enumerate(report.options):
+    if mixed:
+        lines.append("steps: S = squeeze, P = push-grasp, each after its gripper turn")
+    lines.append(
+        f"{'k':>3} {'first (deg)':>11}  {head:<{width}} {'final (deg)':>11} "
+        f"{'P(success)':>10} {'E[cost]':>8} {'tol (deg)':>9}"
+    )
+    for i, (o, text) in enumerate(zip(report.options, texts, strict=True)):
         marks = ("B" if i == report.bayes else " ") + ("C" if i == report.most_certain else " ")
         tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f}"
         lines.append(
-            f"{o.n_actions:>3} {math.degrees(o.first_angle):11.2f}  {_plan_text(o):<34} "
+            f"{o.n_actions:>3} {math.degrees(o.first_angle):11.2f}  {text:<{width}} "
             f"{math.degrees(o.final_orientation):11.2f} {o.success_probability:10.4f} "
             f"{o.expected_cost:8.3f} {tol:>9} {marks}".rstrip()
         )
@@ -287,9 +297,10 @@ def simulate_table(res: SimulationResult, title: str = "") -> str:
     o = res.option
     tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.2f} deg"
     lo, hi = res.ci95
+    steps = _plan_text(o, len(set(o.kinds)) > 1)
     lines = [
         f"{title}{res.engine} execution, {res.trials} trials",
-        f"plan: {_plan_text(o)} (first action at {math.degrees(o.first_angle):.2f} deg, "
+        f"plan: {steps} (first action at {math.degrees(o.first_angle):.2f} deg, "
         f"{o.n_actions} action(s), tolerance {tol}); goal {math.degrees(o.final_orientation):.2f} "
         "deg",
         f"{'final (deg)':>11}  {'predicted':>9}  {'observed':>9}  {'count':>9}",
