@@ -83,7 +83,7 @@ def bench_mujoco(squeezes: int, trials: int) -> None:
     )
 
 
-def study(trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
+def study(trials: int, push_trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
     """The README's table: predicted against MuJoCo success of the catalogue's Bayes plans."""
     from bayesgrasp.execute import SimulationResult
     from bayesgrasp.shapes import names
@@ -93,7 +93,10 @@ def study(trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
         lo, hi = r.ci95
         return f"{r.observed_success:.3f} [{lo:.3f}, {hi:.3f}] ({r.jams}/{r.near_boundary})"
 
-    print(f"Study: {trials} trials a cell, seed 1, {workers} workers ({load_note()})")
+    print(
+        f"Study: {trials} trials a cell ({push_trials} with push-grasps), seed 1, "
+        f"{workers} workers ({load_note()})"
+    )
     print(
         "| part | plan | predicted | MuJoCo, centred | "
         f"MuJoCo, {offset_mm:g} mm off centre |\n|---|---|---|---|---|"
@@ -110,7 +113,8 @@ def study(trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
             kinds = "+".join("P" if k == "push-grasp" else "S" for k in plan.kinds)
             row = [name, f"Bayes, {kinds}", f"{plan.success_probability:.3f}"]
             for off in (0.0, offset_mm / 1000.0):
-                r = simulate_mujoco(pb, plan, trials, offset=off, rng=1, workers=workers)
+                n = push_trials if label == "push" else trials
+                r = simulate_mujoco(pb, plan, n, offset=off, rng=1, workers=workers)
                 row.append(cell(r))
             print("| " + " | ".join(row) + " |", flush=True)
     print(
@@ -168,9 +172,11 @@ def agreement(n: int) -> None:
         return [squeeze_function(p.hull)]
 
     print(f"single actions, starts >= 2.5 deg from basin boundaries ({load_note()})")
+    from bayesgrasp.shapes import names
+
     tri, rect = load("triangle"), load("rectangle")
-    print("  triangle, centred:", run([tri], sq_f))
-    print("  rectangle, centred:", run([rect], sq_f))
+    for name in names():
+        print(f"  {name}, centred:", run([load(name)], sq_f), flush=True)
     print("  8 random 10-gons, 5 cm:", run(randoms, sq_f, count=max(10, n // 3)))
     print("  quadrilateral (0,0),(50,0),(40,30),(5,35) mm:", run([quad], sq_f))
     for off in (0.005, 0.010):
@@ -190,7 +196,7 @@ def agreement(n: int) -> None:
 def main() -> None:
     quick = "--quick" in sys.argv
     if "--study" in sys.argv:
-        study(60 if quick else 300)
+        study(60 if quick else 300, 30 if quick else 150)
         return
     if "--agreement" in sys.argv:
         agreement(20 if quick else 100)

@@ -119,8 +119,12 @@ def test_missing_mujoco_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None
 
 @pytest.mark.parametrize(
     ("part", "scale"),
-    [(SCALENE, 1.0), (HEXAGON, 1.0), (load("triangle"), 0.001), (load("rectangle"), 0.001)],
-    ids=["scalene", "hexagon", "triangle", "rectangle"],
+    [
+        (SCALENE, 1.0),
+        (HEXAGON, 1.0),
+        *((load(n), 0.001) for n in ("triangle", "rectangle", "example", "ic-chip")),
+    ],
+    ids=["scalene", "hexagon", "triangle", "rectangle", "example", "ic-chip"],
 )
 @pytest.mark.physics
 @pytest.mark.skipif(
@@ -170,11 +174,16 @@ def test_push_grasps_end_in_the_predicted_orientation() -> None:
     not HAVE_MUJOCO, reason="MuJoCo is not installed: pip install 'bayesgrasp[sim]'"
 )
 def test_two_squeeze_bayes_plan_success_within_a_binomial_bound() -> None:
+    from bayesgrasp.shapes import names
     from bayesgrasp.sim import simulate_mujoco
 
-    pb = Problem.build(load("triangle"))
-    plan = plan_exact(pb).bayes_plan
-    assert plan.n_actions == 2
+    # the first catalogue part (the example first) whose Bayes plan has two squeezes
+    two = [
+        (pb, pb_plan)
+        for pb in (Problem.build(load(n)) for n in ["example", *names()])
+        if (pb_plan := plan_exact(pb).bayes_plan).n_actions == 2
+    ]
+    pb, plan = two[0]
     res = simulate_mujoco(pb, plan, 120, rng=5)
     assert res.engine == "mujoco" and res.trials == 120
     assert_allclose(res.predicted_success, plan.success_probability, atol=1e-12)

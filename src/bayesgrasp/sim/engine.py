@@ -62,11 +62,9 @@ TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 
 #: Part sizes (metres across, twice the hull's largest distance from its centroid) the
-#: default settings were checked on: random 10-gons agreed with the squeeze model in 30/30
-#: single squeezes from 2.3 cm to 47 cm across (a heavier part gets a stronger squeeze,
-#: ``SimParams.force_ratio``), but lighter parts were thrown out of the jaws by the 0.5 N
-#: squeeze and its soft contacts (0/30 at 1.2 cm, 8/30 at 1.6 cm).
-SIZE_RANGE = (0.02, 0.5)
+#: defaults were checked on: random 10-gons agreed with the squeeze model in 30/30 single
+#: squeezes from 1.2 cm to 35 cm across; at 0.5 and 0.7 cm none agreed, at 94 cm 24/30.
+SIZE_RANGE = (0.01, 0.5)
 
 
 def require_mujoco() -> Any:

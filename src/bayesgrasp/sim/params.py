@@ -40,15 +40,19 @@ class SimParams:
     table_friction : float
         Sliding friction of the part on the table, 0.2 (a plastic part on a smooth metal
         plate). The notes' 6 g triangle agreed at 0.2 and 0.5, but 5 cm random polygons
-        (10-15 g) stalled at 0.5 where the squeeze's couple ``jaw_force * |d'(theta)|`` is
-        small: 246/277 single squeezes agreed at 0.5, 270/277 at 0.2 (this module's
+        (10-15 g) squeezed with 0.5 N stalled at 0.5 where the couple ``force * |d'(theta)|``
+        is small: 246/277 single squeezes agreed at 0.5, 270/277 at 0.2 (this module's
         measurement). The jaws are frictionless whatever this is.
     thickness : float
         The hull is extruded 1 cm: thin enough that the part does not tip, thick enough for
         robust side contacts.
     density : float
-        1000 kg/m^3 (a plastic part): a 4 cm triangle weighs 6 g, so table friction is
-        about 0.012 N, well below the jaw force.
+        1000 kg/m^3 (a plastic part): a 4 cm triangle weighs 6 g. With the jaw force
+        proportional to the weight, the density does not change the outcome.
+    edge_radius : float
+        The jaws touch vertical capsules of radius 0.3 mm at the hull's vertices (see
+        :mod:`bayesgrasp.sim.scene`): thin next to a part of a few centimetres, thick
+        enough for robust contacts. It adds 0.6 mm to every width and moves no extremum.
     jaw_thickness : float
         4 mm plates.
     jaw_length : float
@@ -56,24 +60,27 @@ class SimParams:
         never slides off a jaw's end.
     jaw_mass : float
         0.1 kg per jaw (notes).
-    jaw_damping : float
-        Slide-joint damping, 20 N s/m: with the force limit, caps a free jaw at 2.5 cm/s and
-        damps the contact (notes).
-    jaw_kp : float
-        Position gain, 400 N/m (the notes used 100 and 400). The force limit, not the gain,
-        sets the squeeze force; once a jaw is blocked its force ramps up at
-        ``jaw_kp * jaw_speed``, so 400 N/m reaches 0.5 N 0.125 s after contact (100 N/m: 0.5 s,
-        squeezes a third longer, the same agreement).
-    jaw_force : float
-        Least force limit of each jaw, 0.5 N (notes): 40 times the table friction of a 6 g
-        part, low enough for quasi-static motion and shallow contact penetration (2 N gave
-        the same agreement with four times the orientation error, 0.12 degrees). A squeeze
-        ends only once both jaws push with the full force.
     force_ratio : float
-        A heavier part gets ``force_ratio`` times its table friction ``mu m g`` instead
-        (:meth:`squeeze_force`), 20: parts up to 13 g keep the measured 0.5 N, and a large
-        part is squeezed as firmly relative to its friction (the couple that turns it,
-        ``force * |d'(theta)|``, must beat the friction's moment).
+        Each jaw's force limit is 8 times the part's weight (:meth:`squeeze_force`): 0.47 N
+        for the notes' 6 g triangle, which they squeezed with 0.5 N. A fixed force does not
+        fit every part: 0.5 N threw parts of 1-2 g out of the jaws (0/30 single squeezes
+        agreed for a 1.2 cm random 10-gon, 8/30 at 1.6 cm, 61/100 for the 0.4 g
+        ``ic-chip``), while scaled with the weight every size from 1.2 to 35 cm agreed in
+        30/30. Against support friction the ratio is ``8 / table_friction`` = 40: the couple
+        that turns the part, ``force * |d'(theta)|``, must beat the friction's moment.
+    jaw_force : float
+        The reference force, 0.5 N, for which ``jaw_kp`` and ``jaw_damping`` are given;
+        both are scaled by ``squeeze_force / jaw_force``, so every part sees the same jaw
+        motion and force ramp.
+    jaw_damping : float
+        Slide-joint damping, 20 N s/m at 0.5 N: with the force limit it caps a free jaw at
+        2.5 cm/s and damps the contact (notes).
+    jaw_kp : float
+        Position gain, 400 N/m at 0.5 N (the notes used 100 and 400). The force limit, not
+        the gain, sets the squeeze force; once a jaw is blocked its force ramps up at
+        ``jaw_kp * jaw_speed``, so it reaches the limit 0.125 s after contact (100 N/m:
+        0.5 s, squeezes a third longer, the same agreement). A squeeze ends only once both
+        jaws push with the full force.
     jaw_speed : float
         The jaw targets close at 1 cm/s (notes; 5 cm/s also agreed): slow enough to be
         quasi-static as the model assumes.
@@ -99,8 +106,8 @@ class SimParams:
 
     Examples
     --------
-    >>> SimParams().jaw_force
-    0.5
+    >>> SimParams().force_ratio
+    8.0
     >>> SimParams(jaw_speed=0.05).jaw_speed
     0.05
     """
@@ -113,13 +120,14 @@ class SimParams:
     table_friction: float = 0.2
     thickness: float = 0.01
     density: float = 1000.0
+    edge_radius: float = 0.0003
     jaw_thickness: float = 0.004
     jaw_length: float = 0.16
     jaw_mass: float = 0.1
     jaw_damping: float = 20.0
     jaw_kp: float = 400.0
     jaw_force: float = 0.5
-    force_ratio: float = 20.0
+    force_ratio: float = 8.0
     jaw_speed: float = 0.01
     clearance: float = 0.003
     settle_speed: float = 1e-4
@@ -130,14 +138,26 @@ class SimParams:
     push_distance: float = 0.0
 
     def squeeze_force(self, mass: float) -> float:
-        """Force limit of each jaw for a part of the given mass (kg).
+        """Force limit of each jaw for a part of the given mass (kg): ``force_ratio`` weights.
 
         Examples
         --------
-        >>> SimParams().squeeze_force(0.006), round(SimParams().squeeze_force(0.1), 3)
-        (0.5, 3.924)
+        >>> round(SimParams().squeeze_force(0.006), 4), round(SimParams().squeeze_force(0.1), 3)
+        (0.4709, 7.848)
         """
-        return max(self.jaw_force, self.force_ratio * self.table_friction * mass * 9.81)
+        return self.force_ratio * mass * 9.81
+
+    def jaw_gains(self, mass: float) -> tuple[float, float, float]:
+        """Force limit, position gain and joint damping of each jaw for a part of this mass.
+
+        Examples
+        --------
+        >>> [round(x, 3) for x in SimParams().jaw_gains(0.006)]
+        [0.471, 376.704, 18.835]
+        """
+        force = self.squeeze_force(mass)
+        k = force / self.jaw_force
+        return force, self.jaw_kp * k, self.jaw_damping * k
 
     def __post_init__(self) -> None:
         for f in fields(self):

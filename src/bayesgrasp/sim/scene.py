@@ -8,7 +8,13 @@ coordinates are not rotated). Contacts:
 - part-table: friction ``table_friction`` (support friction, as on a real table);
 - part-jaw: frictionless. The jaw geoms have ``condim="1"`` *and* ``priority="1"``: with
   equal priority MuJoCo takes the larger friction of the two geoms, so without the priority
-  the jaws grip (physics notes: 137/183 agreement instead of 183/183);
+  the jaws grip (physics notes: 137/183 agreement instead of 183/183). The jaws touch thin
+  vertical capsules at the hull's vertices, not the mesh: a flat jaw touches a convex part
+  only at vertices, a capsule's contact normal is the jaw's face normal, and the capsules
+  add ``2 * edge_radius`` to every width, which moves no extremum of the diameter (or
+  radius) function. Against the mesh, MuJoCo's convex collider sometimes returned the
+  normal of a part edge a few degrees from the jaw, whose sideways force pushed the part
+  out between the jaws (the ``example`` part: 199 jams in 200 trials);
 - jaw-table: none (contact bit masks), the jaws hover 1 mm above the table (less under
   a thin part).
 """
@@ -115,8 +121,8 @@ class Prism:
         Diagonal inertia about the centre of mass.
     size : float
         Largest distance of a vertex from the centre of mass.
-    force : float
-        Each jaw's force limit (:meth:`SimParams.squeeze_force`).
+    force, kp, damping : float
+        Each jaw's force limit, position gain and joint damping (:meth:`SimParams.jaw_gains`).
     """
 
     vertices: FloatArray
@@ -125,6 +131,8 @@ class Prism:
     inertia: FloatArray
     size: float
     force: float
+    kp: float
+    damping: float
 
 
 def prism(part: Part, scale: float, params: SimParams | None = None) -> Prism:
@@ -133,8 +141,8 @@ def prism(part: Part, scale: float, params: SimParams | None = None) -> Prism:
     Examples
     --------
     >>> body = prism(Part.from_points([(0, 0), (40, 0), (10, 30)]), 0.001)
-    >>> round(body.mass, 6), body.thickness, body.force
-    (0.006, 0.01, 0.5)
+    >>> round(body.mass, 6), body.thickness, round(body.force, 4)
+    (0.006, 0.01, 0.4709)
     """
     if not (math.isfinite(scale) and scale > 0):
         raise PartError(f"`scale` must be a finite number > 0 (metres per unit); got {scale!r}")
@@ -149,7 +157,7 @@ def prism(part: Part, scale: float, params: SimParams | None = None) -> Prism:
     h = min(sp.thickness, 0.5 * width)
     mass, inertia = part_inertia(rel, np.zeros(2), h, sp.density)
     size = float(np.max(np.hypot(rel[:, 0], rel[:, 1])))
-    return Prism(rel, h, mass, inertia, size, sp.squeeze_force(mass))
+    return Prism(rel, h, mass, inertia, size, *sp.jaw_gains(mass))
 
 
 def _fmt(values: FloatArray | list[float]) -> str:
@@ -190,6 +198,13 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
     gap = min(0.001, 0.25 * h)  # the jaws hover this far above the table
     jaw_h = 0.5 * (h - gap + 0.003)  # half-height: up to 3 mm above the part
     jaw_z = gap + jaw_h
+    rc = min(sp.edge_radius, 0.25 * h)
+    capsules = "\n".join(
+        f'      <geom name="vertex{i}" type="capsule" size="{rc:.9g}" '
+        f'fromto="{x:.9g} {y:.9g} {rc:.9g} {x:.9g} {y:.9g} {h - rc:.9g}" '
+        'mass="0" contype="2" conaffinity="2"/>'
+        for i, (x, y) in enumerate(rel)
+    )
     tc = sp.solref_timeconst
     fr = sp.table_friction
     return f"""<mujoco model="bayesgrasp-squeeze">
@@ -208,24 +223,25 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
     <body name="part" pos="0 0 0">
       <freejoint name="part"/>
       <inertial pos="0 0 {h / 2:.9g}" mass="{mass:.9g}" diaginertia="{_fmt(inertia)}"/>
-      <geom name="part" type="mesh" mesh="part" contype="3" conaffinity="3"
+      <geom name="part" type="mesh" mesh="part" contype="1" conaffinity="1"
             friction="{fr:.9g} 0.005 0.0001"/>
+{capsules}
     </body>
     <body name="jaw_neg" pos="0 0 {jaw_z:.9g}">
-      <joint name="jaw_neg" type="slide" axis="1 0 0" damping="{sp.jaw_damping:.9g}"/>
+      <joint name="jaw_neg" type="slide" axis="1 0 0" damping="{body.damping:.9g}"/>
       <geom name="jaw_neg" type="box" pos="{-t / 2:.9g} 0 0" size="{t / 2:.9g} {jaw_half:.9g} \
 {jaw_h:.9g}" mass="{sp.jaw_mass:.9g}" condim="1" priority="1" contype="2" conaffinity="2"/>
     </body>
     <body name="jaw_pos" pos="0 0 {jaw_z:.9g}">
-      <joint name="jaw_pos" type="slide" axis="1 0 0" damping="{sp.jaw_damping:.9g}"/>
+      <joint name="jaw_pos" type="slide" axis="1 0 0" damping="{body.damping:.9g}"/>
       <geom name="jaw_pos" type="box" pos="{t / 2:.9g} 0 0" size="{t / 2:.9g} {jaw_half:.9g} \
 {jaw_h:.9g}" mass="{sp.jaw_mass:.9g}" condim="1" priority="1" contype="2" conaffinity="2"/>
     </body>
   </worldbody>
   <actuator>
-    <position name="jaw_neg" joint="jaw_neg" kp="{sp.jaw_kp:.9g}"
+    <position name="jaw_neg" joint="jaw_neg" kp="{body.kp:.9g}"
               forcerange="{-force:.9g} {force:.9g}"/>
-    <position name="jaw_pos" joint="jaw_pos" kp="{sp.jaw_kp:.9g}"
+    <position name="jaw_pos" joint="jaw_pos" kp="{body.kp:.9g}"
               forcerange="{-force:.9g} {force:.9g}"/>
   </actuator>
 </mujoco>
