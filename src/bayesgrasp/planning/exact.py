@@ -61,7 +61,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -75,12 +75,16 @@ __all__ = ["plan_exact"]
 
 TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
+Counts = tuple[int, ...]  # how many actions of each type, in ``problem.action_kinds`` order
 _CHUNK = 1 << 20  # arcs enumerated at once (bounds memory for parts with many states)
 
 
 @dataclass(frozen=True, slots=True)
-class _Arc:
-    """An open arc ``(lo, hi)`` of one action's frame and its image ``[s_first, s_last]``."""
+class Arc:
+    """An open arc ``(lo, hi)`` of one action's frame and its image ``[s_first, s_last]``.
+
+    ``s_first .. s_last`` are the stable orientations of the basins the arc covers.
+    """
 
     kind: str
     lo: float
@@ -90,10 +94,12 @@ class _Arc:
 
     @property
     def width(self) -> float:
+        """Length of the arc."""
         return self.hi - self.lo
 
     @property
     def span(self) -> float:
+        """Length of its image."""
         return self.s_last - self.s_first
 
 
@@ -115,23 +121,25 @@ class _Front:
     span_list: list[float]
     width_list: list[float]
 
-    def arc(self, n: int) -> _Arc:
+    def arc(self, n: int) -> Arc:
         """Arc ``n`` as plain floats."""
         lo, s = float(self.lo[n]), float(self.s_first[n])
-        return _Arc(self.kind, lo, lo + self.width_list[n], s, s + self.span_list[n])
+        return Arc(self.kind, lo, lo + self.width_list[n], s, s + self.span_list[n])
 
 
 def _arc_front(f: TransferFunction, max_span: float) -> _Front:
     """The front of the arcs of ``f`` whose image spans less than ``max_span``.
 
-    Of arcs equal in width and span the one of the first basin is kept.
+    Single basins (span 0) are always arcs, even when ``max_span <= 0``. Of arcs equal in
+    width and span the one of the first basin is kept.
     """
     k = f.n_states
     s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
     hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
     i_all = np.arange(k)
-    # Last basin j of an arc starting at basin i: at most K basins, image span < max_span.
-    last = np.minimum(np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all + k - 1)
+    # Last basin j of an arc starting at basin i: at most K basins, image span < max_span,
+    # at least basin i itself.
+    last = np.clip(np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1)
     n_off = int(np.max(last - i_all)) + 1
     rows = max(1, _CHUNK // n_off)
     parts: list[tuple[FloatArray, ...]] = []
@@ -202,7 +210,7 @@ class _Staircase:
         value = np.maximum(at, before)
         return np.asarray(np.where(value > self.tol, value, -np.inf), dtype=np.float64)
 
-    def pick(self, x: float) -> _Arc:
+    def pick(self, x: float) -> Arc:
         """The arc that attains ``tau(x)`` for one span ``x``."""
         r = bisect.bisect_left(self.c_list, x)
         at = float(self.rest[r]) if r < len(self.c_list) else -math.inf
@@ -228,21 +236,65 @@ def _staircase(front: _Front, after: _Staircase | None, tol: float) -> _Staircas
 
 @dataclass(slots=True)
 class _Planner:
-    """The fronts and staircases of one problem, computed on first use."""
+    """The fronts, widest arcs and staircases of one problem, computed on first use.
+
+    ``best[counts]`` is the widest arc that actions of those counts collapse (their best
+    order) and the type of the first action of that order.
+    """
 
     problem: Problem
     tol: float
     max_span: float
-    fronts: dict[str, _Front]
+    fronts: dict[str, _Front] = field(default_factory=dict)
     # Staircase of an action type followed by the actions of staircase ``next_id`` (-1:
     # none), with its own id: a suffix of a plan is found in O(1) from the next one.
-    stairs: dict[tuple[str, int], tuple[int, _Staircase]]
+    stairs: dict[tuple[str, int], tuple[int, _Staircase]] = field(default_factory=dict)
+    best: dict[Counts, tuple[float, str]] = field(default_factory=dict)
+    index: dict[str, int] = field(init=False)  # position of each action type in a Counts
+
+    def __post_init__(self) -> None:
+        self.index = {t: i for i, t in enumerate(self.problem.action_kinds)}
 
     def front(self, kind: str) -> _Front:
         """The arc front of one action type."""
         if kind not in self.fronts:
             self.fronts[kind] = _arc_front(self.problem.transfers[kind], self.max_span)
         return self.fronts[kind]
+
+    def extend(self, level: list[Counts]) -> tuple[list[tuple[Counts, str, float]], list[Counts]]:
+        """The plans one action longer than those of ``level`` (all zeros: no action yet).
+
+        For each counts in ``level`` and each action type put before them: the new counts,
+        that type, and the widest arc the plan collapses (the later actions in their best
+        order). Updates ``best``. Returns these candidates and the next level (the new
+        counts, in order of first appearance).
+        """
+        kinds = self.problem.action_kinds
+        tol = self.tol
+        candidates: list[tuple[Counts, str, float]] = []
+        nxt: dict[Counts, None] = {}
+        for rest in level:
+            # The last action must leave a single stable orientation: an image under tol.
+            limit = self.best[rest][0] if any(rest) else 3.0 * tol
+            for i, t in enumerate(kinds):
+                key = (*rest[:i], rest[i] + 1, *rest[i + 1 :])
+                width = _widest(self.front(t), limit, tol)
+                candidates.append((key, t, width))
+                nxt[key] = None
+                if key not in self.best or width > self.best[key][0] + tol:
+                    self.best[key] = (width, t)
+        return candidates, list(nxt)
+
+    def order(self, counts: Counts, first: str) -> tuple[str, ...]:
+        """Action types of a plan in order: ``first``, then the best order of the rest."""
+        kinds = [first]
+        left = list(counts)
+        left[self.index[first]] -= 1
+        while any(left):
+            kind = self.best[tuple(left)][1]
+            kinds.append(kind)
+            left[self.index[kind]] -= 1
+        return tuple(kinds)
 
     def staircases(self, kinds: tuple[str, ...]) -> list[_Staircase]:
         """The staircase of ``kinds[m:]`` for each ``m``."""
@@ -257,7 +309,7 @@ class _Planner:
             out.append(after)
         return out[::-1]
 
-    def witnesses(self, kinds: tuple[str, ...], length: float) -> tuple[list[_Arc], float | None]:
+    def witnesses(self, kinds: tuple[str, ...], length: float) -> tuple[list[Arc], float | None]:
         """The chain of witness arcs of largest least margin, and that margin.
 
         ``length`` is the success arc's length; the first witness is an arc that wide.
@@ -320,13 +372,10 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     periods = [problem.transfers[t].period for t in kinds]
     cap = min(max(periods), TWO_PI / group)  # no plan orients beyond the period
     p_best, _ = prior.max_arc_mass(cap, group)
-    planner = _Planner(problem, tol, max(periods) + tol, {}, {})
+    planner = _Planner(problem, tol, max(periods) + tol)
 
-    counts_of = {t: i for i, t in enumerate(kinds)}
-    zero = (0,) * len(kinds)
-    best: dict[tuple[int, ...], tuple[float, str]] = {}  # widest arc, first type, per count
     options: list[PlanOption] = []
-    level: list[tuple[int, ...]] = [zero]
+    level: list[Counts] = [(0,) * len(kinds)]
     limit_hard = 4 * problem.part.hull.n_sides + 8
     first_kind = min(kinds, key=lambda t: problem.cost.action_cost(t, first=True))
     next_kind = min(kinds, key=lambda t: problem.cost.action_cost(t))
@@ -340,23 +389,11 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     k = 0
     while True:
         k += 1
-        nxt: dict[tuple[int, ...], None] = {}
-        candidates: list[tuple[tuple[int, ...], str, float]] = []
-        for rest in level:
-            for t in kinds:
-                counts = list(rest)
-                counts[counts_of[t]] += 1
-                key = tuple(counts)
-                limit = best[rest][0] if rest != zero else 3.0 * tol
-                width = _widest(planner.front(t), limit, tol)
-                candidates.append((key, t, width))
-                nxt[key] = None
-                if key not in best or width > best[key][0] + tol:
-                    best[key] = (width, t)
+        candidates, nxt = planner.extend(level)
         scored = []
         for key, t, width in candidates:
             p, _ = prior.max_arc_mass(min(width, cap), group)
-            order = _order(best, key, t, counts_of)
+            order = planner.order(key, t)
             scored.append((p, problem.cost.expected_cost(order, p), order, width))
         cheapest = min(scored, key=lambda s: (s[1], -s[0]))
         if certain_at is None:
@@ -387,29 +424,12 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
                 break
         if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
             raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
-        level = list(nxt)
+        level = nxt
     if extra is not None:
         p, cost, order, width = extra
         options.append(_option(planner, order, width, min(width, cap), p, cost))
     bayes, most = choose_indices(tuple(options))
     return PlanReport(problem, tuple(options), bayes, most, "exact")
-
-
-def _order(
-    best: dict[tuple[int, ...], tuple[float, str]],
-    key: tuple[int, ...],
-    first: str,
-    counts_of: dict[str, int],
-) -> tuple[str, ...]:
-    """Action types of a plan in order: the first, then the best order of the rest."""
-    kinds = [first]
-    counts = list(key)
-    counts[counts_of[first]] -= 1
-    while any(counts):
-        kind = best[tuple(counts)][1]
-        kinds.append(kind)
-        counts[counts_of[kind]] -= 1
-    return tuple(kinds)
 
 
 def _option(
@@ -424,16 +444,32 @@ def _option(
 
     ``placed`` is the length of arc the prior is placed on (``width`` capped at the period).
     """
-    problem = planner.problem
     chain, tolerance = planner.witnesses(kinds, width)
+    return _chain_option(planner.problem, chain, tolerance, placed, p, cost, chain[0].width)
+
+
+def _chain_option(
+    problem: Problem,
+    chain: list[Arc],
+    tolerance: float | None,
+    placed: float,
+    p: float,
+    cost: float,
+    arc: float,
+) -> PlanOption:
+    """The plan option of a chain of witness arcs: gripper angles and final orientation.
+
+    The first action's world angle puts ``chain[0]`` where the prior's mass on an arc of
+    length ``placed`` is largest; the success arc is reported ``arc`` long from there.
+    """
     _, start = problem.prior.max_arc_mass(placed, problem.goal_group, prefer=chain[0].lo)
     angles = [start - chain[0].lo]
     for prev, w in itertools.pairwise(chain):
         # Centre the image [s_first, s_last] of the previous arc inside this witness.
         angles.append(0.5 * (prev.s_first + prev.s_last) - 0.5 * (w.lo + w.hi))
-    steps, turned = _short_turns(kinds, angles)
+    steps, turned = _short_turns(tuple(a.kind for a in chain), angles)
     final = math.fmod(chain[-1].s_first + turned + TWO_PI, TWO_PI)
-    return PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + chain[0].width))
+    return PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + arc))
 
 
 def _short_turns(kinds: tuple[str, ...], angles: list[float]) -> tuple[list[PlanStep], float]:
