@@ -75,8 +75,8 @@ def sequence_costs(pb: Problem, n_max: int) -> dict[tuple[str, ...], tuple[float
     """(success probability, expected cost) of every sequence of action types up to n_max.
 
     Uniform prior, single goal: p = L / (2 pi), with L by backchaining the widest arcs of
-    each sequence (guaranteed.widest_arc: every pair of boundaries, not the exact
-    planner's fronts or count vectors).
+    each sequence in its own order (guaranteed.widest_arc, checked against every pair of
+    boundaries in test_guaranteed; not the exact planner's count vectors and best orders).
     """
     tol = pb.states.angle_tol
     cap = min(max(pb.transfers[t].period for t in pb.action_kinds), TWO_PI)
