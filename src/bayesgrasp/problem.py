@@ -6,7 +6,10 @@
   distribution over states after the first action is the prior mass of each basin.
 - ``A`` (actions): gripper rotations ``alpha`` followed by an action of a given type. For each
   type the continuum of angles falls into finitely many classes with the same effect on the
-  states (section 4.4: at most n^2 for squeezes), see :class:`ActionClasses`.
+  states (section 4.4: at most n^2 for squeezes), see :class:`ActionClasses`. The gripper's
+  ``accuracy`` (radians, default 0) bounds the error of each relative rotation
+  ``alpha_2..alpha_k``: a planner that honours it returns only plans that keep their success
+  under any errors of less than ``accuracy`` on every turn (plan tolerance >= accuracy).
 - ``G`` (transfer): one :class:`~bayesgrasp.transfer.TransferFunction` per action type.
 - ``C`` (cost): a :class:`CostModel`.
 - ``theta*`` (goal): a :class:`Goal`: one final orientation (the seed), or a set of
@@ -219,6 +222,7 @@ class Problem:
     cost: CostModel
     goal: Goal
     action_kinds: tuple[str, ...]
+    accuracy: float = 0.0
     _classes: dict[str, ActionClasses] = field(default_factory=dict, repr=False)
     _memo: dict[str, int] = field(default_factory=dict, repr=False)
 
@@ -230,6 +234,7 @@ class Problem:
         cost: CostModel | None = None,
         goal: Goal | None = None,
         actions: tuple[str, ...] = ("squeeze",),
+        accuracy: float = 0.0,
     ) -> Problem:
         """Set up the six-tuple for a part.
 
@@ -244,7 +249,34 @@ class Problem:
             Default: a single final orientation.
         actions : tuple of str
             Action types available: ``"squeeze"`` and/or ``"push-grasp"``.
+        accuracy : float
+            Accuracy of the gripper's turns, radians (default 0): every relative rotation
+            ``alpha_2..alpha_k`` may err by less than this. The exact and guaranteed planners
+            return only plans whose tolerance is at least ``accuracy``.
+
+        Raises
+        ------
+        PlanningError
+            If ``actions`` is empty or unknown, or ``accuracy`` is not a finite number >= 0.
+        CostError
+            If every plan would cost nothing.
+
+        Examples
+        --------
+        >>> from bayesgrasp.geometry import Part
+        >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]), accuracy=0.01)
+        >>> pb.accuracy
+        0.01
         """
+        if (
+            isinstance(accuracy, bool)
+            or not isinstance(accuracy, int | float)
+            or not math.isfinite(accuracy)
+            or accuracy < 0
+        ):
+            raise PlanningError(
+                f"`accuracy` must be a finite number of radians >= 0; got {accuracy!r}"
+            )
         if not actions:
             raise PlanningError("at least one action type is needed")
         transfers: dict[str, TransferFunction] = {"squeeze": squeeze_function(part.hull)}
@@ -260,7 +292,9 @@ class Problem:
         kinds = tuple(dict.fromkeys(actions))
         cost = cost or CostModel()
         cost.check_positive(kinds)
-        return cls(part, prior or UniformPrior(), transfers, cost, goal or Goal(), kinds)
+        return cls(
+            part, prior or UniformPrior(), transfers, cost, goal or Goal(), kinds, float(accuracy)
+        )
 
     @property
     def states(self) -> TransferFunction:

@@ -77,6 +77,10 @@ TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 Counts = tuple[int, ...]  # how many actions of each type, in ``problem.action_kinds`` order
 _CHUNK = 1 << 20  # arcs enumerated at once (bounds memory for parts with many states)
+# The lengths admit a margin above ``accuracy`` by ``span < L - 2 accuracy``, the staircases
+# compute it as ``(L - span) / 2``: these may differ by rounding, and the witness chain must
+# exist whenever the lengths allow it.
+_ROUNDING = 1e-13
 
 
 @dataclass(frozen=True, slots=True)
@@ -174,12 +178,14 @@ def _front_index(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
     return np.asarray(kept[np.append(c[1:] != c[:-1], True)], dtype=np.intp)
 
 
-def _widest(front: _Front, limit: float, tol: float) -> float:
-    """Width of the widest arc whose image spans less than ``limit - 2 tol``."""
-    n = bisect.bisect_left(front.span_list, limit - 2.0 * tol) - 1
-    if n < 0:  # pragma: no cover - every front holds a single basin (span 0)
-        raise PlanningError("internal error: no arc fits the limit")
-    return front.width_list[n]
+def _widest(front: _Front, max_span: float) -> float:
+    """Width of the widest arc whose image spans less than ``max_span`` (0 if none does).
+
+    Every front holds a single basin (span 0), so only ``max_span <= 0`` gives 0: the arc
+    after this action is too narrow to take even one point with the margin asked for.
+    """
+    n = bisect.bisect_left(front.span_list, max_span) - 1
+    return front.width_list[n] if n >= 0 else 0.0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -200,6 +206,7 @@ class _Staircase:
     c: FloatArray
     c_list: list[float]
     tol: float
+    accuracy: float
 
     def tau(self, x: FloatArray) -> FloatArray:
         """Best least margin for images of spans ``x`` (``-inf`` where none fits)."""
@@ -208,7 +215,8 @@ class _Staircase:
         at = np.where(r < n, self.rest[np.minimum(r, n - 1)], -np.inf)
         before = np.where(r > 0, 0.5 * (self.width[np.maximum(r - 1, 0)] - x), -np.inf)
         value = np.maximum(at, before)
-        return np.asarray(np.where(value > self.tol, value, -np.inf), dtype=np.float64)
+        ok = (value > self.tol) & (value >= self.accuracy - _ROUNDING)
+        return np.asarray(np.where(ok, value, -np.inf), dtype=np.float64)
 
     def pick(self, x: float) -> Arc:
         """The arc that attains ``tau(x)`` for one span ``x``."""
@@ -218,8 +226,13 @@ class _Staircase:
         return self.front.arc(int(self.index[r if at >= before else r - 1]))
 
 
-def _staircase(front: _Front, after: _Staircase | None, tol: float) -> _Staircase:
-    """The staircase of an action whose arcs are ``front``, given the one of the next action."""
+def _staircase(
+    front: _Front, after: _Staircase | None, tol: float, accuracy: float = 0.0
+) -> _Staircase:
+    """The staircase of an action whose arcs are ``front``, given the one of the next action.
+
+    Only margins above ``tol`` and at least ``accuracy`` count (``tau`` is ``-inf`` below).
+    """
     if after is None:  # the last action collapses one basin: only single basins count
         index = np.flatnonzero(front.span <= 0.0)
         rest = np.full(len(index), np.inf)
@@ -231,7 +244,7 @@ def _staircase(front: _Front, after: _Staircase | None, tol: float) -> _Staircas
     index, rest = index[keep], rest[keep]
     width = front.width[index]
     c = width - 2.0 * rest
-    return _Staircase(front, index, rest, width, c, c.tolist(), tol)
+    return _Staircase(front, index, rest, width, c, c.tolist(), tol, accuracy)
 
 
 @dataclass(slots=True)
@@ -271,19 +284,42 @@ class _Planner:
         """
         kinds = self.problem.action_kinds
         tol = self.tol
+        margin = max(tol, self.problem.accuracy)
         candidates: list[tuple[Counts, str, float]] = []
         nxt: dict[Counts, None] = {}
         for rest in level:
             # The last action must leave a single stable orientation: an image under tol.
-            limit = self.best[rest][0] if any(rest) else 3.0 * tol
+            # Before it, the image must fit the next arc with ``margin`` to spare each side.
+            max_span = self.best[rest][0] - 2.0 * margin if any(rest) else tol
             for i, t in enumerate(kinds):
                 key = (*rest[:i], rest[i] + 1, *rest[i + 1 :])
-                width = _widest(self.front(t), limit, tol)
+                width = _widest(self.front(t), max_span)
                 candidates.append((key, t, width))
                 nxt[key] = None
                 if key not in self.best or width > self.best[key][0] + tol:
                     self.best[key] = (width, t)
         return candidates, list(nxt)
+
+    def widest_reachable(self, cap: float, max_actions: int) -> float:
+        """The widest arc any plan collapses, up to ``cap`` (at most ``max_actions`` actions).
+
+        The widest arc of ``k + 1`` actions is ``G(W_k)``, with ``G(L)`` the widest arc of any
+        action type whose image fits an arc ``L`` wide (the best counts of each length keep
+        the widest arc, and ``G`` is non-decreasing). So the widths ``W_k`` are monotone from
+        the first step on: once ``W_{k+1} <= W_k`` no longer plan collapses more. Without
+        accuracy they grow to the period (Goldberg 1993); with it they may stop short.
+        """
+        margin = max(self.tol, self.problem.accuracy)
+        fronts = [self.front(t) for t in self.problem.action_kinds]
+        width = max(_widest(f, self.tol) for f in fronts)
+        for _ in range(max_actions - 1):
+            if width >= cap:
+                break
+            wider = max(_widest(f, width - 2.0 * margin) for f in fronts)
+            if wider <= width + self.tol:
+                break
+            width = wider
+        return width
 
     def order(self, counts: Counts, first: str) -> tuple[str, ...]:
         """Action types of a plan in order: ``first``, then the best order of the rest."""
@@ -303,7 +339,7 @@ class _Planner:
         for kind in reversed(kinds):
             key = (kind, next_id)
             if key not in self.stairs:
-                stair = _staircase(self.front(kind), after, self.tol)
+                stair = _staircase(self.front(kind), after, self.tol, self.problem.accuracy)
                 self.stairs[key] = (len(self.stairs), stair)
             next_id, after = self.stairs[key]
             out.append(after)
@@ -371,12 +407,15 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     kinds = problem.action_kinds
     periods = [problem.transfers[t].period for t in kinds]
     cap = min(max(periods), TWO_PI / group)  # no plan orients beyond the period
-    p_best, _ = prior.max_arc_mass(cap, group)
     planner = _Planner(problem, tol, max(periods) + tol)
+    limit_hard = 4 * problem.part.hull.n_sides + 8
+    # With an accuracy the widths may stop growing short of the period: the highest
+    # attainable probability is that of the widest arc any plan collapses.
+    reach = planner.widest_reachable(cap, limit_hard)
+    p_best, _ = prior.max_arc_mass(min(reach, cap), group)
 
     options: list[PlanOption] = []
     level: list[Counts] = [(0,) * len(kinds)]
-    limit_hard = 4 * problem.part.hull.n_sides + 8
     first_kind = min(kinds, key=lambda t: problem.cost.action_cost(t, first=True))
     next_kind = min(kinds, key=lambda t: problem.cost.action_cost(t))
 
