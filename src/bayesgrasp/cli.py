@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import enum
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Annotated, Any
@@ -15,7 +16,7 @@ from typing import Annotated, Any
 import typer
 
 from . import report
-from .errors import BayesGraspError
+from .errors import BayesGraspError, NoPlanError
 from .geometry import Part
 from .io import resolve_part
 from .planning import plan_exact
@@ -144,6 +145,7 @@ def build_problem(
     goal: GoalKind,
     actions: tuple[str, ...] = ("squeeze",),
     push_grasp_cost: float = 1.0,
+    accuracy_deg: float = 0.0,
 ) -> Problem:
     """Parse the options shared by planning commands into a problem."""
     cost = CostModel(
@@ -154,7 +156,27 @@ def build_problem(
         push_grasp=push_grasp_cost,
     )
     p = resolve_part(part) if isinstance(part, str) else part
-    return Problem.build(p, parse_prior(prior), cost, Goal(goal.value), actions=actions)
+    return Problem.build(
+        p,
+        parse_prior(prior),
+        cost,
+        Goal(goal.value),
+        actions=actions,
+        accuracy=math.radians(accuracy_deg),
+    )
+
+
+# The gripper accuracy of the commands that plan (Problem.build's ``accuracy``, in degrees).
+AccuracyOpt = Annotated[
+    float,
+    typer.Option(
+        "--accuracy",
+        min=0,
+        metavar="DEG",
+        help="Gripper accuracy: each turn between actions may err by up to DEG degrees; "
+        "only plans whose tolerance is at least DEG are returned (exact planner).",
+    ),
+]
 
 
 @app.command()
@@ -189,6 +211,7 @@ def plan(
         ),
     ] = "squeeze",
     push_grasp_cost: Annotated[float, typer.Option(min=0, help="Cost of a push-grasp.")] = 1.0,
+    accuracy: AccuracyOpt = 0.0,
     guaranteed: Annotated[
         bool,
         typer.Option(
@@ -225,6 +248,7 @@ def plan(
         goal,
         actions=tuple(a.strip() for a in actions.split(",") if a.strip()),
         push_grasp_cost=push_grasp_cost,
+        accuracy_deg=accuracy,
     )
     if method is Method.bfs:
         from .planning.bfs import plan_bfs
@@ -233,25 +257,36 @@ def plan(
     else:
         rep = plan_exact(pb, max_actions=max_squeezes)
     sure = None
+    no_plan: str | None = None  # why no guaranteed plan exists (exit code 1)
     if guaranteed:
         from .planning.guaranteed import plan_guaranteed
 
-        sure = plan_guaranteed(pb)
+        try:
+            sure = plan_guaranteed(pb)
+        except NoPlanError as exc:
+            no_plan = str(exc)
     if as_json:
         plan2 = guaranteed or "push-grasp" in pb.action_kinds
         doc = report.plan_json(rep, "bayesgrasp.plan/2" if plan2 else "bayesgrasp.plan/1")
         if sure is not None:
             doc["guaranteed"] = report.guaranteed_json(sure)
+        if no_plan is not None:
+            doc["guaranteed"] = None
+            doc["guaranteed_missing"] = no_plan
         emit_json(doc)
     else:
         typer.echo(report.plan_table(rep))
         if sure is not None:
             typer.echo(report.guaranteed_text(sure))
+        if no_plan is not None:
+            typer.echo(f"Guaranteed plan: none ({no_plan})")
     if plot_file is not None:
         from .plotting import plan_figure
 
         save_figure(plan_figure(rep), plot_file)
         typer.echo(f"bayesgrasp: wrote {plot_file}", err=True)
+    if no_plan is not None:
+        raise typer.Exit(1)
 
 
 IMAGE_FORMATS = ("png", "svg", "pdf")
@@ -317,6 +352,7 @@ def plot(
     frames: Annotated[
         int, typer.Option(min=4, max=240, help="Animation frames per plan step.")
     ] = 20,
+    accuracy: AccuracyOpt = 0.0,
     as_json: JsonOpt = False,
     fmt: FormatOpt = None,
     element: ElementOpt = None,
@@ -333,7 +369,11 @@ def plot(
             f"expected a comma-separated list of png, svg, pdf; got {image_formats!r}",
             param_hint="--image-formats",
         )
-    pb = Problem.build(load_part(part, fmt, element, layer, flatten_tol), parse_prior(prior))
+    pb = Problem.build(
+        load_part(part, fmt, element, layer, flatten_tol),
+        parse_prior(prior),
+        accuracy=math.radians(accuracy),
+    )
     if which is PlotPlan.guaranteed:
         from .planning.guaranteed import plan_guaranteed
 
@@ -568,6 +608,7 @@ def simulate(
         bool,
         typer.Option("--push-grasp", help="Plan with push-grasps as well as squeezes."),
     ] = False,
+    accuracy: AccuracyOpt = 0.0,
     units: Annotated[
         str | None,
         typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
@@ -590,10 +631,13 @@ def simulate(
         )
     p = load_part(part, fmt, element, layer, flatten_tol)
     actions: tuple[str, ...] = ("squeeze", "push-grasp") if push_grasp else ("squeeze",)
-    pb = Problem.build(p, parse_prior(prior), goal=Goal(goal.value), actions=actions)
+    acc = math.radians(accuracy)
+    pb = Problem.build(p, parse_prior(prior), goal=Goal(goal.value), actions=actions, accuracy=acc)
     option, label = simulated_plan(which, pb)
     if "push-grasp" in option.kinds and "push-grasp" not in pb.transfers:
-        pb = Problem.build(p, pb.prior, goal=pb.goal, actions=("squeeze", "push-grasp"))
+        pb = Problem.build(
+            p, pb.prior, goal=pb.goal, actions=("squeeze", "push-grasp"), accuracy=acc
+        )
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
     err = GripperNoise(noise_kind.value, math.radians(noise))
 

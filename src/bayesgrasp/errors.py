@@ -16,6 +16,9 @@ turns each into one line on stderr and exit code 2.
 
     ``PlanningError``: a planning problem that cannot be set up or solved.
 
+    ``NoPlanError`` (a ``PlanningError``): no plan reaches the goal asked for (a guaranteed
+    plan under a gripper accuracy no plan can honour); the command line exits with code 1.
+
     ``MissingExtraError`` (also an ``ImportError``): an optional extra is not installed.
 """
 
@@ -25,6 +28,7 @@ __all__ = [
     "BayesGraspError",
     "CostError",
     "MissingExtraError",
+    "NoPlanError",
     "PartError",
     "PartFileError",
     "PlanningError",
@@ -54,6 +58,10 @@ class CostError(BayesGraspError, ValueError):
 
 class PlanningError(BayesGraspError):
     """A planning problem that cannot be set up or solved."""
+
+
+class NoPlanError(PlanningError):
+    """No plan reaches the goal asked for; the message says why."""
 
 
 class MissingExtraError(BayesGraspError, ImportError):

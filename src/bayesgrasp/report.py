@@ -127,6 +127,8 @@ def plan_json(report: PlanReport, schema: str = "bayesgrasp.plan/1") -> dict[str
     }
     if report.nodes is not None:
         out["nodes"] = report.nodes
+    if pb.accuracy > 0:
+        out["accuracy_rad"] = pb.accuracy
     return out
 
 
@@ -224,7 +226,8 @@ def plan_table(report: PlanReport) -> str:
     head = "steps (deg)" if mixed else "alphas (deg)"
     lines = [
         f"{pb.part.name}: {pb.part.hull.n_sides} sides, {pb.n_states} stable orientations, "
-        f"prior {pb.prior.name}, goal {pb.goal.kind}, method {report.method}",
+        f"prior {pb.prior.name}, goal {pb.goal.kind}, method {report.method}"
+        + (f", gripper accuracy {math.degrees(pb.accuracy):g} deg" if pb.accuracy > 0 else ""),
         f"first: gripper angle of the first {action} (world frame); "
         f"alphas: gripper turn before each further {action}",
         f"(relative to the previous {action}); final: the part's orientation in the last "

@@ -365,6 +365,12 @@ def search_bfs(
     -------
     BfsResult
 
+    Raises
+    ------
+    PlanningError
+        If ``max_actions``, ``node_limit`` or ``fallback_limit`` is less than 1, or the
+        problem has a gripper ``accuracy`` (the baseline assumes exact turns).
+
     Examples
     --------
     >>> from bayesgrasp.geometry import Part
@@ -375,6 +381,13 @@ def search_bfs(
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    if problem.accuracy > 0:
+        # Its action classes assume exact turns; a class margin is only a lower bound on a
+        # plan's tolerance, so filtering on it would lose plans the exact planner finds.
+        raise PlanningError(
+            "the breadth-first baseline assumes exact gripper turns: the problem's "
+            f"`accuracy` must be 0; got {problem.accuracy!r} rad (use the exact planner)"
+        )
     if node_limit < 1 or fallback_limit < 1:
         raise PlanningError(
             f"`node_limit` and `fallback_limit` must be at least 1; got {node_limit} and "

@@ -33,6 +33,11 @@ each turn after the first may err by the plan's tolerance, the largest of any pl
 these action types in this order that collapses an arc this wide. Among equally cheap
 shortest plans the one of largest tolerance is returned.
 
+With a gripper accuracy (``Problem.accuracy``) every image must fit the next arc with that
+margin to spare on each side, as in the exact planner; the widths may then stop growing
+short of the period, and no guaranteed plan exists (:class:`~bayesgrasp.errors.NoPlanError`,
+raised as soon as the widths stop growing).
+
 Cost: O(K^2) once per action type for its front (K stable orientations), O(log K) per
 (count of each type, first type), and O(F log F) per action for the witnesses (F arcs on a
 front). Sharing the code, the lengths agree with the exact planner's by construction; the
@@ -46,7 +51,7 @@ import bisect
 import math
 from dataclasses import dataclass
 
-from ..errors import PlanningError
+from ..errors import NoPlanError, PlanningError
 from ..problem import Problem
 from ..transfer import TransferFunction
 from .exact import Arc, _arc_front, _chain_option, _Planner
@@ -137,6 +142,9 @@ def plan_guaranteed(problem: Problem) -> GuaranteedPlan:
 
     Raises
     ------
+    NoPlanError
+        If the widest collapsible arc stops growing short of the period: no plan honours the
+        problem's gripper accuracy (without one, Goldberg 1993 proves a plan exists).
     PlanningError
         If no plan is found within ``4 n + 8`` actions (a degenerate part; Goldberg 1993
         bounds plans by O(n)).
@@ -174,6 +182,15 @@ def plan_guaranteed(problem: Problem) -> GuaranteedPlan:
             cost = problem.cost.expected_cost(tuple(a.kind for a in chain), p)
             option = _chain_option(problem, chain, margin, placed, p, cost, placed)
             return GuaranteedPlan(option, period, tuple(widths))
+        # The widest arc of k + 1 actions is a non-decreasing function of that of k (see
+        # exact.py): once it stops growing it never grows again.
+        if len(widths) > 1 and widths[-1] <= widths[-2] + tol:
+            raise NoPlanError(
+                f"no guaranteed plan for part {problem.part.name!r} with gripper accuracy "
+                f"{math.degrees(problem.accuracy):.6g} deg: the widest arc any plan collapses "
+                f"stops at {math.degrees(max(widths)):.6f} deg, short of the period "
+                f"{math.degrees(period):.6f} deg"
+            )
     raise PlanningError(
         f"no guaranteed plan within {4 * poly.n_sides + 8} actions for part "
         f"{problem.part.name!r} (widest collapsible arc {math.degrees(widths[-1]):.6f} deg, "
