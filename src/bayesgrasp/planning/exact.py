@@ -51,6 +51,17 @@ at most ``t`` on every turn, the orientations that can arrive before an action f
 basins of an arc whose width exceeds the arriving span by ``2 t``; so no plan with this
 success arc has a larger tolerance than the chain's.
 
+Gripper accuracy (``Problem.accuracy``, ``A``): the same argument with margin ``A``. An
+image must span less than ``L(seq') - 2 max(tol, A)``, so that it fits the next witness with
+more than ``A`` to spare on each side, and the staircases admit only margins of at least
+``A``: every plan of two or more actions then has tolerance at least ``A``, and since under
+errors up to ``A`` the arriving orientations fill an arc ``2 A`` wider than the image, no
+plan robust to such errors collapses more. The widest arc of ``k + 1`` actions is
+``G(W_k)`` with ``G`` non-decreasing (the widest arc of any action type whose image fits an
+arc ``W_k`` wide), so ``W_k`` is monotone; with ``A > 0`` it may stop short of the period,
+and the search then stops at the fixed point: the highest attainable probability is that of
+the widest arc reached (``_Planner.widest_reachable``, computed before the search).
+
 Cost: O(K^2) once per action type for the front (K stable orientations; usually far fewer
 arcs survive), then O(log K) per (count, type) for the lengths and O(F log F) per action of
 each reported plan for its witnesses (F arcs on the front).
@@ -375,6 +386,9 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
         Stop after plans of this many actions even if more would raise the success
         probability (default: go on until the highest attainable probability).
 
+    Honours the problem's gripper ``accuracy``: every plan of two or more actions has
+    tolerance at least ``accuracy``, and is the best of those that do.
+
     Returns
     -------
     PlanReport
@@ -398,6 +412,16 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
     ([6.3, 6.0], 1)
     >>> [round(math.degrees(a), 2) for a in rep.options[1].alphas]
     [-45.0]
+
+    >>> round(math.degrees(rep.options[1].tolerance), 3)
+    12.171
+
+    With turns that err by up to 20 degrees no 2-squeeze plan collapses more than the
+    widest basin, which one squeeze collapses already:
+
+    >>> rep = plan_exact(Problem.build(rect, accuracy=math.radians(20)))
+    >>> [o.n_actions for o in rep.options]
+    [1]
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
