@@ -520,16 +520,7 @@ class Part:
         """
         outline = as_points(points).copy()
         hull = ConvexPolygon.from_points(outline, tol)
-        if center_of_mass is None:
-            com = hull.centroid.copy()
-        else:
-            com = as_points(
-                np.reshape(np.asarray(center_of_mass, dtype=object), (1, -1)), "center_of_mass"
-            )[0].copy()
-            if not hull_contains(hull, com):
-                raise PartError(
-                    f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull"
-                )
+        com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
         outline.setflags(write=False)
         com.setflags(write=False)
         return cls(name, hull, outline, com, units)
@@ -629,18 +620,20 @@ class Part:
             weighted = areas[0] * centroids[0] - sum(
                 (a * c for a, c in zip(areas[1:], centroids[1:], strict=True)), np.zeros(2)
             )
-            com = np.asarray(weighted / net, dtype=np.float64)
+            com = _center_of_mass(hull, weighted / net)
         else:
-            com = as_points(
-                np.reshape(np.asarray(center_of_mass, dtype=object), (1, -1)), "center_of_mass"
-            )[0].copy()
-        if not hull_contains(hull, com):
-            raise PartError(
-                f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull"
-            )
+            com = _center_of_mass(hull, center_of_mass)
         for arr in (*oriented, com):
             arr.setflags(write=False)
         return cls(name, hull, oriented[0], com, units, tuple(oriented[1:]))
+
+
+def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
+    """A centre of mass as a fresh (2,) array, refused unless strictly inside the hull."""
+    com = as_points(np.reshape(np.asarray(point, dtype=object), (1, -1)), "center_of_mass")[0]
+    if not hull_contains(hull, com):
+        raise PartError(f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull")
+    return np.array(com, dtype=np.float64)
 
 
 def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
