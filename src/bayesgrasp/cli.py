@@ -43,6 +43,13 @@ PartArg = Annotated[
     typer.Argument(help="Catalogue name or part file (.json, .csv, .wkt, .geojson, .svg, .dxf)."),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON for machines.")]
+PriorOpt = Annotated[
+    str,
+    typer.Option(
+        help="Prior on the initial orientation: uniform | vonmises:MEAN_DEG,KAPPA | "
+        "histogram:FILE (bin weights over [0, 360) deg) | sample:FILE (observed angles, deg)."
+    ),
+]
 
 
 class PartFormat(enum.StrEnum):
@@ -116,9 +123,7 @@ class GoalKind(enum.StrEnum):
 @app.command()
 def squeeze(
     part: PartArg,
-    prior: Annotated[
-        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
-    ] = "uniform",
+    prior: PriorOpt = "uniform",
     as_json: JsonOpt = False,
     fmt: FormatOpt = None,
     element: ElementOpt = None,
@@ -182,9 +187,7 @@ AccuracyOpt = Annotated[
 @app.command()
 def plan(
     part: PartArg,
-    prior: Annotated[
-        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
-    ] = "uniform",
+    prior: PriorOpt = "uniform",
     squeeze_cost: Annotated[float, typer.Option(min=0, help="Cost of a squeeze.")] = 1.0,
     verify_cost: Annotated[float, typer.Option(min=0, help="Cost of the verification.")] = 1.0,
     first_squeeze_cost: Annotated[
@@ -334,9 +337,7 @@ def plot(
         PlotPlan,
         typer.Option("--plan", help="The plan to draw: Bayes, most certain, or guaranteed."),
     ] = PlotPlan.bayes,
-    prior: Annotated[
-        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
-    ] = "uniform",
+    prior: PriorOpt = "uniform",
     push_grasp: Annotated[
         bool, typer.Option("--push-grasp", help="Also draw the push-grasp function.")
     ] = False,
@@ -407,9 +408,7 @@ def plot(
 @app.command()
 def push(
     part: PartArg,
-    prior: Annotated[
-        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
-    ] = "uniform",
+    prior: PriorOpt = "uniform",
     as_json: JsonOpt = False,
     fmt: FormatOpt = None,
     element: ElementOpt = None,
@@ -598,9 +597,7 @@ def simulate(
         NoiseKind, typer.Option(help="Gripper error distribution.")
     ] = NoiseKind.normal,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
-    prior: Annotated[
-        str, typer.Option(help="uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE | sample:FILE")
-    ] = "uniform",
+    prior: PriorOpt = "uniform",
     goal: Annotated[
         GoalKind, typer.Option(help="single: one final orientation; symmetry: up to symmetry.")
     ] = GoalKind.single,
