@@ -10,6 +10,7 @@ import enum
 import json
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -104,6 +105,28 @@ def load_part(
 def emit_json(doc: dict[str, Any]) -> None:
     """Print a JSON document (no NaN or infinity: those become null upstream)."""
     typer.echo(json.dumps(doc, indent=2, allow_nan=False))
+
+
+def with_progress(description: str, total: int, work: Callable[[Any], Any]) -> Any:
+    """Run ``work(progress)`` with a rich progress bar on a terminal, without one elsewhere.
+
+    ``progress`` is ``None`` or a callback ``(done, total)`` the library calls as it goes.
+    """
+    if not sys.stderr.isatty():
+        return work(None)
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    with Progress(
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    ) as bar:
+        task = bar.add_task(description, total=total)
+        return work(lambda done, _total: bar.update(task, completed=done))
 
 
 class Method(enum.StrEnum):
@@ -489,24 +512,9 @@ def study(
         "method": method.value,
         "bfs_stats": bfs_stats or method is Method.bfs,
     }
-    if sys.stderr.isatty():
-        from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
-
-        with Progress(
-            "[progress.description]{task.description}",
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeElapsedColumn(),
-            console=Console(stderr=True),
-            transient=True,
-        ) as bar:
-            task = bar.add_task("planning polygons", total=polygons)
-            res = run_study(
-                **kwargs, progress=lambda done, _total: bar.update(task, completed=done)
-            )
-    else:
-        res = run_study(**kwargs)
+    res = with_progress(
+        "planning polygons", polygons, lambda progress: run_study(**kwargs, progress=progress)
+    )
     if as_json:
         emit_json(study_json(res))
     else:
@@ -657,22 +665,7 @@ def simulate(
             progress=progress,
         )
 
-    if sys.stderr.isatty():
-        from rich.console import Console
-        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
-
-        with Progress(
-            "[progress.description]{task.description}",
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeElapsedColumn(),
-            console=Console(stderr=True),
-            transient=True,
-        ) as bar:
-            task = bar.add_task(f"{engine.value} trials", total=n)
-            res = run(lambda done, _total: bar.update(task, completed=done))
-    else:
-        res = run(None)
+    res = with_progress(f"{engine.value} trials", n, run)
     if as_json:
         emit_json(report.simulate_json(res, p))
     else:
