@@ -20,11 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from bayesgrasp.geometry import Part
+from bayesgrasp.geometry.polygon import Part
+from bayesgrasp.model.problem import CostModel, Problem
+from bayesgrasp.paper.study import random_polygon
 from bayesgrasp.planning import plan_exact
 from bayesgrasp.planning.guaranteed import plan_guaranteed
-from bayesgrasp.problem import CostModel, Problem
-from bayesgrasp.study import random_polygon
 
 
 def timed(fn: Callable[[], Any], repeat: int) -> tuple[float, float, Any]:

@@ -19,11 +19,11 @@ from typing import Any
 
 import numpy as np
 
-from bayesgrasp.geometry import Part
+from bayesgrasp.geometry.polygon import Part
+from bayesgrasp.model.problem import Problem
+from bayesgrasp.paper.study import random_polygon, run_study
 from bayesgrasp.planning import plan_exact
 from bayesgrasp.planning.bfs import search_bfs
-from bayesgrasp.problem import Problem
-from bayesgrasp.study import random_polygon, run_study
 
 
 def timed(fn: Callable[[], Any], repeat: int = 1) -> tuple[float, float, Any]:

@@ -21,10 +21,10 @@ import time
 
 import numpy as np
 
-from bayesgrasp.execute import simulate_kinematic
+from bayesgrasp.model.problem import Problem
 from bayesgrasp.planning import plan_exact
-from bayesgrasp.problem import Problem
 from bayesgrasp.shapes import load
+from bayesgrasp.sim.kinematic import simulate_kinematic
 
 
 def load_note() -> str:
@@ -85,9 +85,9 @@ def bench_mujoco(squeezes: int, trials: int) -> None:
 
 def study(trials: int, push_trials: int, offset_mm: float = 5.0, workers: int = 2) -> None:
     """The README's table: predicted against MuJoCo success of the catalogue's Bayes plans."""
-    from bayesgrasp.execute import SimulationResult
     from bayesgrasp.shapes import names
     from bayesgrasp.sim import simulate_mujoco
+    from bayesgrasp.sim.kinematic import SimulationResult
 
     def cell(r: SimulationResult) -> str:
         lo, hi = r.ci95
@@ -125,13 +125,13 @@ def study(trials: int, push_trials: int, offset_mm: float = 5.0, workers: int = 
 
 def agreement(n: int) -> None:
     """Single actions from random yaws away from basin boundaries: model against MuJoCo."""
-    from bayesgrasp.execute import boundary_distance
-    from bayesgrasp.geometry import Part
+    from bayesgrasp.geometry.polygon import Part
+    from bayesgrasp.geometry.transfer import TransferFunction, squeeze_function
     from bayesgrasp.sim import Squeezer
-    from bayesgrasp.transfer import TransferFunction, squeeze_function
+    from bayesgrasp.sim.kinematic import boundary_distance
 
     try:
-        from bayesgrasp.push import push_function, push_grasp_function
+        from bayesgrasp.geometry.push import push_function, push_grasp_function
     except ImportError:  # pragma: no cover
         push_function = push_grasp_function = None  # type: ignore[assignment]
 

@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from bayesgrasp.diameter import diameter_function
-from bayesgrasp.geometry import ConvexPolygon
-from bayesgrasp.transfer import squeeze_function
+from bayesgrasp.geometry.diameter import diameter_function
+from bayesgrasp.geometry.polygon import ConvexPolygon
+from bayesgrasp.geometry.transfer import squeeze_function
 
 Timing = dict[str, tuple[float, float]]  # stage -> (wall seconds, cpu seconds)
 

@@ -34,13 +34,13 @@ from importlib import resources
 
 import numpy as np
 
-from bayesgrasp.diameter import diameter_function
 from bayesgrasp.errors import BayesGraspError
-from bayesgrasp.geometry import Part
+from bayesgrasp.geometry.diameter import diameter_function
+from bayesgrasp.geometry.polygon import Part
+from bayesgrasp.geometry.transfer import squeeze_function
+from bayesgrasp.model.problem import Problem
+from bayesgrasp.paper.table1 import paper_row
 from bayesgrasp.planning import execute_plan, plan_exact
-from bayesgrasp.problem import Problem
-from bayesgrasp.table1 import paper_row
-from bayesgrasp.transfer import squeeze_function
 
 Points = list[tuple[float, float]]
 

@@ -24,7 +24,7 @@ from shapely.geometry import LineString, Point, Polygon
 
 from bayesgrasp.cli import main
 from bayesgrasp.errors import MissingExtraError, PartError, PartFileError
-from bayesgrasp.geometry import Part, find_crossing
+from bayesgrasp.geometry.polygon import Part, find_crossing
 from bayesgrasp.io import MAX_POINTS, read_part, resolve_part
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

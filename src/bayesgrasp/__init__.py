@@ -12,7 +12,6 @@ Examples
 [6.3, 6.0]
 """
 
-from .diameter import DiameterFunction, diameter_function
 from .errors import (
     BayesGraspError,
     CostError,
@@ -23,8 +22,21 @@ from .errors import (
     PlanningError,
     PriorError,
 )
-from .geometry import ConvexPolygon, Part
+from .geometry.diameter import DiameterFunction, diameter_function
+from .geometry.polygon import ConvexPolygon, Part
+from .geometry.push import RadiusFunction, push_function, push_grasp_function, radius_function
+from .geometry.transfer import TransferFunction, squeeze_function
 from .io import read_part, resolve_part
+from .model.prior import (
+    DensityPrior,
+    HistogramPrior,
+    Prior,
+    SamplePrior,
+    UniformPrior,
+    parse_prior,
+    von_mises,
+)
+from .model.problem import CostModel, Goal, Problem
 from .planning import (
     GuaranteedPlan,
     PlanOption,
@@ -34,19 +46,7 @@ from .planning import (
     plan_exact,
     plan_guaranteed,
 )
-from .prior import (
-    DensityPrior,
-    HistogramPrior,
-    Prior,
-    SamplePrior,
-    UniformPrior,
-    parse_prior,
-    von_mises,
-)
-from .problem import CostModel, Goal, Problem
-from .push import RadiusFunction, push_function, push_grasp_function, radius_function
 from .tolerance import DEFAULT_TOLERANCE, Tolerance
-from .transfer import TransferFunction, squeeze_function
 
 __version__ = "0.1.0"
 

@@ -18,13 +18,13 @@ import typer
 
 from . import report
 from .errors import BayesGraspError, NoPlanError
-from .geometry import Part
+from .geometry.polygon import Part
+from .geometry.transfer import squeeze_function
 from .io import resolve_part
+from .model.prior import parse_prior
+from .model.problem import CostModel, Goal, Problem
 from .planning import plan_exact
-from .prior import parse_prior
-from .problem import CostModel, Goal, Problem
 from .shapes import names as catalogue_names
-from .transfer import squeeze_function
 
 app = typer.Typer(
     help=(
@@ -307,7 +307,7 @@ def plan(
         if no_plan is not None:
             typer.echo(f"Guaranteed plan: none ({no_plan})")
     if plot_file is not None:
-        from .plotting import plan_figure
+        from .figures.plots import plan_figure
 
         save_figure(plan_figure(rep), plot_file)
         typer.echo(f"bayesgrasp: wrote {plot_file}", err=True)
@@ -384,7 +384,7 @@ def plot(
     flatten_tol: FlattenTolOpt = None,
 ) -> None:
     """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif."""
-    from .plotting import write_figures
+    from .figures.plots import write_figures
 
     formats = [f.strip().lower() for f in image_formats.split(",") if f.strip()]
     bad = [f for f in formats if f not in IMAGE_FORMATS]
@@ -443,7 +443,7 @@ def push(
     The push turns the part down its radius function about the centre of mass until an edge
     lies flat against the pushing jaw (on the gripper's -x side); the table names that edge.
     """
-    from .push import push_function, push_grasp_function, radius_function
+    from .geometry.push import push_function, push_grasp_function, radius_function
 
     p = load_part(part, fmt, element, layer, flatten_tol)
     pr = parse_prior(prior)
@@ -458,8 +458,8 @@ def push(
 @app.command()
 def demo() -> None:
     """The main job: the seed's Table 1, then the example part analysed and planned."""
+    from .paper.table1 import table1_rows, table1_text
     from .shapes import load
-    from .table1 import table1_rows, table1_text
 
     typer.echo(table1_text(table1_rows()))
     typer.echo("")
@@ -476,7 +476,7 @@ def demo() -> None:
 @app.command()
 def table1(as_json: JsonOpt = False) -> None:
     """The seed's Table 1: our expected cost per plan length beside the printed numbers."""
-    from .table1 import table1_json, table1_rows, table1_text
+    from .paper.table1 import table1_json, table1_rows, table1_text
 
     rows = table1_rows()
     if as_json:
@@ -504,7 +504,7 @@ def study(
     as_json: JsonOpt = False,
 ) -> None:
     """The seed's study: hulls of 10 random points in the unit square, planned and counted."""
-    from .study import run_study, study_json, study_table
+    from .paper.study import run_study, study_json, study_table
 
     kwargs: dict[str, Any] = {
         "polygons": polygons,
@@ -537,7 +537,7 @@ class NoiseKind(enum.StrEnum):
 
 def simulated_plan(which: str, pb: Problem) -> tuple[Any, str]:
     """The plan option named by ``--plan`` (bayes, most-certain, guaranteed or a file)."""
-    from .execute import SimulationError, plan_from_json
+    from .sim.kinematic import SimulationError, plan_from_json
 
     if which in ("bayes", "most-certain"):
         rep = plan_exact(pb)
@@ -627,7 +627,7 @@ def simulate(
     """Execute a plan many times and compare the final orientations with the prediction."""
     import math
 
-    from .execute import GripperNoise, simulate_kinematic
+    from .sim.kinematic import GripperNoise, simulate_kinematic
 
     if engine is Engine.kinematic and offset > 0:
         raise typer.BadParameter(

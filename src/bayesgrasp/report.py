@@ -11,16 +11,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .geometry import Part
+from .geometry.polygon import Part
+from .geometry.push import RadiusFunction
+from .geometry.transfer import TransferFunction
+from .model.prior import Prior, UniformPrior
+from .model.problem import Problem
 from .planning.guaranteed import GuaranteedPlan
-from .planning.plan import PlanOption, PlanReport
-from .prior import Prior, UniformPrior
-from .problem import Problem
-from .push import RadiusFunction
-from .transfer import TransferFunction
+from .planning.result import PlanOption, PlanReport
 
 if TYPE_CHECKING:
-    from .execute import SimulationResult
+    from .sim.kinematic import SimulationResult
 
 __all__ = [
     "guaranteed_json",

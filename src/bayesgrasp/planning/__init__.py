@@ -1,9 +1,9 @@
-"""Planners: each takes a :class:`~bayesgrasp.problem.Problem` and returns a plan report."""
+"""Planners: each takes a :class:`~bayesgrasp.model.problem.Problem` and returns a plan report."""
 
 from .bfs import plan_bfs
 from .exact import plan_exact
 from .guaranteed import GuaranteedPlan, plan_guaranteed
-from .plan import PlanOption, PlanReport, PlanStep, execute_plan
+from .result import PlanOption, PlanReport, PlanStep, execute_plan
 
 __all__ = [
     "GuaranteedPlan",

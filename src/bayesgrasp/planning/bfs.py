@@ -3,7 +3,7 @@
 A *hyperstate* is a probability vector over the states (the stable orientations of the
 squeeze function, ``problem.states.stable``) in the frame of the last action. The root is
 the distribution after the first action; each node has one child per action class
-(:meth:`~bayesgrasp.problem.Problem.classes`, for every kind in ``problem.action_kinds``):
+(:meth:`~bayesgrasp.model.problem.Problem.classes`, for every kind in ``problem.action_kinds``):
 class ``a`` sends the mass of state ``i`` to state ``transfer[a, i]``. The search goes level
 by level and stops at the first node that reaches the highest attainable success
 probability; after ``node_limit`` nodes (the seed's 1000) it gives up and runs a second,
@@ -61,10 +61,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import PlanningError
-from ..prior import UniformPrior
-from ..problem import Problem, nearest_state
-from ..transfer import TransferFunction
-from .plan import PlanOption, PlanReport, PlanStep, choose_indices
+from ..geometry.transfer import TransferFunction
+from ..model.prior import UniformPrior
+from ..model.problem import Problem, nearest_state
+from .result import PlanOption, PlanReport, PlanStep, choose_indices
 
 __all__ = ["BfsResult", "SearchStats", "plan_bfs", "search_bfs"]
 
@@ -373,7 +373,7 @@ def search_bfs(
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.geometry.polygon import Part
     >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
     >>> res = search_bfs(Problem.build(rect))
     >>> [round(o.expected_cost, 1) for o in res.report.options], res.stats.nodes
@@ -552,7 +552,7 @@ def plan_bfs(problem: Problem, max_actions: int | None = None) -> PlanReport:
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.geometry.polygon import Part
     >>> tri = Part.from_points([(0, 0), (3, 0), (1, 2)])
     >>> rep = plan_bfs(Problem.build(tri))
     >>> rep.method, rep.nodes, [round(o.success_probability, 4) for o in rep.options]

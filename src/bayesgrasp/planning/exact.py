@@ -78,9 +78,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import PlanningError
-from ..problem import Problem
-from ..transfer import TransferFunction
-from .plan import PlanOption, PlanReport, PlanStep, choose_indices
+from ..geometry.transfer import TransferFunction
+from ..model.problem import Problem
+from .result import PlanOption, PlanReport, PlanStep, choose_indices
 
 __all__ = ["plan_exact"]
 
@@ -405,7 +405,7 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanReport:
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.geometry.polygon import Part
     >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
     >>> rep = plan_exact(Problem.build(rect))
     >>> [round(o.expected_cost, 1) for o in rep.options], rep.bayes

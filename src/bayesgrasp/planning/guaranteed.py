@@ -52,10 +52,10 @@ import math
 from dataclasses import dataclass
 
 from ..errors import NoPlanError, PlanningError
-from ..problem import Problem
-from ..transfer import TransferFunction
+from ..geometry.transfer import TransferFunction
+from ..model.problem import Problem
 from .exact import Arc, _arc_front, _chain_option, _Planner
-from .plan import PlanOption
+from .result import PlanOption
 
 __all__ = ["GuaranteedPlan", "plan_guaranteed", "widest_arc"]
 
@@ -111,8 +111,8 @@ def widest_arc(f: TransferFunction, limit: float, tol: float) -> Arc:
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import ConvexPolygon
-    >>> from bayesgrasp.transfer import squeeze_function
+    >>> from bayesgrasp.geometry.polygon import ConvexPolygon
+    >>> from bayesgrasp.geometry.transfer import squeeze_function
     >>> s = squeeze_function(ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
     >>> one = widest_arc(s, 0.0, 1e-9)  # a single basin
     >>> two = widest_arc(s, one.width, 1e-9)
@@ -151,7 +151,7 @@ def plan_guaranteed(problem: Problem) -> GuaranteedPlan:
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.geometry.polygon import Part
     >>> rect = Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)])
     >>> g = plan_guaranteed(Problem.build(rect))
     >>> g.n_actions, round(math.degrees(g.period), 6), g.option.success_probability

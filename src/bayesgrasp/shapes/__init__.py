@@ -8,14 +8,14 @@ Each part is a JSON file beside this module::
 
 ``vertices`` is the part's *outline* in order (a simple polygon, possibly non-convex: a tuning
 fork, a hand). The gripper only ever touches the convex hull (the seed, section 4.1,
-assumption 3), so the loader builds the :class:`~bayesgrasp.geometry.Part` from the outline
+assumption 3), so the loader builds the :class:`~bayesgrasp.geometry.polygon.Part` from the outline
 and the hull is computed; the side counts of Table 1 are side counts of the hull. The centre
 of mass is the area centroid of the outline (a plate of uniform thickness), not of the hull:
 the two differ for non-convex parts, and pushing depends on it.
 
 The seed prints no coordinates. The outlines are designed to be recognisable with the stated
 side counts and fitted so that the exact planner comes close to the printed rows; each file's
-``description`` says how (see ``benchmarks/fit_catalogue.py`` and :mod:`bayesgrasp.table1`).
+``description`` says how (see ``benchmarks/fit_catalogue.py`` and :mod:`bayesgrasp.paper.table1`).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from importlib import resources
 import numpy as np
 
 from ..errors import PartError
-from ..geometry import Part, as_points, polygon_area_centroid
+from ..geometry.polygon import Part, as_points, polygon_area_centroid
 
 __all__ = ["CatalogueEntry", "describe", "entry", "load", "names"]
 

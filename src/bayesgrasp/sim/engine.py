@@ -3,7 +3,7 @@
 The engine knows nothing of diameter or transfer functions: it gets the part's hull, a table
 with friction, two frictionless jaws and a yaw to start from, and reports the yaw where the
 part stops. The library then compares those yaws with the model's stable orientations
-(:func:`bayesgrasp.execute.summarize`).
+(:func:`bayesgrasp.sim.kinematic.summarize`).
 
 One action, in the gripper frame (which is the world frame of the scene):
 
@@ -38,7 +38,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import MissingExtraError
-from ..execute import (
+from ..geometry.polygon import Part
+from ..model.problem import Problem
+from ..planning.result import PlanOption
+from .kinematic import (
     DEFAULT_BOUNDARY_MARGIN,
     GripperNoise,
     Progress,
@@ -48,9 +51,6 @@ from ..execute import (
     sample_prior,
     summarize,
 )
-from ..geometry import Part
-from ..planning.plan import PlanOption
-from ..problem import Problem
 from .params import SimParams
 from .scene import prism, scene_xml, units_scale
 
@@ -116,8 +116,8 @@ class Squeezer:
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import Part
-    >>> from bayesgrasp.transfer import squeeze_function
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.geometry.transfer import squeeze_function
     >>> tri = Part.from_points([(0, 0), (0.04, 0), (0.01, 0.03)])
     >>> out = Squeezer(tri, 1.0).act(np.radians(30.0))
     >>> predicted = squeeze_function(tri.hull)(np.radians(30.0))
@@ -343,7 +343,7 @@ def simulate_mujoco(
 
     Examples
     --------
-    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.geometry.polygon import Part
     >>> from bayesgrasp.planning import plan_exact
     >>> pb = Problem.build(Part.from_points([(0, 0), (0.04, 0), (0.01, 0.03)]))
     >>> plan = plan_exact(pb).options[0]

@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import PartError
-from ..geometry import Part
+from ..geometry.polygon import Part
 from .params import SimParams
 
 __all__ = ["Prism", "part_inertia", "prism", "scene_xml", "units_scale"]

@@ -1,0 +1,783 @@
+"""Planar parts: the convex polygon the gripper sees, and the part the user gave.
+
+A frictionless parallel-jaw gripper only ever touches the convex hull of a part (the seed,
+section 4.1, assumption 3, and Appendix A: "the diameter function for C is equal to the
+diameter function for the convex hull of C"), so every transfer function is built from a
+:class:`ConvexPolygon`. The :class:`Part` keeps the user's outline, name, units and centre of
+mass beside the hull; the centre of mass matters for pushing (Goldberg 1993).
+
+The library never rotates the user's coordinates: an orientation ``theta`` is always the
+rotation of the part *as given* relative to the gripper frame.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import PartError
+from ..tolerance import DEFAULT_TOLERANCE, Tolerance
+
+__all__ = ["ConvexPolygon", "Part", "as_points", "find_crossing", "polygon_area_centroid"]
+
+FloatArray = NDArray[np.float64]
+
+
+def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
+    """Validate a point list and return it as a float64 array of shape (N, 2).
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+        Coordinates; must be finite numbers.
+    what : str
+        Name used in error messages.
+
+    Returns
+    -------
+    ndarray of shape (N, 2)
+
+    Raises
+    ------
+    PartError
+        If the input is not numeric, has the wrong shape, or holds NaN or infinite values.
+
+    Examples
+    --------
+    >>> as_points([(0, 0), (1, 0), (0, 1)]).shape
+    (3, 2)
+    """
+    try:
+        raw = np.asarray(points)
+        items = None
+        if not isinstance(points, np.ndarray) and raw.dtype.kind in "iuf":
+            # Lists mixing booleans and numbers become numbers in numpy: look at the items.
+            items = np.asarray(points, dtype=object)
+    except (TypeError, ValueError) as exc:
+        raise PartError(
+            f"`{what}` must be numbers of shape (N, 2); could not read them: {exc}"
+        ) from None
+    if raw.dtype.kind not in "iuf":
+        _check_real(raw, what)
+    elif items is not None and items.ndim == 2:
+        _check_real(items, what)
+    arr = np.array(raw, dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise PartError(f"`{what}` must have shape (N, 2); got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
+        raise PartError(f"`{what}` must be finite; point {bad} is {arr[bad].tolist()}")
+    return arr
+
+
+_KIND_NAMES = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes"}
+
+
+def _check_real(raw: NDArray[Any], what: str) -> None:
+    """Refuse arrays of anything but real numbers (text, booleans, complex, None ...).
+
+    ``np.array(["1", "2"], dtype=float)`` would quietly parse text and booleans would become
+    0 and 1; coordinates must be numbers.
+    """
+    if raw.dtype.kind == "O":
+        for x in raw.flat:
+            if isinstance(x, bool | np.bool_) or not isinstance(x, numbers.Real):
+                raise PartError(
+                    f"`{what}` must be numbers of shape (N, 2); got a {type(x).__name__} "
+                    f"({x!r:.40})"
+                )
+        return
+    name = _KIND_NAMES.get(raw.dtype.kind, f"values of type {raw.dtype}")
+    raise PartError(f"`{what}` must be numbers of shape (N, 2); got {name}")
+
+
+# Areas are products of two coordinates: beyond these magnitudes they overflow or underflow.
+_MAX_COORD = 1e150
+_MIN_EXTENT = 1e-150
+
+
+def _check_magnitude(pts: FloatArray, extent: float) -> None:
+    """Refuse coordinates whose products overflow, or parts too small to tell from a point."""
+    if len(pts) and float(np.max(np.abs(pts))) > _MAX_COORD:
+        raise PartError(
+            f"`vertices` must be at most {_MAX_COORD:g} in absolute value; "
+            f"got {float(np.max(np.abs(pts))):g} (rescale the part's units)"
+        )
+    if 0.0 < extent < _MIN_EXTENT:
+        raise PartError(
+            f"the part is {extent:g} across; parts smaller than {_MIN_EXTENT:g} cannot be "
+            "resolved (rescale the part's units)"
+        )
+
+
+def polygon_area_centroid(vertices: FloatArray) -> tuple[float, FloatArray]:
+    """Signed area and area centroid of a simple polygon (shoelace formula).
+
+    Parameters
+    ----------
+    vertices : ndarray of shape (N, 2)
+        Vertices in order, no repeated closing vertex.
+
+    Returns
+    -------
+    area : float
+        Signed area (positive when counter-clockwise).
+    centroid : ndarray of shape (2,)
+
+    Examples
+    --------
+    >>> a, c = polygon_area_centroid(np.array([[0.0, 0], [2, 0], [2, 1], [0, 1]]))
+    >>> a, c.tolist()
+    (2.0, [1.0, 0.5])
+    """
+    # Shift to the first vertex: keeps the cross products well conditioned far from the origin;
+    # and scale to unit size: the products neither overflow nor underflow (1e150 or 1e-150).
+    origin = vertices[0]
+    p = vertices - origin
+    scale = float(np.max(np.abs(p)))
+    if not 0.0 < scale < math.inf:
+        return 0.0, vertices.mean(axis=0)
+    p = p / scale
+    q = np.concatenate((p[1:], p[:1]))
+    cross = p[:, 0] * q[:, 1] - q[:, 0] * p[:, 1]  # (N,)
+    unit_area = 0.5 * float(cross.sum())
+    if unit_area == 0.0:
+        return 0.0, vertices.mean(axis=0)
+    centroid = ((p + q) * cross[:, None]).sum(axis=0) * (scale / (6.0 * unit_area))
+    return unit_area * scale * scale, centroid + origin
+
+
+def _hull_indices(points: FloatArray) -> NDArray[np.intp]:
+    """Counter-clockwise convex hull vertex indices (Andrew's monotone chain, vectorised sort).
+
+    Collinear points on the hull are dropped. Runs in O(N log N).
+    """
+    order = np.lexsort((points[:, 1], points[:, 0]))
+    pts = points[order]
+    chain = _monotone_chain(pts[:, 0].tolist(), pts[:, 1].tolist())
+    return order[np.array(chain, dtype=np.intp)]
+
+
+def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
+    """Counter-clockwise hull of points sorted by x then y: indices, starting at the first."""
+
+    def half(idx: range) -> list[int]:
+        chain: list[int] = []
+        for k in idx:
+            while len(chain) >= 2:
+                a, b = chain[-2], chain[-1]
+                cross = (xs[b] - xs[a]) * (ys[k] - ys[a]) - (ys[b] - ys[a]) * (xs[k] - xs[a])
+                if cross > 0:
+                    break
+                chain.pop()
+            chain.append(k)
+        return chain
+
+    n = len(xs)
+    return half(range(n))[:-1] + half(range(n - 1, -1, -1))[:-1]
+
+
+def _hull_python(
+    pts: FloatArray, eps: float
+) -> tuple[list[float], list[float], float, float, float]:
+    """Hull, area and centroid of a few points in plain Python.
+
+    For a few points numpy's cost per call is larger than the work. The steps are those of
+    ``_hull_indices``, ``_drop_near_collinear`` and ``polygon_area_centroid``.
+
+    Returns
+    -------
+    xs, ys : list of float
+        Hull vertices, counter-clockwise from the lowest leftmost point.
+    area, cx, cy : float
+        Area and centroid (area 0 when degenerate).
+    """
+    px, py = pts[:, 0].tolist(), pts[:, 1].tolist()
+    order = sorted(range(len(px)), key=lambda i: (px[i], py[i]))  # stable, as np.lexsort
+    sx, sy = [px[i] for i in order], [py[i] for i in order]
+    chain = _monotone_chain(sx, sy)
+    xs, ys = [sx[i] for i in chain], [sy[i] for i in chain]
+    while len(xs) > 3:  # _drop_near_collinear, step for step
+        n = len(xs)
+        bad = []
+        for i in range(n):
+            ax, ay, bx, by = xs[i - 1], ys[i - 1], xs[(i + 1) % n], ys[(i + 1) % n]
+            ux, uy = bx - ax, by - ay
+            cross = ux * (ys[i] - ay) - uy * (xs[i] - ax)
+            bad.append(abs(cross) <= eps * math.hypot(ux, uy))
+        if not any(bad):
+            break
+        drop, run_start = [], 0
+        for i in range(n):
+            if not bad[i]:
+                run_start = i + 1
+            drop.append(bad[i] and (i - run_start) % 2 == 0)
+        if drop[0] and drop[-1]:
+            drop[-1] = False
+        kept = n - sum(drop)
+        if kept < 3:
+            for i in [i for i in range(n) if drop[i]][: 3 - kept]:
+                drop[i] = False
+        xs = [x for x, d in zip(xs, drop, strict=True) if not d]
+        ys = [y for y, d in zip(ys, drop, strict=True) if not d]
+    if len(xs) < 3:
+        return xs, ys, 0.0, 0.0, 0.0
+    ox, oy = xs[0], ys[0]
+    scale = max(max(abs(x - ox) for x in xs), max(abs(y - oy) for y in ys))
+    if not 0.0 < scale < math.inf:
+        return xs, ys, 0.0, 0.0, 0.0
+    qx, qy = [(x - ox) / scale for x in xs], [(y - oy) / scale for y in ys]
+    n = len(qx)
+    twice, cx, cy = 0.0, 0.0, 0.0
+    for i in range(n):
+        j = (i + 1) % n
+        c = qx[i] * qy[j] - qx[j] * qy[i]
+        twice += c
+        cx += (qx[i] + qx[j]) * c
+        cy += (qy[i] + qy[j]) * c
+    if twice == 0.0:
+        return xs, ys, 0.0, 0.0, 0.0
+    unit = scale / (3.0 * twice)
+    return xs, ys, 0.5 * twice * scale * scale, cx * unit + ox, cy * unit + oy
+
+
+def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
+    """Drop hull vertices closer than ``eps`` to the segment joining their neighbours.
+
+    Each round removes every other vertex of each run of such vertices, so a removed vertex
+    always lies within ``eps`` of a chord whose ends stay: the error never accumulates.
+    """
+    while len(v) > 3:
+        prev = np.roll(v, 1, axis=0)
+        base = np.roll(v, -1, axis=0) - prev
+        blen = np.hypot(base[:, 0], base[:, 1])
+        cross = base[:, 0] * (v[:, 1] - prev[:, 1]) - base[:, 1] * (v[:, 0] - prev[:, 0])
+        bad = np.abs(cross) <= eps * blen  # (N,) within eps of the neighbours' chord
+        if not bad.any():
+            break
+        idx = np.arange(len(v))
+        run_start = np.maximum.accumulate(np.where(~bad, idx + 1, 0))
+        drop = bad & ((idx - run_start) % 2 == 0)
+        if drop[0] and drop[-1]:
+            drop[-1] = False
+        keep = ~drop
+        if keep.sum() < 3:
+            keep[np.flatnonzero(drop)[: 3 - keep.sum()]] = True
+        v = v[keep]
+    return v
+
+
+# Up to this many points, ConvexPolygon.from_points works on Python floats (faster there).
+_SMALL = 64
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ConvexPolygon:
+    """Convex polygon, vertices counter-clockwise, no repeated closing vertex.
+
+    Build it with :meth:`from_points`, which takes the convex hull of any point list.
+    The vertices array is read-only.
+
+    Attributes
+    ----------
+    vertices : ndarray of shape (N, 2)
+        Counter-clockwise hull vertices in the user's coordinates (never rotated).
+    tol : Tolerance
+        The tolerances used for this polygon.
+
+    Examples
+    --------
+    >>> ConvexPolygon.from_points([(0, 0), (2, 0), (0, 1), (0.5, 0.2)]).n_sides
+    3
+    """
+
+    vertices: FloatArray
+    tol: Tolerance = DEFAULT_TOLERANCE
+    area: float = field(init=False)
+    centroid: FloatArray = field(init=False)
+    size: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        v = as_points(self.vertices)
+        n = len(v)
+        what = "`vertices` must be a counter-clockwise convex polygon"
+        if n < 3:
+            raise PartError(f"{what} of at least 3 vertices; got {n}")
+        area, centroid = polygon_area_centroid(v)
+        size = float(np.max(np.hypot(*(v - centroid).T)))
+        e = np.concatenate((v[1:], v[:1])) - v  # (N, 2) edge i runs from vertex i to i + 1
+        elen = np.hypot(e[:, 0], e[:, 1])
+        short = np.flatnonzero(elen <= self.tol.length_for(size))
+        if len(short):
+            raise PartError(f"{what}; vertices {short[0]} and {(short[0] + 1) % n} coincide")
+        en = np.concatenate((e[1:], e[:1]))  # (N, 2) the edge after each edge
+        cross = e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0]
+        right = np.flatnonzero(cross < -self.tol.angle * elen * np.roll(elen, -1))
+        if len(right):
+            raise PartError(f"{what}; it turns clockwise at vertex {(right[0] + 1) % n}")
+        turns = float(np.sum(np.arctan2(cross, np.sum(e * en, axis=1)))) / (2.0 * math.pi)
+        if abs(turns - 1.0) > 1e-6:
+            raise PartError(f"{what}; it winds {turns:.3g} times around")
+        self._set(v, area, centroid, size)
+
+    def _set(self, v: FloatArray, area: float, centroid: FloatArray, size: float) -> None:
+        v.setflags(write=False)
+        centroid.setflags(write=False)
+        object.__setattr__(self, "vertices", v)
+        object.__setattr__(self, "area", area)
+        object.__setattr__(self, "centroid", centroid)
+        object.__setattr__(self, "size", size)
+
+    @classmethod
+    def _trusted(
+        cls,
+        v: FloatArray,
+        tol: Tolerance,
+        area: float,
+        centroid: FloatArray,
+        size: float | None = None,
+    ) -> ConvexPolygon:
+        """A polygon known to be convex and counter-clockwise (from a hull or a rotation)."""
+        poly = object.__new__(cls)
+        object.__setattr__(poly, "tol", tol)
+        if size is None:
+            d = v - centroid
+            size = math.sqrt(float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2)))
+        poly._set(v, area, centroid, size)
+        return poly
+
+    @classmethod
+    def from_points(cls, points: ArrayLike, tol: Tolerance = DEFAULT_TOLERANCE) -> ConvexPolygon:
+        """Convex hull of a point list, counter-clockwise, duplicates and collinear points dropped.
+
+        Parameters
+        ----------
+        points : array_like of shape (N, 2)
+            At least 3 distinct points, not all collinear. Order does not matter.
+        tol : Tolerance, optional
+            Points closer than ``tol.length`` times the part's size are merged.
+
+        Returns
+        -------
+        ConvexPolygon
+
+        Raises
+        ------
+        PartError
+            Fewer than 3 distinct points, all points collinear, or bad coordinates.
+
+        Examples
+        --------
+        >>> sq = ConvexPolygon.from_points([(1, 1), (0, 0), (1, 0), (0, 1), (0.5, 0)])
+        >>> sq.vertices.tolist()
+        [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
+        """
+        pts = as_points(points)
+        extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
+        _check_magnitude(pts, extent)
+        eps = tol.length_for(extent)
+        area = 0.0
+        if len(pts) < 3 or extent == 0.0:
+            hull = pts[:0]
+        elif len(pts) <= _SMALL:
+            xs, ys, area, cx, cy = _hull_python(pts, eps)
+            hull = np.array([xs, ys], dtype=np.float64).T.copy()
+            centroid = np.array([cx, cy])
+        else:
+            hull = pts[_hull_indices(pts)]
+            if len(hull) > 3:
+                hull = _drop_near_collinear(hull, eps)
+            if len(hull) >= 3:
+                area, centroid = polygon_area_centroid(hull)
+        if len(hull) < 3 or area <= eps * extent:
+            # Tell "too few points" from "collinear" only on failure (np.unique is slow).
+            distinct = 0
+            if len(pts):
+                grid = np.round((pts - pts.min(axis=0)) / max(eps, 1e-300))
+                distinct = len(np.unique(grid, axis=0))
+            if distinct < 3:
+                raise PartError(
+                    f"a part needs at least 3 distinct points; got {len(pts)} point(s) "
+                    f"with {distinct} distinct"
+                )
+            raise PartError("the part's points are all collinear; a part needs a non-zero area")
+        if len(pts) <= _SMALL:
+            size = math.sqrt(
+                max((x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True))
+            )
+            return cls._trusted(hull, tol, area, centroid, size)
+        return cls._trusted(hull, tol, area, centroid)
+
+    @property
+    def n_sides(self) -> int:
+        """Number of sides (equal to the number of vertices)."""
+        return len(self.vertices)
+
+    def rotated(self, angle: float) -> ConvexPolygon:
+        """The polygon rotated counter-clockwise by ``angle`` about the origin.
+
+        Used to place the part in a gripper frame; the user's part is never changed.
+
+        Examples
+        --------
+        >>> sq = ConvexPolygon.from_points([(0, 0), (1, 0), (1, 1), (0, 1)])
+        >>> np.round(sq.rotated(np.pi / 2).vertices, 12).tolist()[1]
+        [0.0, 1.0]
+        """
+        c, s = math.cos(angle), math.sin(angle)
+        rot = np.array([[c, -s], [s, c]])
+        return ConvexPolygon._trusted(
+            self.vertices @ rot.T, self.tol, self.area, rot @ self.centroid
+        )
+
+    @property
+    def symmetry_order(self) -> int:
+        """Order r of the part's rotational symmetry about its centroid (1 if none).
+
+        A rotation by ``2 pi / r`` must map every vertex within ``tol.symmetry * size`` of
+        another vertex. A square is 4, an equilateral triangle 3, a rectangle 2.
+
+        Examples
+        --------
+        >>> ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]).symmetry_order
+        2
+        """
+        v = self.vertices - self.centroid
+        n = len(v)
+        eps = self.tol.symmetry_for(self.size)
+        radii = np.hypot(v[:, 0], v[:, 1])  # (N,) a rotation about the centroid keeps them
+        small = [r for r in range(2, math.isqrt(n) + 1) if n % r == 0]
+        for r in sorted({n, *small, *(n // r for r in small)} - {1}, reverse=True):
+            # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r. Test the
+            # distances from the centroid first (cheap, and enough to reject most parts).
+            step = n // r
+            if np.max(np.abs(radii[step:] - radii[:-step])) > eps:
+                continue
+            a = 2.0 * math.pi / r
+            c, s = math.cos(a), math.sin(a)
+            turned = v @ np.array([[c, s], [-s, c]])  # (N, 2) rotated counter-clockwise
+            miss = turned - np.concatenate((v[step:], v[:step]))
+            if np.all(np.hypot(miss[:, 0], miss[:, 1]) <= eps):
+                return r
+        return 1
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Part:
+    """A part as the user gave it: name, outline, hull, centre of mass and units.
+
+    Parameters
+    ----------
+    name : str
+        Name shown in reports.
+    hull : ConvexPolygon
+        What the gripper touches.
+    outline : ndarray of shape (M, 2)
+        The user's points, as given (may be non-convex); read-only.
+    center_of_mass : ndarray of shape (2,)
+        Defaults to the hull's area centroid.
+    units : str or None
+        The units of the coordinates, when known (reported, never converted).
+    holes : tuple of ndarray of shape (K, 2)
+        Holes inside the outline (parts built by :meth:`from_outline`); they move the
+        centre of mass, never the hull.
+
+    Examples
+    --------
+    >>> p = Part.from_points([(0, 0), (3, 0), (0, 1)], name="wedge")
+    >>> p.hull.n_sides, p.center_of_mass.tolist()
+    (3, [1.0, 0.3333333333333333])
+    """
+
+    name: str
+    hull: ConvexPolygon
+    outline: FloatArray
+    center_of_mass: FloatArray
+    units: str | None = None
+    holes: tuple[FloatArray, ...] = ()
+
+    @classmethod
+    def from_points(
+        cls,
+        points: ArrayLike,
+        name: str = "part",
+        center_of_mass: ArrayLike | None = None,
+        units: str | None = None,
+        tol: Tolerance = DEFAULT_TOLERANCE,
+    ) -> Part:
+        """Build a part from a point list; the hull is what the gripper sees.
+
+        Raises
+        ------
+        PartError
+            Bad coordinates, or a centre of mass outside the hull.
+        """
+        outline = as_points(points).copy()
+        hull = ConvexPolygon.from_points(outline, tol)
+        com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
+        outline.setflags(write=False)
+        com.setflags(write=False)
+        return cls(name, hull, outline, com, units)
+
+    @classmethod
+    def from_outline(
+        cls,
+        outline: ArrayLike,
+        holes: Sequence[ArrayLike] = (),
+        name: str = "part",
+        center_of_mass: ArrayLike | None = None,
+        units: str | None = None,
+        tol: Tolerance = DEFAULT_TOLERANCE,
+    ) -> Part:
+        """Build a part from a simple (possibly non-convex) outline, optionally with holes.
+
+        The outline is an ordered ring, closed implicitly (a repeated closing vertex is
+        dropped). The gripper sees its convex hull; the default centre of mass is the area
+        centroid of the outline minus the holes (uniform density), not the hull's.
+
+        Parameters
+        ----------
+        outline : array_like of shape (N, 2)
+            Vertices in order around the outline, either direction.
+        holes : sequence of array_like of shape (K, 2), optional
+            Rings strictly inside the outline, not touching it or each other.
+        name : str
+        center_of_mass : array_like of shape (2,), optional
+            Overrides the area centroid; must lie inside the hull.
+        units : str, optional
+        tol : Tolerance, optional
+
+        Returns
+        -------
+        Part
+            ``outline`` and ``holes`` are stored counter-clockwise without repeated
+            vertices.
+
+        Raises
+        ------
+        PartError
+            Fewer than 3 distinct vertices, non-finite coordinates, a self-intersecting
+            outline (two edges that cross or touch, or an edge that folds back), a hole
+            outside the outline or crossing it, zero area, or a centre of mass outside the
+            hull.
+
+        Examples
+        --------
+        >>> p = Part.from_outline([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)], name="L")
+        >>> p.hull.n_sides, np.round(p.center_of_mass, 6).tolist()
+        (5, [0.833333, 0.833333])
+        >>> Part.from_outline([(0, 0), (1, 1), (1, 0), (0, 1)])  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        bayesgrasp.errors.PartError: `outline` must be a simple polygon; it crosses itself ...
+        """
+        ring = _clean_ring(outline, "outline")
+        rings = [ring] + [_clean_ring(h, f"holes[{k}]") for k, h in enumerate(holes)]
+        names = ["outline"] + [f"holes[{k}]" for k in range(len(rings) - 1)]
+        for r, what in zip(rings, names, strict=True):
+            fold = _fold_back(r)
+            if fold is not None:
+                x, y = r[fold]
+                raise PartError(
+                    f"`{what}` must be a simple polygon; it folds back on itself at vertex "
+                    f"{fold} ({x:.6g}, {y:.6g})"
+                )
+        hit = find_crossing(rings)
+        if hit is not None:
+            ra, _, rb, _ = hit
+            point = _crossing_point(rings, hit)
+            where = "it crosses itself" if ra == rb else f"it crosses `{names[rb]}`"
+            raise PartError(
+                f"`{names[ra]}` must be a simple polygon; {where} near "
+                f"({point[0]:.6g}, {point[1]:.6g})"
+            )
+        oriented: list[FloatArray] = []
+        areas: list[float] = []
+        centroids: list[FloatArray] = []
+        for r in rings:
+            a, c = polygon_area_centroid(r)
+            oriented.append(r if a > 0 else r[::-1].copy())
+            areas.append(abs(a))
+            centroids.append(c)
+        extent = float(np.max(np.ptp(ring, axis=0)))
+        for k in range(1, len(rings)):
+            if not _point_in_ring(oriented[k][0], oriented[0]):
+                raise PartError(f"`{names[k]}` must lie inside `outline`; it lies outside")
+            for m in range(1, len(rings)):
+                if m != k and _point_in_ring(oriented[k][0], oriented[m]):
+                    raise PartError(f"`{names[k]}` lies inside `{names[m]}`; holes cannot nest")
+        net = areas[0] - sum(areas[1:])
+        if net <= tol.length_for(extent) * extent:
+            raise PartError(f"`outline` must enclose a non-zero area; got area {net:.6g}")
+        hull = ConvexPolygon.from_points(oriented[0], tol)
+        if center_of_mass is None:
+            weighted = areas[0] * centroids[0] - sum(
+                (a * c for a, c in zip(areas[1:], centroids[1:], strict=True)), np.zeros(2)
+            )
+            com = _center_of_mass(hull, weighted / net)
+        else:
+            com = _center_of_mass(hull, center_of_mass)
+        for arr in (*oriented, com):
+            arr.setflags(write=False)
+        return cls(name, hull, oriented[0], com, units, tuple(oriented[1:]))
+
+
+def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
+    """A centre of mass as a fresh (2,) array, refused unless strictly inside the hull."""
+    com = as_points(np.reshape(np.asarray(point, dtype=object), (1, -1)), "center_of_mass")[0]
+    if not hull_contains(hull, com):
+        raise PartError(f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull")
+    return np.array(com, dtype=np.float64)
+
+
+def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
+    """Whether ``point`` lies strictly inside the convex polygon (by more than the tolerance)."""
+    v = hull.vertices
+    e = np.roll(v, -1, axis=0) - v
+    rel = point - v
+    cross = e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0]
+    lengths = np.hypot(e[:, 0], e[:, 1])
+    return bool(np.all(cross / lengths > hull.tol.length_for(hull.size)))
+
+
+def _clean_ring(points: ArrayLike, what: str) -> FloatArray:
+    """A ring as float64 (N, 2) without repeated consecutive vertices or closing vertex."""
+    ring = as_points(points, what)
+    if len(ring) > 1:
+        ring = ring[~np.all(ring == np.roll(ring, -1, axis=0), axis=1)]
+    if len(ring) < 3:
+        raise PartError(f"`{what}` must have at least 3 distinct vertices; got {len(ring)}")
+    return np.array(ring, dtype=np.float64)
+
+
+def _fold_back(ring: FloatArray) -> int | None:
+    """Index of a vertex where the ring turns back along its incoming edge, if any."""
+    u = ring - np.roll(ring, 1, axis=0)  # (N, 2) incoming edges
+    w = np.roll(ring, -1, axis=0) - ring  # (N, 2) outgoing edges
+    cross = u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]
+    dot = (u * w).sum(axis=1)
+    scale = np.hypot(u[:, 0], u[:, 1]) * np.hypot(w[:, 0], w[:, 1])
+    bad = np.flatnonzero((np.abs(cross) <= 1e-12 * scale) & (dot < 0))
+    return int(bad[0]) if len(bad) else None
+
+
+def _point_in_ring(point: FloatArray, ring: FloatArray) -> bool:
+    """Even-odd test: whether ``point`` lies inside the ring (vectorised over edges)."""
+    x, y = float(point[0]), float(point[1])
+    a, b = ring, np.roll(ring, -1, axis=0)
+    straddle = (a[:, 1] > y) != (b[:, 1] > y)  # (N,) edges crossing the horizontal line
+    dy = np.where(straddle, b[:, 1] - a[:, 1], 1.0)
+    x_cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
+    return bool(np.count_nonzero(straddle & (x < x_cross)) % 2)
+
+
+def _crossing_point(rings: Sequence[FloatArray], hit: tuple[int, int, int, int]) -> FloatArray:
+    """A point where the two segments named by ``hit`` meet (for error messages)."""
+    ra, sa, rb, sb = hit
+    a0, a1 = rings[ra][sa], rings[ra][(sa + 1) % len(rings[ra])]
+    b0, b1 = rings[rb][sb], rings[rb][(sb + 1) % len(rings[rb])]
+    da, db = a1 - a0, b1 - b0
+    denom = da[0] * db[1] - da[1] * db[0]
+    if denom == 0.0:  # collinear overlap: any shared point will do
+        for p in (b0, b1, a0, a1):
+            if min(a0[0], a1[0]) <= p[0] <= max(a0[0], a1[0]) and min(a0[1], a1[1]) <= p[1] <= max(
+                a0[1], a1[1]
+            ):
+                return np.asarray(p, dtype=np.float64)
+        return np.asarray(a0, dtype=np.float64)  # pragma: no cover - not reached
+    t = ((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / denom
+    return np.asarray(a0 + t * da, dtype=np.float64)
+
+
+_PAIR_CHUNK = 1 << 20  # candidate segment pairs examined per vectorised batch
+
+
+def find_crossing(rings: Sequence[FloatArray]) -> tuple[int, int, int, int] | None:
+    """Find two non-adjacent edges of a set of rings that cross or touch.
+
+    A sweep along the axis where the edges are shortest pairs every edge with the edges whose
+    intervals overlap it on that axis (sort and prune); the pairs are filtered on the other
+    axis and settled by exact orientation tests, in vectorised batches. Typical outlines
+    (short edges) give O(N log N) work; the worst case is O(N^2).
+
+    Parameters
+    ----------
+    rings : sequence of ndarray of shape (N_k, 2)
+        Closed rings without repeated closing vertex and without repeated vertices.
+
+    Returns
+    -------
+    tuple of int or None
+        ``(ring_a, edge_a, ring_b, edge_b)`` for one offending pair (edge ``i`` runs from
+        vertex ``i`` to vertex ``i + 1``), or ``None`` when the rings are simple and disjoint.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0], [1, 0], [1, 1], [0, 1]])
+    >>> find_crossing([square]) is None
+    True
+    >>> find_crossing([np.array([[0.0, 0], [1, 1], [1, 0], [0, 1]])])
+    (0, 0, 0, 2)
+    """
+    starts = np.concatenate(rings)  # (S, 2)
+    ends = np.concatenate([np.roll(r, -1, axis=0) for r in rings])  # (S, 2)
+    ring_id = np.concatenate([np.full(len(r), k, dtype=np.intp) for k, r in enumerate(rings)])
+    edge_id = np.concatenate([np.arange(len(r), dtype=np.intp) for r in rings])
+    ring_len = np.asarray([len(r) for r in rings], dtype=np.intp)[ring_id]
+    lo = np.minimum(starts, ends)  # (S, 2) bounding boxes
+    hi = np.maximum(starts, ends)
+    axis = int(np.argmin((hi - lo).sum(axis=0)))
+    other = 1 - axis
+    order = np.argsort(lo[:, axis], kind="stable")
+    lo_sorted = lo[order, axis]
+    stop = np.searchsorted(lo_sorted, hi[order, axis], side="right")  # (S,)
+    counts = stop - np.arange(len(order)) - 1  # partners after each edge in sweep order
+    cum = np.cumsum(counts)
+    row = 0
+    n = len(order)
+    while row < n:
+        base = cum[row - 1] if row else 0
+        last = int(np.searchsorted(cum, base + _PAIR_CHUNK, side="right"))
+        last = max(last, row + 1)
+        c = counts[row:last]
+        total = int(c.sum())
+        if total:
+            i_sorted = np.repeat(np.arange(row, last), c)
+            j_sorted = i_sorted + 1 + (np.arange(total) - np.repeat(np.cumsum(c) - c, c))
+            a, b = order[i_sorted], order[j_sorted]
+            keep = (lo[a, other] <= hi[b, other]) & (lo[b, other] <= hi[a, other])
+            gap = np.abs(edge_id[a] - edge_id[b])
+            adjacent = (ring_id[a] == ring_id[b]) & ((gap == 1) | (gap == ring_len[a] - 1))
+            keep &= ~adjacent
+            a, b = a[keep], b[keep]
+            hits = _segments_meet(starts[a], ends[a], starts[b], ends[b])
+            if hits.any():
+                k = int(np.flatnonzero(hits)[0])
+                pa, pb = sorted((int(a[k]), int(b[k])))
+                return (int(ring_id[pa]), int(edge_id[pa]), int(ring_id[pb]), int(edge_id[pb]))
+        row = last
+    return None
+
+
+def _segments_meet(p: FloatArray, q: FloatArray, r: FloatArray, s: FloatArray) -> NDArray[np.bool_]:
+    """Whether segments pq and rs share a point, for boxes already known to overlap."""
+
+    def orient(a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+        out: FloatArray = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (
+            c[:, 0] - a[:, 0]
+        )
+        return out
+
+    o1, o2 = orient(p, q, r), orient(p, q, s)
+    o3, o4 = orient(r, s, p), orient(r, s, q)
+    # With overlapping boxes, opposite (or zero) signs on both sides mean the segments meet,
+    # including the collinear case (all four zero).
+    return np.asarray(
+        (np.sign(o1) * np.sign(o2) <= 0) & (np.sign(o3) * np.sign(o4) <= 0), dtype=np.bool_
+    )

@@ -1,0 +1,258 @@
+"""Transfer functions: what one action does to the part's orientation.
+
+A transfer function here is a step function on the circle: the part, at orientation
+``theta`` in the gripper frame, ends at ``F(theta)``. Both the squeeze function (the seed,
+section 4.2) and the push-grasp function (Goldberg 1993) have this form: finitely many stable
+orientations, each with a *basin* (an open arc between consecutive unstable equilibria) that
+it attracts, and ``F(theta + 2 pi) = F(theta) + 2 pi`` with ``F`` non-decreasing. An
+orientation exactly at a basin boundary is an unstable equilibrium and stays where it is.
+
+The squeeze function descends the diameter function: each minimum of ``d`` over ``[0, 2 pi)``
+is a stable orientation and its basin runs between the neighbouring maxima. It commutes with
+the part's symmetry: ``s(theta + T) = s(theta) + T`` for the period ``T`` (pi, or
+``2 pi / (r (1 + r mod 2))`` for an r-fold symmetric part, Goldberg 1993).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import BayesGraspError
+from .diameter import DiameterFunction, diameter_function
+from .polygon import ConvexPolygon
+
+__all__ = ["TransferFunction", "detect_period", "squeeze_function", "transfer_from_extrema"]
+
+TWO_PI = 2.0 * math.pi
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TransferFunction:
+    """A monotone step function on the circle: stable orientations and their basins.
+
+    State ``i`` is the stable orientation ``stable[i]`` in ``[0, 2 pi)`` (increasing); its
+    basin is the open arc ``(basin_lo[i], basin_hi[i])`` around it (``basin_lo[0]`` may be
+    negative and ``basin_hi[-1]`` may pass ``2 pi``). Basins tile the circle.
+
+    Attributes
+    ----------
+    kind : str
+        ``"squeeze"`` or ``"push-grasp"`` (or ``"push"``).
+    stable, basin_lo, basin_hi : ndarray of shape (K,)
+    period : float
+        Smallest ``T`` with ``F(theta + T) = F(theta) + T`` (divides ``2 pi``).
+    angle_tol : float
+        Angles closer than this are equal.
+
+    Examples
+    --------
+    >>> s = squeeze_function(ConvexPolygon.from_points([(0, 0), (1, 0), (1, 1), (0, 1)]))
+    >>> np.degrees(s.stable).round(6).tolist(), round(float(np.degrees(s.period)), 6)
+    ([0.0, 90.0, 180.0, 270.0], 90.0)
+    >>> float(np.degrees(s(np.radians(30.0))))
+    0.0
+    """
+
+    kind: str
+    stable: FloatArray
+    basin_lo: FloatArray
+    basin_hi: FloatArray
+    period: float
+    angle_tol: float
+
+    def __call__(self, theta: ArrayLike) -> FloatArray:
+        """Final orientation in ``[0, 2 pi)`` for each initial orientation (vectorised).
+
+        An orientation within ``angle_tol`` of a basin boundary is an unstable equilibrium
+        and is returned unchanged (reduced to ``[0, 2 pi)``).
+        """
+        th = np.mod(np.asarray(theta, dtype=np.float64), TWO_PI)
+        idx = self.state_index(th)
+        out = self.stable[idx]
+        at_edge = (
+            np.minimum(
+                np.abs(np.mod(th - self.basin_lo[idx] + math.pi, TWO_PI) - math.pi),
+                np.abs(np.mod(th - self.basin_hi[idx] + math.pi, TWO_PI) - math.pi),
+            )
+            <= self.angle_tol
+        )
+        return np.where(at_edge, th, out)
+
+    def state_index(self, theta: ArrayLike) -> NDArray[np.intp]:
+        """Index of the basin that holds each orientation."""
+        th = np.mod(np.asarray(theta, dtype=np.float64), TWO_PI)
+        hi = np.mod(self.basin_hi, TWO_PI)
+        order = np.argsort(hi)
+        k = np.searchsorted(hi[order], th, side="right")
+        return order[k % len(order)]
+
+    @property
+    def n_states(self) -> int:
+        """Number of stable orientations over ``[0, 2 pi)``."""
+        return len(self.stable)
+
+    @property
+    def boundaries(self) -> FloatArray:
+        """Basin boundaries (unstable equilibria) in ``[0, 2 pi)``, increasing."""
+        return np.sort(np.mod(self.basin_hi, TWO_PI))
+
+    @property
+    def widths(self) -> FloatArray:
+        """Width of each basin (radians)."""
+        return self.basin_hi - self.basin_lo
+
+
+def detect_period(stable: FloatArray, boundaries: FloatArray, tol: float) -> float:
+    """Smallest shift ``T = 2 pi / m`` mapping both point sets onto themselves.
+
+    ``m`` runs over the divisors of ``K = len(stable)``; a shift by ``T`` moves every point
+    ``K / m`` places along, so the test is exact up to ``tol`` radians for any ``m``.
+
+    Examples
+    --------
+    >>> T = detect_period(np.radians([0.0, 120, 240]), np.radians([60.0, 180, 300]), 1e-9)
+    >>> round(float(np.degrees(T)), 9)
+    120.0
+    """
+    st = np.asarray(stable, dtype=np.float64).tolist()
+    bd = np.asarray(boundaries, dtype=np.float64).tolist()
+    return TWO_PI / _period_count(st, bd, len(st), 1, tol)
+
+
+def _period_count(stable: list[float], bounds: list[float], top: int, base: int, tol: float) -> int:
+    """Largest ``m <= top``, a multiple of ``base`` dividing ``K``, whose shift maps both lists.
+
+    Returns ``base`` when no larger ``m`` works. Plain Python: ``K`` is small, and numpy's
+    cost per call would be most of the work.
+    """
+    k = len(stable)
+    first = stable[0]
+    for m in range(top, base, -1):
+        if k % m or m % base:
+            continue
+        step, t = k // m, TWO_PI / m
+        # Cheap test on one point first: most m fail there.
+        if abs((stable[step] - first - t + math.pi) % TWO_PI - math.pi) > tol:
+            continue
+        if _shifts_onto_itself(stable, step, t, tol) and _shifts_onto_itself(bounds, step, t, tol):
+            return m
+    return base
+
+
+def _shifts_onto_itself(points: list[float], step: int, shift: float, tol: float) -> bool:
+    """Whether point ``i + step`` lies ``shift`` after point ``i`` (cyclically), for all i."""
+    k, pi = len(points), math.pi
+    return all(
+        abs((points[(i + step) % k] - points[i] - shift + pi) % TWO_PI - pi) <= tol
+        for i in range(k)
+    )
+
+
+def _wrap(x: float) -> float:
+    """``x`` reduced to ``[0, 2 pi)`` (``%`` can round a tiny negative to ``2 pi``)."""
+    out = x % TWO_PI
+    return 0.0 if out >= TWO_PI else out
+
+
+def transfer_from_extrema(
+    kind: str, minima: FloatArray, maxima: FloatArray, angle_tol: float, period_tol: float
+) -> TransferFunction:
+    """Build a transfer function from its stable orientations and unstable equilibria.
+
+    Parameters
+    ----------
+    kind : str
+    minima, maxima : ndarray
+        Stable orientations and basin boundaries over ``[0, 2 pi)``; they must alternate.
+    angle_tol, period_tol : float
+        Angle equality, and the looser tolerance of the period test.
+    """
+    stable = sorted(_wrap(x) for x in np.asarray(minima, dtype=np.float64).tolist())
+    bounds = sorted(_wrap(x) for x in np.asarray(maxima, dtype=np.float64).tolist())
+    return _from_sorted(kind, stable, bounds, angle_tol, period_tol)
+
+
+def _from_sorted(
+    kind: str, stable: list[float], bounds: list[float], angle_tol: float, period_tol: float
+) -> TransferFunction:
+    """:func:`transfer_from_extrema` for sorted lists in ``[0, 2 pi)``."""
+    n = len(stable)
+    if n != len(bounds) or n == 0:  # pragma: no cover - a bug
+        raise BayesGraspError("internal error: stable orientations and boundaries differ")
+    # The boundary above each stable orientation (wrapping past 2 pi). They alternate when
+    # that index counts up by one: 0, 1, ..., K - 1 or 1, 2, ..., K.
+    k0 = bisect.bisect_right(bounds, stable[0])
+    if k0 > 1 or any(bisect.bisect_right(bounds, x) != k0 + i for i, x in enumerate(stable)):
+        raise BayesGraspError(  # pragma: no cover - a bug
+            "internal error: extrema of the transfer function do not alternate"
+        )
+    if k0 == 0:  # stable[i] lies between bounds[i - 1] and bounds[i]
+        lo = [bounds[-1] - TWO_PI, *bounds[:-1]]
+        hi = bounds
+    else:  # stable[i] lies between bounds[i] and bounds[i + 1]
+        lo = bounds
+        hi = [*bounds[1:], bounds[0] + TWO_PI]
+    arrays = [np.array(x, dtype=np.float64) for x in (stable, lo, hi)]
+    for arr in arrays:
+        arr.setflags(write=False)
+    period = TWO_PI / _period_count(stable, bounds, n, 1, period_tol)
+    return TransferFunction(kind, arrays[0], arrays[1], arrays[2], period, angle_tol)
+
+
+def squeeze_function(
+    part: ConvexPolygon | DiameterFunction,
+) -> TransferFunction:
+    """The squeeze function of a polygon (the seed, section 4.2).
+
+    Parameters
+    ----------
+    part : ConvexPolygon or DiameterFunction
+
+    Returns
+    -------
+    TransferFunction
+        Stable orientations are the minima of ``d`` over ``[0, 2 pi)``; basins run between
+        consecutive maxima. The period is the smallest shift ``2 pi / m`` that maps them
+        onto themselves (to ``tol.symmetry`` radians): ``pi``, or ``2 pi / (r (1 + r mod 2))``
+        for an r-fold symmetric part, also when rounded coordinates make the extrema
+        periodic only to about 1e-5 rad (the vertex test of ``symmetry_order`` decides).
+
+    Examples
+    --------
+    >>> tri = ConvexPolygon.from_points([(0, 0), (1, 0), (0.5, np.sqrt(3) / 2)])
+    >>> s = squeeze_function(tri)
+    >>> s.n_states, round(float(np.degrees(s.period)), 9), s.widths.round(9).tolist()[0]
+    (6, 60.0, 1.047197551)
+    """
+    d = part if isinstance(part, DiameterFunction) else diameter_function(part)
+    poly = d.polygon
+    half = d.minima.tolist(), d.maxima.tolist()  # in [0, pi)
+    stable, bounds = ([*x, *(_wrap(a + math.pi) for a in x)] for x in half)
+    stable.sort()
+    bounds.sort()
+    f = _from_sorted("squeeze", stable, bounds, poly.tol.angle, poly.tol.symmetry)
+    k, m_strict = len(stable), round(TWO_PI / f.period)
+    if k > m_strict:
+        # Rounded coordinates can leave an r-fold symmetric part's extrema periodic only to
+        # about 1e-5 rad, beyond the strict test. A finer period is accepted when shifting
+        # by it keeps every extremum within a quarter of the closest gap of its partner
+        # (their order is kept) and the vertex test finds the matching symmetry order.
+        both = sorted(stable + bounds)
+        loose = 0.25 * min(b - a for a, b in zip(both, [*both[1:], both[0] + TWO_PI], strict=True))
+        top = k
+        while top > m_strict:
+            m = _period_count(stable, bounds, top, m_strict, loose)
+            if m == m_strict:
+                break
+            r = poly.symmetry_order
+            if r * (1 + r % 2) == m:
+                f = replace(f, period=TWO_PI / m)
+                break
+            top = m - 1
+    return f

@@ -1,0 +1,186 @@
+"""The problem model (problem.py): cost model, goal, problem set-up and action classes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from bayesgrasp import CostError, CostModel, Goal, Part, PlanningError, Problem, von_mises
+from bayesgrasp.model.problem import action_classes, nearest_state
+from bayesgrasp.shapes import load
+from reference import regular_polygon
+
+TWO_PI = 2.0 * math.pi
+RECTANGLE = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)]
+
+
+def random_part(rng: np.random.Generator, n: int = 10) -> Part:
+    return Part.from_points(rng.uniform(size=(n, 2)))
+
+
+# --------------------------------------------------------------------------------------
+# Cost model
+# --------------------------------------------------------------------------------------
+
+
+def test_cost_model_defaults_are_the_seeds() -> None:
+    c = CostModel()
+    assert c.attempt_cost(("squeeze",) * 3) == 4.0
+    assert c.expected_cost(("squeeze", "squeeze"), 0.5) == 6.0
+    assert c.expected_cost(("squeeze",), 0.0) == math.inf
+
+
+@pytest.mark.parametrize("p", [0.1, 0.25, 0.5, 1.0])
+def test_expected_cost_formula(p: float) -> None:
+    c = CostModel(squeeze=2.0, verify=3.0, first_squeeze=5.0, retry=0.7, push_grasp=4.0)
+    kinds = ("squeeze", "push-grasp", "squeeze")
+    attempt = 5.0 + 4.0 + 2.0 + 3.0
+    assert c.attempt_cost(kinds) == attempt
+    # Repeating until success: 1 / p attempts, 1 / p - 1 of them failures paying the retry.
+    assert_allclose(c.expected_cost(kinds, p), attempt / p + 0.7 * (1 / p - 1), rtol=1e-15)
+    # A first push-grasp is not a first squeeze.
+    assert c.attempt_cost(("push-grasp", "squeeze")) == 4.0 + 2.0 + 3.0
+
+
+def test_expected_cost_by_simulation(rng: np.random.Generator) -> None:
+    """Run the retry loop literally and average its cost."""
+    c = CostModel(squeeze=1.5, verify=0.5, first_squeeze=3.0, retry=2.0)
+    kinds = ("squeeze", "squeeze")
+    p = 0.3
+    attempts = rng.geometric(p, size=200_000)
+    total = attempts * c.attempt_cost(kinds) + (attempts - 1) * c.retry
+    se = total.std() / math.sqrt(len(total))
+    assert abs(total.mean() - c.expected_cost(kinds, p)) < 5 * se
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"squeeze": -1.0}, r"cost `squeeze` must be a finite number >= 0; got -1.0"),
+        ({"verify": math.nan}, r"cost `verify` must be a finite number >= 0; got nan"),
+        ({"retry": math.inf}, r"cost `retry` must be a finite number >= 0; got inf"),
+        ({"first_squeeze": -0.5}, r"cost `first_squeeze` must be .*; got -0.5"),
+        ({"push_grasp": "1"}, r"cost `push_grasp` must be a finite number >= 0; got '1'"),
+        ({"squeeze": True}, r"cost `squeeze` must be a finite number >= 0; got True"),
+    ],
+)
+def test_cost_model_rejects_bad_costs(kwargs: dict[str, object], match: str) -> None:
+    with pytest.raises(CostError, match=match):
+        CostModel(**kwargs)  # type: ignore[arg-type]
+
+
+def test_cost_model_unknown_action() -> None:
+    with pytest.raises(PlanningError, match="unknown action kind 'poke'"):
+        CostModel().action_cost("poke")
+
+
+def test_plans_that_cost_nothing_are_refused() -> None:
+    part = Part.from_points(RECTANGLE)
+    with pytest.raises(CostError, match=r"at least one of the costs .* must be positive"):
+        Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0))
+    # Any positive cost of the actions used is enough.
+    Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0, retry=1.0))
+    Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0, first_squeeze=1.0))
+    # A push-grasp cost does not count for squeeze-only plans.
+    with pytest.raises(CostError, match="`verify`, `retry`, `squeeze`, `first_squeeze`"):
+        Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0, push_grasp=5.0))
+
+
+# --------------------------------------------------------------------------------------
+# Goal and problem set-up
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("n", [3, 4, 5, 6])
+def test_goal_group(n: int) -> None:
+    part = Part.from_points(regular_polygon(n))
+    assert Problem.build(part).goal_group == 1
+    pb = Problem.build(part, goal=Goal("symmetry"))
+    assert pb.goal_group == n
+    assert pb.goal_group == n  # cached, same answer
+    assert Goal("symmetry").group_order(1) == 1
+
+
+def test_build_defaults_and_actions() -> None:
+    pb = Problem.build(Part.from_points(RECTANGLE))
+    assert pb.action_kinds == ("squeeze",)
+    assert pb.prior.name == "uniform"
+    assert pb.cost == CostModel()
+    assert pb.goal == Goal()
+    assert pb.states is pb.transfers["squeeze"]
+    assert pb.n_states == 4
+    pb2 = Problem.build(Part.from_points(RECTANGLE), actions=("squeeze", "squeeze"))
+    assert pb2.action_kinds == ("squeeze",)
+
+
+@pytest.mark.parametrize(
+    ("actions", "match"),
+    [((), "at least one action type is needed"), (("poke",), "unknown action type 'poke'")],
+)
+def test_build_rejects_bad_actions(actions: tuple[str, ...], match: str) -> None:
+    with pytest.raises(PlanningError, match=match):
+        Problem.build(Part.from_points(RECTANGLE), actions=actions)
+
+
+def test_state_distribution_against_grid(rng: np.random.Generator) -> None:
+    """The prior mass of each basin, against initial orientations pushed through s."""
+    n = 1 << 16
+    theta = (np.arange(n) + 0.5) * (TWO_PI / n)
+    for part in [load("triangle"), random_part(rng), random_part(rng)]:
+        for mean, kappa in [(0.0, 0.0), (1.0, 3.0), (4.0, 8.0)]:
+            pb = Problem.build(part, von_mises(mean, kappa))
+            w = np.exp(kappa * np.cos(theta - mean))
+            for a in [0.0, 0.7, -2.0]:
+                dist = pb.state_distribution(a)
+                end = pb.states(theta - a)
+                idx = nearest_state(pb.states, end)
+                grid = np.bincount(idx, weights=w, minlength=pb.n_states) / w.sum()
+                assert_allclose(dist.sum(), 1.0, atol=1e-12)
+                point = w.max() / w.sum()
+                assert_allclose(dist, grid, atol=(pb.n_states + 1) * point + 1e-5)
+
+
+def test_state_distribution_uniform_is_basin_widths(rng: np.random.Generator) -> None:
+    pb = Problem.build(random_part(rng))
+    assert_allclose(pb.state_distribution(1.234), pb.states.widths / TWO_PI, atol=1e-12)
+
+
+def test_nearest_state() -> None:
+    pb = Problem.build(Part.from_points(RECTANGLE))
+    s = pb.states.stable
+    assert_array_equal(nearest_state(pb.states, s + 1e-3), np.arange(4))
+    assert_array_equal(nearest_state(pb.states, np.array([TWO_PI - 1e-9])), [0])
+
+
+# --------------------------------------------------------------------------------------
+# Action classes (the seed, 4.4)
+# --------------------------------------------------------------------------------------
+
+
+def test_action_classes_against_squeezing(rng: np.random.Generator) -> None:
+    for _ in range(30):
+        part = random_part(rng, int(rng.integers(4, 12)))
+        pb = Problem.build(part)
+        cls = pb.classes("squeeze")
+        assert pb.classes("squeeze") is cls
+        # At most n^2 classes (the seed), tiling the gripper's half turn.
+        assert len(cls.lo) <= part.hull.n_sides**2
+        assert_allclose(np.sum(cls.hi - cls.lo), math.pi, atol=1e-12)
+        assert np.all(cls.hi > cls.lo)
+        # Any turn inside a class sends each state where the table says.
+        for a in range(len(cls.lo)):
+            alpha = rng.uniform(cls.lo[a], cls.hi[a], size=5)
+            end = pb.states(pb.states.stable[None, :] - alpha[:, None])
+            assert_array_equal(nearest_state(pb.states, end), np.tile(cls.transfer[a], (5, 1)))
+
+
+def test_action_classes_of_a_square() -> None:
+    pb = Problem.build(Part.from_points([(0, 0), (1, 0), (1, 1), (0, 1)]))
+    cls = action_classes(pb.states, pb.states, math.pi)
+    # Stable at multiples of 90 deg, boundaries at 45 + 90 m: classes change at 45 and 135.
+    assert_allclose(np.degrees(cls.lo), [45.0, 135.0], atol=1e-9)
+    assert_array_equal(cls.transfer[0], [3, 0, 1, 2])
+    assert_array_equal(cls.transfer[1], [2, 3, 0, 1])

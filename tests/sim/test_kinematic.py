@@ -1,0 +1,433 @@
+"""Kinematic Monte Carlo of plans (bayesgrasp.sim.kinematic) and the `simulate` command with it."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_allclose
+from scipy.stats import kstest
+
+from bayesgrasp.cli import main
+from bayesgrasp.geometry.polygon import Part
+from bayesgrasp.model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior, von_mises
+from bayesgrasp.model.problem import Goal, Problem
+from bayesgrasp.planning import PlanOption, PlanStep, execute_plan, plan_exact
+from bayesgrasp.report import option_json
+from bayesgrasp.shapes import load, names
+from bayesgrasp.sim.kinematic import (
+    GripperNoise,
+    SimulationError,
+    boundary_distance,
+    goal_states,
+    goodness_of_fit,
+    plan_from_json,
+    predicted_distribution,
+    sample_prior,
+    simulate_kinematic,
+    wilson_interval,
+)
+from reference import descend
+from strategies import convex_points
+
+TWO_PI = 2.0 * math.pi
+P_MIN = 1e-3  # goodness-of-fit threshold at a fixed seed
+
+
+def random_parts(count: int, seed: int) -> list[Part]:
+    """The seed paper's random polygons: 10 uniform points in the unit square."""
+    rng = np.random.default_rng(seed)
+    return [Part.from_points(rng.random((10, 2)), name=f"random{i}") for i in range(count)]
+
+
+def brute_execute(points: np.ndarray, steps: tuple[PlanStep, ...], theta: np.ndarray) -> np.ndarray:
+    """Run squeezes by walking downhill on a grid of the width (no bayesgrasp code)."""
+    grid, _, end = descend(points, 1 << 16)
+    h = TWO_PI / len(grid)
+    th = np.asarray(theta, dtype=np.float64)
+    for s in steps:
+        k = np.round(np.mod(th - s.alpha, TWO_PI) / h).astype(np.intp) % len(grid)
+        th = grid[end[k]]
+    return th
+
+
+# --- sampling the prior -------------------------------------------------------------------
+
+
+class Wedge(Prior):
+    """A prior of no built-in type: density proportional to theta on [0, 2 pi)."""
+
+    def cdf(self, theta: object) -> np.ndarray:
+        th = np.asarray(theta, dtype=np.float64)
+        turns = np.floor(th / TWO_PI)
+        r = th - turns * TWO_PI
+        return turns + (r / TWO_PI) ** 2
+
+    @property
+    def breakpoints(self) -> np.ndarray:
+        return np.zeros(1)
+
+
+@pytest.mark.parametrize(
+    "prior",
+    [UniformPrior(), HistogramPrior([3, 0, 1, 2]), von_mises(1.0, 3.0), Wedge()],
+    ids=["uniform", "histogram", "von-mises", "custom"],
+)
+def test_sample_prior_follows_the_cdf(prior: Prior, rng: np.random.Generator) -> None:
+    x = sample_prior(prior, 20_000, rng)
+    assert x.shape == (20_000,)
+    assert np.all((x >= 0) & (x < TWO_PI))
+    res = kstest(x, lambda t: prior.cdf(t) - prior.cdf(0.0))
+    assert res.pvalue > P_MIN
+
+
+def test_sample_prior_draws_atoms_of_a_sample_prior(rng: np.random.Generator) -> None:
+    prior = SamplePrior([0.5, 0.5, 2.0, 4.0])
+    x = sample_prior(prior, 40_000, rng)
+    assert set(np.unique(x).tolist()) == {0.5, 2.0, 4.0}
+    assert_allclose(np.mean(x == 0.5), 0.5, atol=0.01)
+
+
+def test_sample_prior_uses_the_prior_s_own_sampler() -> None:
+    class Fixed(UniformPrior):
+        def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
+            return np.full(n, 7.0)
+
+    assert_allclose(sample_prior(Fixed(), 3, 0), np.full(3, 7.0 - TWO_PI), atol=1e-12)
+
+
+def test_sample_prior_rejects_negative_counts() -> None:
+    with pytest.raises(SimulationError, match="`n` must be >= 0; got -1"):
+        sample_prior(UniformPrior(), -1)
+
+
+# --- statistics ----------------------------------------------------------------------------
+
+
+def test_wilson_interval_known_values() -> None:
+    lo, hi = wilson_interval(0, 10)
+    assert lo == 0.0
+    assert_allclose(hi, 0.27753, atol=1e-5)
+    # Newcombe (1998), Statistics in Medicine 17, Table I: 81/263 and 15/148
+    assert_allclose(wilson_interval(81, 263), (0.2553, 0.3662), atol=1e-4)
+    assert_allclose(wilson_interval(15, 148), (0.0624, 0.1605), atol=1e-4)
+    assert wilson_interval(0, 0) == (0.0, 1.0)
+    with pytest.raises(SimulationError, match=r"`successes` must be in \[0, 3\]; got 4"):
+        wilson_interval(4, 3)
+
+
+def test_wilson_interval_covers_the_truth(rng: np.random.Generator) -> None:
+    p, n = 0.3, 200
+    hits = sum(
+        lo <= p <= hi for lo, hi in (wilson_interval(int(k), n) for k in rng.binomial(n, p, 2000))
+    )
+    assert 0.93 <= hits / 2000 <= 0.97
+
+
+def test_goodness_of_fit_cases() -> None:
+    assert goodness_of_fit([0, 0], [0.5, 0.5]) == 1.0
+    assert goodness_of_fit([10, 1], [1.0, 0.0]) == 0.0  # an impossible outcome happened
+    assert goodness_of_fit([100], [1.0]) == 1.0
+    assert goodness_of_fit([500, 500], [0.5, 0.5]) == 1.0
+    assert goodness_of_fit([700, 300], [0.5, 0.5]) < 1e-12
+    # small expected counts are pooled: 3 cells of expectation 1 become one of 3
+    assert_allclose(goodness_of_fit([97, 1, 1, 1], [0.97, 0.01, 0.01, 0.01]), 1.0, atol=1e-12)
+
+
+def test_boundary_distance_wraps() -> None:
+    b = np.array([0.5, 3.0])
+    assert_allclose(boundary_distance(b, [0.4, 1.0, 6.2, 3.0]), [0.1, 0.5, 0.5 + TWO_PI - 6.2, 0])
+
+
+def test_gripper_noise_validation() -> None:
+    with pytest.raises(SimulationError, match="`kind` must be 'normal' or 'uniform'; got 'x'"):
+        GripperNoise("x", 0.1)
+    with pytest.raises(SimulationError, match="`scale` must be a finite number >= 0; got -1"):
+        GripperNoise("normal", -1)
+    e = GripperNoise("normal", 0.2).draw((50_000,), 0)
+    assert_allclose(e.std(), 0.2, atol=0.005)
+    assert not GripperNoise().draw((4,), 0).any()
+
+
+# --- prediction ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", names())
+def test_prediction_matches_the_planner(name: str) -> None:
+    pb = Problem.build(load(name))
+    for opt in plan_exact(pb).options:
+        pred = predicted_distribution(pb, opt.steps)
+        assert_allclose(pred.sum(), 1.0, atol=1e-12)
+        assert_allclose(pred[goal_states(pb, opt.final_orientation)].sum(),
+                        opt.success_probability, atol=1e-9)  # fmt: skip
+
+
+@settings(max_examples=30)
+@given(convex_points(), st.sampled_from(["uniform", "vonmises"]), st.booleans())
+def test_prediction_is_a_distribution_that_matches_the_planner(
+    points: np.ndarray, prior_kind: str, symmetry: bool
+) -> None:
+    prior = UniformPrior() if prior_kind == "uniform" else von_mises(0.7, 2.0, bins=360)
+    pb = Problem.build(
+        Part.from_points(points), prior, goal=Goal("symmetry" if symmetry else "single")
+    )
+    for opt in plan_exact(pb).options:
+        pred = predicted_distribution(pb, opt.steps)
+        assert np.all(pred >= 0)
+        assert_allclose(pred.sum(), 1.0, atol=1e-9)
+        got = pred[goal_states(pb, opt.final_orientation)].sum()
+        assert_allclose(got, opt.success_probability, atol=1e-7)
+
+
+def test_prediction_against_a_grid_walk() -> None:
+    """The exact prediction equals the fraction of a fine grid that the walk sends there."""
+    for part in random_parts(5, 7):
+        pb = Problem.build(part)
+        for opt in plan_exact(pb).options:
+            grid = np.arange(1 << 16) * (TWO_PI / (1 << 16))
+            end = brute_execute(part.hull.vertices, opt.steps, grid)
+            dist = np.abs(np.mod(end[:, None] - pb.states.stable + math.pi, TWO_PI) - math.pi)
+            frac = np.bincount(dist.argmin(axis=1), minlength=pb.n_states) / len(grid)
+            assert_allclose(frac, predicted_distribution(pb, opt.steps), atol=1e-3)
+
+
+# --- the Monte Carlo -----------------------------------------------------------------------
+
+
+def test_kinematic_agrees_with_execute_plan_and_a_grid_walk(rng: np.random.Generator) -> None:
+    for part in [*random_parts(4, 11), load("triangle")]:
+        pb = Problem.build(part)
+        for opt in plan_exact(pb).options:
+            res = simulate_kinematic(pb, opt, 300, rng=5, boundary_margin=0.0)
+            theta0 = sample_prior(pb.prior, 300, np.random.default_rng(5))
+            assert_allclose(res.final, execute_plan(pb, opt.steps, theta0), atol=0.0)
+            # away from basin boundaries the grid walk lands on the same orientation
+            walk = brute_execute(part.hull.vertices, opt.steps, theta0)
+            err = np.abs(np.mod(walk - res.final + math.pi, TWO_PI) - math.pi)
+            assert np.mean(err < 1e-3) > 0.99
+
+
+@pytest.mark.parametrize("part", [*random_parts(6, 3), *(load(n) for n in names())],
+                         ids=lambda p: p.name)  # fmt: skip
+def test_observed_distribution_matches_prediction(part: Part) -> None:
+    pb = Problem.build(part)
+    for opt in plan_exact(pb).options:
+        res = simulate_kinematic(pb, opt, 100_000, rng=2024)
+        assert res.trials == 100_000
+        assert res.jams == 0
+        assert res.p_value > P_MIN
+        lo, hi = res.ci95
+        assert lo <= res.observed_success <= hi
+        # many plans are checked: a 99.99% interval keeps false alarms rare
+        lo, hi = wilson_interval(res.successes, res.trials, confidence=0.9999)
+        assert lo <= res.predicted_success <= hi
+        assert_allclose(res.observed.sum(), res.trials, atol=0)
+
+
+def test_observed_distribution_matches_prediction_under_a_prior() -> None:
+    pb = Problem.build(load("triangle"), von_mises(2.0, 4.0))
+    for opt in plan_exact(pb).options:
+        res = simulate_kinematic(pb, opt, 100_000, rng=9)
+        assert res.p_value > P_MIN
+        assert_allclose(res.predicted_success, opt.success_probability, atol=1e-9)
+
+
+def test_a_wrong_prediction_is_detected() -> None:
+    """The test has teeth: a plan run with a shifted first angle misses the prediction."""
+    pb = Problem.build(load("triangle"), von_mises(2.0, 4.0))
+    opt = plan_exact(pb).options[1]
+    moved = type(opt)(
+        (PlanStep("squeeze", opt.steps[0].alpha + 1.0), *opt.steps[1:]),
+        opt.final_orientation, opt.success_probability, opt.expected_cost, opt.tolerance,
+        opt.success_arc,
+    )  # fmt: skip
+    res = simulate_kinematic(pb, moved, 20_000, rng=1)
+    # the prediction is recomputed for the steps actually run, so it still matches ...
+    assert res.p_value > P_MIN
+    # ... but running the moved steps against the original prediction fails
+    orig = simulate_kinematic(pb, opt, 1, rng=1).predicted
+    assert goodness_of_fit(res.observed, orig) < 1e-9
+
+
+def plans_with_tolerance() -> list[tuple[Problem, PlanOption]]:
+    out = []
+    for part in [load("triangle"), load("rectangle"), *random_parts(3, 5)]:
+        pb = Problem.build(part)
+        for opt in plan_exact(pb).options:
+            if opt.tolerance is not None and opt.tolerance > math.radians(2):
+                out.append((pb, opt))
+    return out
+
+
+@pytest.mark.parametrize("kind", ["uniform", "normal"])
+def test_noise_below_the_tolerance_keeps_the_success_rate(kind: str) -> None:
+    cases = plans_with_tolerance()
+    assert len(cases) >= 3
+    for pb, opt in cases:
+        tol = opt.tolerance
+        assert tol is not None
+        # a normal error of sigma tol / 5 exceeds tol with probability 6e-7
+        scale = 0.95 * tol if kind == "uniform" else tol / 5
+        res = simulate_kinematic(pb, opt, 50_000, GripperNoise(kind, scale), rng=4)
+        sd = math.sqrt(res.predicted_success * (1 - res.predicted_success) / res.trials)
+        assert res.observed_success >= res.predicted_success - 4 * sd
+
+
+@pytest.mark.parametrize("kind", ["uniform", "normal"])
+def test_noise_above_the_tolerance_lowers_the_success_rate(kind: str) -> None:
+    for pb, opt in plans_with_tolerance():
+        tol = opt.tolerance
+        assert tol is not None
+        scale = 4.0 * tol if kind == "uniform" else 2.0 * tol
+        res = simulate_kinematic(pb, opt, 50_000, GripperNoise(kind, scale), rng=4)
+        sd = math.sqrt(res.predicted_success * (1 - res.predicted_success) / res.trials)
+        assert res.observed_success < res.predicted_success - 6 * sd
+        assert res.p_value < 1e-6
+
+
+def test_noise_within_the_tolerance_changes_no_successful_trial() -> None:
+    """Errors on alpha_2..alpha_k within the tolerance keep every success (same starts)."""
+    for pb, opt in plans_with_tolerance():
+        tol = opt.tolerance
+        assert tol is not None
+        theta0 = sample_prior(pb.prior, 20_000, 3)
+        base = execute_plan(pb, opt.steps, theta0)
+        goal = goal_states(pb, opt.final_orientation)
+        idx = np.argmin(np.abs(np.mod(base[:, None] - pb.states.stable + 3.2, TWO_PI) - 3.2), 1)
+        ok = goal[idx]
+        for sign in (-1.0, 1.0):
+            steps = (
+                opt.steps[0],
+                *(PlanStep(s.kind, s.alpha + sign * 0.99 * tol) for s in opt.steps[1:]),
+            )
+            moved = execute_plan(pb, steps, theta0)
+            assert_allclose(moved[ok], base[ok], atol=1e-12)
+
+
+def test_near_boundary_counts_starts_within_the_margin() -> None:
+    pb = Problem.build(load("rectangle"))
+    opt = plan_exact(pb).options[0]
+    res = simulate_kinematic(pb, opt, 200_000, rng=0, boundary_margin=math.radians(2.5))
+    # 4 boundaries, 5 degrees around each, over 360 degrees
+    assert_allclose(res.near_boundary / res.trials, 20 / 360, atol=0.003)
+    assert simulate_kinematic(pb, opt, 1000, rng=0, boundary_margin=0.0).near_boundary == 0
+
+
+def test_progress_is_reported_per_chunk() -> None:
+    pb = Problem.build(load("rectangle"))
+    calls: list[tuple[int, int]] = []
+    simulate_kinematic(pb, plan_exact(pb).bayes_plan, 1000, rng=0, chunk=300,
+                       progress=lambda d, t: calls.append((d, t)))  # fmt: skip
+    assert calls == [(300, 1000), (600, 1000), (900, 1000), (1000, 1000)]
+
+
+def test_kinematic_rejects_bad_settings() -> None:
+    pb = Problem.build(load("rectangle"))
+    opt = plan_exact(pb).bayes_plan
+    with pytest.raises(SimulationError, match="`trials` must be an integer >= 1; got 0"):
+        simulate_kinematic(pb, opt, 0)
+    with pytest.raises(SimulationError, match="`chunk` must be >= 1; got 0"):
+        simulate_kinematic(pb, opt, 10, chunk=0)
+    bad = type(opt)((PlanStep("push-grasp", 0.0),), 0.0, 1.0, 2.0, None, (0.0, 1.0))
+    with pytest.raises(SimulationError, match="uses 'push-grasp' actions but the problem"):
+        simulate_kinematic(pb, bad, 10)
+
+
+def test_push_grasp_plans_run_kinematically() -> None:
+    pytest.importorskip("bayesgrasp.geometry.push")
+    pb = Problem.build(load("triangle"), actions=("squeeze", "push-grasp"))
+    for opt in plan_exact(pb).options:
+        res = simulate_kinematic(pb, opt, 50_000, rng=8)
+        assert res.p_value > P_MIN
+        assert_allclose(res.predicted_success, opt.success_probability, atol=1e-9)
+
+
+# --- plan files ----------------------------------------------------------------------------
+
+
+def test_plan_from_json_reads_options_and_plan_documents() -> None:
+    pb = Problem.build(load("triangle"))
+    rep = plan_exact(pb)
+    for opt in rep.options:
+        back = plan_from_json(option_json(opt))
+        assert back.steps == opt.steps
+        assert back.final_orientation == opt.final_orientation
+    doc = {"options": [option_json(o) for o in rep.options], "bayes": rep.bayes}
+    assert plan_from_json(doc).steps == rep.bayes_plan.steps
+    legacy = {"first_squeeze_rad": 0.1, "actions_rad": [0.5], "final_orientation_rad": 1.0}
+    assert plan_from_json(legacy).steps == (PlanStep("squeeze", 0.1), PlanStep("squeeze", 0.5))
+    with pytest.raises(SimulationError, match="a plan needs `steps` or `first_squeeze_rad`"):
+        plan_from_json({"x": 1})
+    with pytest.raises(SimulationError, match=r"step 1 must be .* got \{'type': 'squeeze'\}"):
+        plan_from_json({"steps": [{"type": "squeeze"}]})
+
+
+# --- the command line ----------------------------------------------------------------------
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_simulate_kinematic_json(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "simulate", "rectangle", "--trials", "20000", "--seed", "3",
+                         "--json")  # fmt: skip
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["schema"] == "bayesgrasp.simulate/1"
+    assert doc["engine"] == "kinematic"
+    assert doc["trials"] == 20000
+    assert doc["plan"]["squeezes"] == 2
+    assert_allclose(doc["predicted_success"], 0.5, atol=1e-12)
+    lo, hi = doc["ci95"]
+    assert lo <= doc["observed_success"] <= hi
+    assert doc["jams"] == 0
+    assert doc["seconds"] >= 0
+    rows = doc["per_orientation"]
+    assert_allclose(sum(r["predicted"] for r in rows), 1.0, atol=1e-12)
+    assert_allclose(sum(r["observed"] for r in rows), 1.0, atol=1e-12)
+    assert {"orientation_rad", "predicted", "observed"} <= set(rows[0])
+
+
+def test_cli_simulate_text_and_plans(capsys: pytest.CaptureFixture[str], tmp_path: object) -> None:
+    code, out, _ = run(capsys, "simulate", "triangle", "--plan", "most-certain", "--trials",
+                       "5000", "--noise", "1", "--noise-kind", "uniform")  # fmt: skip
+    assert code == 0
+    assert "predicted" in out and "observed" in out
+    assert "95% interval" in out and "jams" in out and "near-boundary" in out
+    code, out, err = run(capsys, "plan", "triangle", "--json")
+    assert code == 0, err
+    from pathlib import Path
+
+    f = Path(str(tmp_path)) / "plan.json"
+    f.write_text(out)
+    code, out, err = run(capsys, "simulate", "triangle", "--plan", str(f), "--trials", "1000",
+                         "--json")  # fmt: skip
+    assert code == 0, err
+    assert json.loads(out)["plan"]["squeezes"] == json.loads(f.read_text())["options"][
+        json.loads(f.read_text())["bayes"]]["squeezes"]  # fmt: skip
+
+
+def test_cli_simulate_bad_input(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "simulate", "triangle", "--plan", "nope.json")
+    assert code == 2
+    assert err.startswith("bayesgrasp: error:") and "nope.json" in err
+    code, _, err = run(capsys, "simulate", "triangle", "--offset", "2")
+    assert code == 2
+    assert "--offset" in err and "mujoco" in err
+    code, _, err = run(capsys, "simulate", "triangle", "--trials", "0")
+    assert code == 2
+
+
+def test_cli_simulate_guaranteed_plan(capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("bayesgrasp.planning.guaranteed")
+    code, out, err = run(capsys, "simulate", "rectangle", "--plan", "guaranteed", "--trials",
+                         "2000", "--goal", "symmetry", "--json")  # fmt: skip
+    assert code == 0, err
+    assert json.loads(out)["observed_success"] == 1.0
