@@ -1,0 +1,1 @@
+"""Snapshot of every number the command line prints with ``--json`` (see ``generate.py``)."""

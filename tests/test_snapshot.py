@@ -1,0 +1,109 @@
+"""Every ``--json`` document of the snapshot ``tests/snapshots/cli.json``, re-run and compared.
+
+Each stored command line is run in-process with the current code from the repository root; the
+exit code must be the same and the document equal to the stored one: floats to a relative or
+absolute 1e-9, everything else (ints, strings, bools, null, list lengths, object keys)
+exactly. Wall times (``VOLATILE_KEYS``) are not compared. To change the snapshot on purpose,
+run ``python tests/snapshots/generate.py`` and review the diff of ``cli.json``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import pytest
+
+from snapshots.generate import ROOT, SNAPSHOT, VOLATILE_KEYS, drop_volatile, run_cli
+
+REL = ABS = 1e-9
+
+ENTRIES: list[dict[str, Any]] = json.loads(SNAPSHOT.read_text(encoding="utf-8"))
+
+
+def _kind(x: Any) -> str:
+    """JSON type of a parsed value (bool before int: a bool is an int in Python)."""
+    for t, name in ((bool, "bool"), (int, "int"), (float, "float"), (str, "string")):
+        if isinstance(x, t):
+            return name
+    if x is None:
+        return "null"
+    return {list: "array", dict: "object"}.get(type(x), type(x).__name__)
+
+
+def first_difference(expected: Any, actual: Any, path: str = "$") -> str | None:
+    """Where ``actual`` first differs from ``expected`` and how, or ``None`` if they agree.
+
+    Floats agree to a relative or absolute ``1e-9``; ints, strings, bools, null, list lengths
+    and object keys must be equal.
+    """
+    ke, ka = _kind(expected), _kind(actual)
+    if ke != ka:
+        return f"{path}: expected {ke} {expected!r}, got {ka} {actual!r}"
+    if ke == "float":
+        if math.isclose(expected, actual, rel_tol=REL, abs_tol=ABS):
+            return None
+        return f"{path}: expected {expected!r}, got {actual!r}"
+    if ke == "array":
+        if len(expected) != len(actual):
+            return f"{path}: expected {len(expected)} items, got {len(actual)}"
+        for i, (e, a) in enumerate(zip(expected, actual, strict=True)):
+            diff = first_difference(e, a, f"{path}[{i}]")
+            if diff is not None:
+                return diff
+        return None
+    if ke == "object":
+        missing = sorted(set(expected) - set(actual))
+        extra = sorted(set(actual) - set(expected))
+        if missing or extra:
+            return f"{path}: keys missing {missing}, unexpected {extra}"
+        for k in expected:
+            diff = first_difference(expected[k], actual[k], f"{path}.{k}")
+            if diff is not None:
+                return diff
+        return None
+    if expected != actual:
+        return f"{path}: expected {expected!r}, got {actual!r}"
+    return None
+
+
+@pytest.mark.parametrize("entry", ENTRIES, ids=[" ".join(e["argv"]) for e in ENTRIES])
+def test_cli_json_unchanged(entry: dict[str, Any], monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+    code, doc = run_cli(entry["argv"])
+    assert code == entry["exit_code"]
+    diff = first_difference(entry["json"], doc)
+    assert diff is None, diff
+
+
+def test_snapshot_has_no_volatile_keys() -> None:
+    assert drop_volatile(ENTRIES) == ENTRIES
+    assert {"seconds", "planner_seconds"} <= VOLATILE_KEYS
+
+
+def test_first_difference_paths() -> None:
+    doc = {"a": [1, 2.0, {"b": None, "c": "x", "d": True}]}
+    assert first_difference(doc, json.loads(json.dumps(doc))) is None
+    assert first_difference(doc, {"a": [1, 2.0 * (1 + 1e-10), doc["a"][2]]}) is None
+    assert first_difference({"x": 0.0}, {"x": 1e-10}) is None
+    cases = [
+        ({"a": [1, 2.0 + 1e-6, doc["a"][2]]}, "$.a[1]: expected 2.0, got 2.000001"),
+        ({"a": [2, 2.0, doc["a"][2]]}, "$.a[0]: expected 1, got 2"),
+        ({"a": [1.0, 2.0, doc["a"][2]]}, "$.a[0]: expected int 1, got float 1.0"),
+        ({"a": [1, 2.0]}, "$.a: expected 3 items, got 2"),
+        ({"a": [1, 2.0, {"b": 0.0, "c": "x", "d": True}]}, "$.a[2].b: expected null None"),
+        ({"a": [1, 2.0, {"b": None, "c": "y", "d": True}]}, "$.a[2].c: expected 'x', got 'y'"),
+        ({"a": [1, 2.0, {"b": None, "c": "x", "d": 1}]}, "$.a[2].d: expected bool True"),
+        ({"a": [1, 2.0, {"b": None, "c": "x"}]}, "$.a[2]: keys missing ['d'], unexpected []"),
+    ]
+    for actual, message in cases:
+        diff = first_difference(doc, actual)
+        assert diff is not None
+        assert diff.startswith(message), diff
+
+
+def test_run_cli_refuses_text_output(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)
+    with pytest.raises(ValueError, match="stdout is not JSON"):
+        run_cli(["squeeze", "triangle"])
