@@ -47,7 +47,7 @@ def guaranteed_all(parts: list[Part]) -> list[tuple[int, int]]:
 def mixed_all(parts: list[Part], push_cost: float) -> list[tuple[float, float, int, float]]:
     """(Bayes cost, most-certain probability, most-certain length, its cost) per part."""
     out = []
-    cost = CostModel(push_grasp=push_cost)
+    cost = CostModel({"push-grasp": push_cost})
     for p in parts:
         rep = plan_exact(Problem.build(p, cost=cost, actions=("squeeze", "push-grasp")))
         mc = rep.most_certain_plan

@@ -177,11 +177,10 @@ def build_problem(
 ) -> Problem:
     """Parse the options shared by planning commands into a problem."""
     cost = CostModel(
-        squeeze=squeeze_cost,
+        {"squeeze": squeeze_cost, "push-grasp": push_grasp_cost},
         verify=verify_cost,
-        first_squeeze=first_squeeze_cost,
+        first={} if first_squeeze_cost is None else {"squeeze": first_squeeze_cost},
         retry=retry_cost,
-        push_grasp=push_grasp_cost,
     )
     p = resolve_part(part) if isinstance(part, str) else part
     return Problem.build(

@@ -33,6 +33,7 @@ __all__ = [
     "PartFileError",
     "PlanningError",
     "PriorError",
+    "SimulationError",
 ]
 
 
@@ -62,6 +63,10 @@ class PlanningError(BayesGraspError):
 
 class NoPlanError(PlanningError):
     """No plan reaches the goal asked for; the message says why."""
+
+
+class SimulationError(BayesGraspError, ValueError):
+    """Bad simulation settings (trials, noise, plan)."""
 
 
 class MissingExtraError(BayesGraspError, ImportError):

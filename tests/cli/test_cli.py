@@ -270,8 +270,8 @@ def test_plan_json_peaked_prior_follows_bayes_plan(capsys: pytest.CaptureFixture
     ("args", "cost", "goal", "bayes", "n_options"),
     [
         ([], CostModel(), Goal(), 1, 2),
-        (["--first-squeeze-cost", "0"], CostModel(first_squeeze=0.0), Goal(), 0, 2),
-        (["--squeeze-cost", "10"], CostModel(squeeze=10.0), Goal(), 0, 2),
+        (["--first-squeeze-cost", "0"], CostModel(first={"squeeze": 0.0}), Goal(), 0, 2),
+        (["--squeeze-cost", "10"], CostModel({"squeeze": 10.0}), Goal(), 0, 2),
         (["--verify-cost", "9", "--retry-cost", "2"], CostModel(verify=9, retry=2), Goal(), 1, 2),
         (["--goal", "symmetry"], CostModel(), Goal("symmetry"), 1, 2),
         (["--max-squeezes", "1"], CostModel(), Goal(), 0, 1),

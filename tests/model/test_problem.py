@@ -35,7 +35,9 @@ def test_cost_model_defaults_are_the_seeds() -> None:
 
 @pytest.mark.parametrize("p", [0.1, 0.25, 0.5, 1.0])
 def test_expected_cost_formula(p: float) -> None:
-    c = CostModel(squeeze=2.0, verify=3.0, first_squeeze=5.0, retry=0.7, push_grasp=4.0)
+    c = CostModel(
+        {"squeeze": 2.0, "push-grasp": 4.0}, verify=3.0, retry=0.7, first={"squeeze": 5.0}
+    )
     kinds = ("squeeze", "push-grasp", "squeeze")
     attempt = 5.0 + 4.0 + 2.0 + 3.0
     assert c.attempt_cost(kinds) == attempt
@@ -47,7 +49,7 @@ def test_expected_cost_formula(p: float) -> None:
 
 def test_expected_cost_by_simulation(rng: np.random.Generator) -> None:
     """Run the retry loop literally and average its cost."""
-    c = CostModel(squeeze=1.5, verify=0.5, first_squeeze=3.0, retry=2.0)
+    c = CostModel({"squeeze": 1.5}, verify=0.5, retry=2.0, first={"squeeze": 3.0})
     kinds = ("squeeze", "squeeze")
     p = 0.3
     attempts = rng.geometric(p, size=200_000)
@@ -59,12 +61,14 @@ def test_expected_cost_by_simulation(rng: np.random.Generator) -> None:
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"squeeze": -1.0}, r"cost `squeeze` must be a finite number >= 0; got -1.0"),
+        ({"actions": {"squeeze": -1.0}}, r"cost `squeeze` must be a finite number >= 0; got -1.0"),
         ({"verify": math.nan}, r"cost `verify` must be a finite number >= 0; got nan"),
         ({"retry": math.inf}, r"cost `retry` must be a finite number >= 0; got inf"),
-        ({"first_squeeze": -0.5}, r"cost `first_squeeze` must be .*; got -0.5"),
-        ({"push_grasp": "1"}, r"cost `push_grasp` must be a finite number >= 0; got '1'"),
-        ({"squeeze": True}, r"cost `squeeze` must be a finite number >= 0; got True"),
+        ({"first": {"squeeze": -0.5}}, r"cost `first squeeze` must be .*; got -0.5"),
+        ({"actions": {"push-grasp": "1"}}, r"cost `push-grasp` must be a finite .*; got '1'"),
+        ({"actions": {"squeeze": True}}, r"cost `squeeze` must be a finite number >= 0; got True"),
+        ({"actions": [1.0]}, r"`actions` must map action names to costs; got \[1.0\]"),
+        ({"first": {3: 1.0}}, r"`first` must map action names to costs; got key 3"),
     ],
 )
 def test_cost_model_rejects_bad_costs(kwargs: dict[str, object], match: str) -> None:
@@ -72,21 +76,24 @@ def test_cost_model_rejects_bad_costs(kwargs: dict[str, object], match: str) -> 
         CostModel(**kwargs)  # type: ignore[arg-type]
 
 
-def test_cost_model_unknown_action() -> None:
-    with pytest.raises(PlanningError, match="unknown action kind 'poke'"):
-        CostModel().action_cost("poke")
+def test_cost_model_by_action_name() -> None:
+    """Costs are looked up by name: an action the model does not name costs 1 (the seed)."""
+    assert CostModel().action_cost("poke") == 1.0
+    assert CostModel({"poke": 3.0}).action_cost("poke") == 3.0
+    assert CostModel({"squeeze": 1.0}) == CostModel()  # one spelling of each model
+    assert CostModel(first={"push-grasp": 7.0}).attempt_cost(("push-grasp",)) == 8.0
 
 
 def test_plans_that_cost_nothing_are_refused() -> None:
     part = Part.from_points(RECTANGLE)
     with pytest.raises(CostError, match=r"at least one of the costs .* must be positive"):
-        Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0))
+        Problem.build(part, cost=CostModel({"squeeze": 0.0}, verify=0.0))
     # Any positive cost of the actions used is enough.
-    Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0, retry=1.0))
-    Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0, first_squeeze=1.0))
+    Problem.build(part, cost=CostModel({"squeeze": 0.0}, verify=0.0, retry=1.0))
+    Problem.build(part, cost=CostModel({"squeeze": 0.0}, verify=0.0, first={"squeeze": 1.0}))
     # A push-grasp cost does not count for squeeze-only plans.
-    with pytest.raises(CostError, match="`verify`, `retry`, `squeeze`, `first_squeeze`"):
-        Problem.build(part, cost=CostModel(squeeze=0.0, verify=0.0, push_grasp=5.0))
+    with pytest.raises(CostError, match="`verify`, `retry`, `squeeze` must be positive; got all zero"):
+        Problem.build(part, cost=CostModel({"squeeze": 0.0, "push-grasp": 5.0}, verify=0.0))
 
 
 # --------------------------------------------------------------------------------------
@@ -118,7 +125,7 @@ def test_build_defaults_and_actions() -> None:
 
 @pytest.mark.parametrize(
     ("actions", "match"),
-    [((), "at least one action type is needed"), (("poke",), "unknown action type 'poke'")],
+    [((), "at least one action type is needed"), (("poke",), "unknown action 'poke'; expected one of 'squeeze', 'push-grasp'")],
 )
 def test_build_rejects_bad_actions(actions: tuple[str, ...], match: str) -> None:
     with pytest.raises(PlanningError, match=match):

@@ -112,7 +112,7 @@ def test_symmetry_goal_orients_square_with_certainty() -> None:
 def test_agrees_with_exact_under_peaked_prior_and_costs(
     rng: np.random.Generator, prior: Prior
 ) -> None:
-    cost = CostModel(first_squeeze=2.5, retry=0.5)
+    cost = CostModel(retry=0.5, first={"squeeze": 2.5})
     parts = random_parts(rng, 30)
     done = sum(assert_agree(Problem.build(p, prior=prior, cost=cost)) for p in parts)
     assert done >= 25  # several roots (first angles) share the node limit
@@ -149,7 +149,7 @@ def fake_push_grasp(problem: Problem, offset: int) -> Problem:
 def test_agrees_with_exact_with_two_action_kinds(rng: np.random.Generator, pg_cost: float) -> None:
     done = eligible = 0
     for j, part in enumerate(random_parts(rng, 30)):
-        pb = Problem.build(part, cost=CostModel(push_grasp=pg_cost))
+        pb = Problem.build(part, cost=CostModel({"push-grasp": pg_cost}))
         if pb.n_states < 6:
             continue
         eligible += 1

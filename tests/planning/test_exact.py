@@ -591,8 +591,8 @@ def test_cost_formula_and_bayes_plan_change() -> None:
     k = np.arange(1, len(ps) + 1)
     cases = [
         (CostModel(), (k + 1) / ps),
-        (CostModel(first_squeeze=4.0), (4.0 + (k - 1) + 1) / ps),
-        (CostModel(squeeze=2.0, verify=3.0), (2.0 * k + 3.0) / ps),
+        (CostModel(first={"squeeze": 4.0}), (4.0 + (k - 1) + 1) / ps),
+        (CostModel({"squeeze": 2.0}, verify=3.0), (2.0 * k + 3.0) / ps),
         (CostModel(retry=1.5), (k + 1) / ps + 1.5 * (1 / ps - 1)),
         (CostModel(verify=0.0), k / ps),
     ]
@@ -608,15 +608,15 @@ def test_cost_formula_and_bayes_plan_change() -> None:
     free = plan_exact(Problem.build(tri, cost=CostModel(verify=0.0)))
     assert free.bayes == int(np.argmin(k / ps)) and free.bayes < 2
     # Ties go to fewer squeezes: a cost model making plans 2 and 3 equal picks 2.
-    tie = CostModel(squeeze=1.0, verify=(3 * ps[1] - 2 * ps[2]) / (ps[2] - ps[1]))
+    tie = CostModel({"squeeze": 1.0}, verify=(3 * ps[1] - 2 * ps[2]) / (ps[2] - ps[1]))
     tied = plan_exact(Problem.build(tri, cost=tie))
     assert_allclose(costs_of(tied)[1], costs_of(tied)[2], rtol=1e-9)
     assert tied.bayes == 1
     # A free first squeeze makes the one-squeeze plan the Bayes plan of the rectangle.
     rect = load("rectangle")
     assert plan_exact(Problem.build(rect)).bayes == 1
-    assert plan_exact(Problem.build(rect, cost=CostModel(first_squeeze=0.0))).bayes == 0
-    assert plan_exact(Problem.build(rect, cost=CostModel(squeeze=10.0))).bayes == 0
+    assert plan_exact(Problem.build(rect, cost=CostModel(first={"squeeze": 0.0}))).bayes == 0
+    assert plan_exact(Problem.build(rect, cost=CostModel({"squeeze": 10.0}))).bayes == 0
 
 
 def test_choose_indices_ties_and_tolerance() -> None:
@@ -657,7 +657,7 @@ def test_two_action_types_against_brute_force(rng: np.random.Generator, push_cos
         part = random_part(rng, 7)
         squeeze = squeeze_function(part.hull)
         push = synthetic_transfer(rng, int(rng.integers(2, 5)))
-        cost = CostModel(push_grasp=push_cost, first_squeeze=0.5)
+        cost = CostModel({"push-grasp": push_cost}, first={"squeeze": 0.5})
         pb = Problem(
             part,
             UniformPrior(),

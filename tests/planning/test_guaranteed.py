@@ -218,7 +218,9 @@ def test_cheapest_of_the_shortest(rng: np.random.Generator) -> None:
 
     for part in random_parts(rng, 60):
         cheap = plan_guaranteed(Problem.build(part, actions=("squeeze", "push-grasp")))
-        pb = Problem.build(part, cost=CostModel(push_grasp=3.0), actions=("squeeze", "push-grasp"))
+        pb = Problem.build(
+            part, cost=CostModel({"push-grasp": 3.0}), actions=("squeeze", "push-grasp")
+        )
         dear = plan_guaranteed(pb)
         assert dear.n_actions == cheap.n_actions
         attempt = pb.cost.attempt_cost

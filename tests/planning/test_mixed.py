@@ -45,7 +45,7 @@ def test_exact_agrees_with_breadth_first(rng: np.random.Generator, push_cost: fl
     depth = 4
     complete = extra = 0
     for part in random_parts(rng, 100):
-        pb = Problem.build(part, cost=CostModel(push_grasp=push_cost), actions=MIXED)
+        pb = Problem.build(part, cost=CostModel({"push-grasp": push_cost}), actions=MIXED)
         exact = plan_exact(pb, max_actions=depth)
         res = search_bfs(pb, max_actions=depth, node_limit=10**7, tree_count=False)
         assert res.stats.completed and res.stats.fallback_nodes == 0
@@ -96,7 +96,7 @@ def test_every_sequence_of_kinds(rng: np.random.Generator, push_cost: float) -> 
     sequences up to three actions longer than the most certain plan."""
     extra = 0
     for part in random_parts(rng, 60):
-        pb = Problem.build(part, cost=CostModel(push_grasp=push_cost), actions=MIXED)
+        pb = Problem.build(part, cost=CostModel({"push-grasp": push_cost}), actions=MIXED)
         rep = plan_exact(pb)
         mc = rep.most_certain
         seqs = sequence_costs(pb, rep.most_certain_plan.n_actions + 3)
@@ -124,7 +124,7 @@ def test_every_sequence_of_kinds(rng: np.random.Generator, push_cost: float) -> 
 @pytest.mark.parametrize("push_cost", [1.0, 2.0])
 def test_exact_plans_do_what_they_claim(rng: np.random.Generator, push_cost: float) -> None:
     for part in random_parts(rng, 40):
-        pb = Problem.build(part, cost=CostModel(push_grasp=push_cost), actions=MIXED)
+        pb = Problem.build(part, cost=CostModel({"push-grasp": push_cost}), actions=MIXED)
         for o in plan_exact(pb).options:
             assert landed(pb, o) == pytest.approx(o.success_probability, abs=2.0 / len(GRID))
             attempt = pb.cost.attempt_cost(o.kinds)
@@ -154,7 +154,7 @@ def test_push_grasps_orient_asymmetric_parts_squeezes_stay_at_half(
 def test_mixed_never_worse_than_either_kind_alone(rng: np.random.Generator) -> None:
     for part in random_parts(rng, 60):
         for push_cost in (1.0, 2.0, 5.0):
-            cost = CostModel(push_grasp=push_cost)
+            cost = CostModel({"push-grasp": push_cost})
             mixed = plan_exact(Problem.build(part, cost=cost, actions=MIXED))
             alone = [
                 plan_exact(Problem.build(part, cost=cost, actions=(k,)))
@@ -195,7 +195,9 @@ def test_cli_actions_and_push_grasp_cost(capsys: pytest.CaptureFixture[str]) -> 
     assert code == 0 and err == ""
     doc = json.loads(out)
     assert doc["schema"] == "bayesgrasp.plan/2"
-    rep = plan_exact(Problem.build(load("triangle"), cost=CostModel(push_grasp=2.0), actions=MIXED))
+    rep = plan_exact(
+        Problem.build(load("triangle"), cost=CostModel({"push-grasp": 2.0}), actions=MIXED)
+    )
     assert [o["expected_cost"] for o in doc["options"]] == pytest.approx(
         [o.expected_cost for o in rep.options]
     )

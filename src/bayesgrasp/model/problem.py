@@ -1,148 +1,51 @@
 """The planning problem: the seed's six-tuple <Theta, f_1, A, G, C, theta*> (section 3).
 
 - ``Theta`` (states): the stable orientations of the squeeze function (section 4.3); every
-  action here ends in one of them (a push-grasp ends with a squeeze).
+  action ends in one of them (:mod:`.states`), and the diameter there is what the gripper
+  reads (:attr:`Problem.widths`).
 - ``f_1`` (prior): a :class:`~bayesgrasp.model.prior.Prior` on the initial orientation; the
   distribution over states after the first action is the prior mass of each basin.
-- ``A`` (actions): gripper rotations ``alpha`` followed by an action of a given type. For each
-  type the continuum of angles falls into finitely many classes with the same effect on the
-  states (section 4.4: at most n^2 for squeezes), see :class:`ActionClasses`. The gripper's
-  ``accuracy`` (radians, default 0) bounds the error of each relative rotation
+- ``A`` (actions): gripper rotations ``alpha`` followed by an :class:`~.actions.Action`.
+  For each action the continuum of angles falls into finitely many classes with the same
+  effect on the states (section 4.4: at most n^2 for squeezes), see :class:`ActionClasses`.
+  The gripper's ``accuracy`` (radians, default 0) bounds the error of each relative rotation
   ``alpha_2..alpha_k``: a planner that honours it returns only plans that keep their success
   under any errors of less than ``accuracy`` on every turn (plan tolerance >= accuracy).
-- ``G`` (transfer): one :class:`~bayesgrasp.geometry.transfer.TransferFunction` per action type.
-- ``C`` (cost): a :class:`CostModel`.
-- ``theta*`` (goal): a :class:`Goal`: one final orientation (the seed), or a set of
+- ``G`` (transfer): each action class is a row-stochastic (K, K) transition matrix over the
+  states (:meth:`ActionClasses.matrix`; one-hot for today's deterministic actions, so a noisy
+  action is another matrix, not another code path), built from the action's transfer
+  function on orientations (:meth:`Problem.transfer`).
+- ``C`` (cost): a :class:`~.cost.CostModel`.
+- ``theta*`` (goal): a :class:`~.goal.Goal`: one final orientation (the seed), or the set of
   orientations equivalent under the part's rotational symmetry.
 
-The pieces are separate values so that sensing, noisy actions or payoffs can later replace
-one of them without touching the others.
+The pieces are separate values so that sensing, noisy actions or payoffs replace one of them
+without touching the others. Everything a planner needs is built with the problem or
+computed on first use inside it; callers never prepare anything.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Literal
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import CostError, PlanningError
+from ..errors import PlanningError
+from ..geometry.diameter import DiameterFunction, diameter_function
 from ..geometry.polygon import Part
 from ..geometry.transfer import TransferFunction, squeeze_function
+from .actions import SQUEEZE, Action, get_action, parse_actions
+from .cost import CostModel
+from .goal import Goal
 from .prior import Prior, UniformPrior
+from .states import nearest_state
 
-__all__ = ["ActionClasses", "CostModel", "Goal", "Problem", "action_classes"]
-
-TWO_PI = 2.0 * math.pi
-ActionKind = Literal["squeeze", "push-grasp"]
-
-
-@dataclass(frozen=True, slots=True)
-class CostModel:
-    """Costs of actions and of the verification that ends each attempt (the seed, 3 and 4.5).
-
-    An attempt is the plan's actions plus one verification; on failure the plan is run again
-    on a part whose orientation is a fresh draw from the prior (the seed's model: expected
-    number of attempts ``1 / p``). Each failed verification also pays ``retry``. So
-
-        E[cost] = attempt / p + retry * (1 / p - 1).
-
-    Parameters
-    ----------
-    squeeze : float
-        Cost of a squeeze (default 1, the seed).
-    verify : float
-        Cost of the verification step (default 1, the seed).
-    first_squeeze : float or None
-        Cost of the first action when it is a squeeze (default: ``squeeze``).
-    retry : float
-        Overhead paid on each failed verification (default 0).
-    push_grasp : float
-        Cost of a push-grasp (default 1).
-
-    Examples
-    --------
-    >>> CostModel().expected_cost(("squeeze", "squeeze"), 0.5)
-    6.0
-    """
-
-    squeeze: float = 1.0
-    verify: float = 1.0
-    first_squeeze: float | None = None
-    retry: float = 0.0
-    push_grasp: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name in ("squeeze", "verify", "first_squeeze", "retry", "push_grasp"):
-            value = getattr(self, name)
-            if value is None:
-                continue
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, int | float)
-                or not math.isfinite(value)
-                or value < 0
-            ):
-                raise CostError(f"cost `{name}` must be a finite number >= 0; got {value!r}")
-
-    def check_positive(self, kinds: tuple[str, ...]) -> None:
-        """Raise :class:`CostError` if every plan made of these action types costs nothing.
-
-        Expected costs could not rank such plans.
-        """
-        costs = [self.verify, self.retry] + [self.action_cost(k) for k in kinds]
-        if "squeeze" in kinds and self.first_squeeze is not None:
-            costs.append(self.first_squeeze)
-        if not any(c > 0 for c in costs):
-            names = ", ".join(
-                ["`verify`", "`retry`"]
-                + (["`squeeze`", "`first_squeeze`"] if "squeeze" in kinds else [])
-                + (["`push_grasp`"] if "push-grasp" in kinds else [])
-            )
-            raise CostError(f"at least one of the costs {names} must be positive; got all zero")
-
-    def action_cost(self, kind: str, first: bool = False) -> float:
-        """Cost of one action of the given kind."""
-        if kind == "squeeze":
-            if first and self.first_squeeze is not None:
-                return self.first_squeeze
-            return self.squeeze
-        if kind == "push-grasp":
-            return self.push_grasp
-        raise PlanningError(f"unknown action kind {kind!r}")
-
-    def attempt_cost(self, kinds: tuple[str, ...]) -> float:
-        """Cost of one attempt: the actions in order, then the verification."""
-        return self.verify + sum(self.action_cost(k, i == 0) for i, k in enumerate(kinds))
-
-    def expected_cost(self, kinds: tuple[str, ...], p: float) -> float:
-        """Expected cost of repeating the plan until verification succeeds (inf if p = 0)."""
-        if p <= 0.0:
-            return math.inf
-        return self.attempt_cost(kinds) / p + self.retry * (1.0 / p - 1.0)
-
-
-@dataclass(frozen=True, slots=True)
-class Goal:
-    """The desired final state.
-
-    ``"single"`` (the seed): one final orientation, the most probable one.
-    ``"symmetry"``: the ``r`` orientations ``2 pi / r`` apart of an r-fold symmetric part
-    count as one (they are the same physical placement).
-
-    Examples
-    --------
-    >>> Goal("symmetry").group_order(4)
-    4
-    """
-
-    kind: Literal["single", "symmetry"] = "single"
-
-    def group_order(self, symmetry_order: int) -> int:
-        """How many orientations ``2 pi / g`` apart the goal counts as one."""
-        return symmetry_order if self.kind == "symmetry" else 1
+__all__ = ["ActionClasses", "CostModel", "Goal", "Problem", "action_classes", "nearest_state"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -169,14 +72,39 @@ class ActionClasses:
     mid: NDArray[np.float64]
     transfer: NDArray[np.intp]
 
+    @property
+    def n_classes(self) -> int:
+        """Number of classes ``A``."""
+        return len(self.lo)
+
+    def matrix(self, a: int) -> NDArray[np.float64]:
+        """The row-stochastic (K, K) transition matrix of class ``a``.
+
+        Entry ``(i, j)`` is the probability that state ``i`` ends in state ``j``: one-hot rows
+        for a deterministic action (``transfer[a, i]``); a noisy action spreads them.
+
+        Examples
+        --------
+        >>> from bayesgrasp.geometry import Part
+        >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+        >>> m = pb.transition("squeeze").matrix(0)
+        >>> m.shape, m.sum(axis=1).tolist()
+        ((4, 4), [1.0, 1.0, 1.0, 1.0])
+        """
+        k = self.transfer.shape[1]
+        m = np.zeros((k, k))
+        m[np.arange(k), self.transfer[a]] = 1.0
+        return m
+
 
 def action_classes(
     states: TransferFunction, action: TransferFunction, gripper_period: float
 ) -> ActionClasses:
     """Enumerate the action classes of ``action`` acting on the states of ``states``.
 
-    ``gripper_period`` is ``pi`` for a squeeze (the gripper turned by pi is the same gripper)
-    and ``2 pi`` for a push-grasp (the pushing jaw is on one side).
+    ``gripper_period`` is the action's :attr:`~.actions.Action.gripper_period`: ``pi`` for
+    a squeeze (the gripper turned by pi is the same gripper) and ``2 pi`` for a push-grasp
+    (the pushing jaw is on one side).
     """
     s = states.stable
     crit = np.unique(np.mod((s[:, None] - action.boundaries[None, :]).ravel(), gripper_period))
@@ -195,18 +123,28 @@ def action_classes(
     return ActionClasses(action.kind, lo, hi, mid, transfer)
 
 
-def nearest_state(states: TransferFunction, theta: NDArray[np.float64]) -> NDArray[np.intp]:
-    """Index of the stable orientation nearest (on the circle) to each angle."""
-    s = states.stable
-    diff = np.abs(np.mod(theta[..., None] - s + math.pi, TWO_PI) - math.pi)
-    return np.asarray(np.argmin(diff, axis=-1), dtype=np.intp)
-
-
 @dataclass(frozen=True, slots=True, eq=False)
 class Problem:
-    """A planning problem: part, prior, actions, transfer functions, cost and goal.
+    """A planning problem: states, prior, actions and their transfers, cost and goal.
 
     Build it with :meth:`build`.
+
+    Attributes
+    ----------
+    part : Part
+    states : TransferFunction
+        The squeeze function, whose K stable orientations are the states.
+    diameter : DiameterFunction
+        The part's diameter function (the squeeze function descends it).
+    prior : Prior
+    actions : tuple of Action
+        The action kinds available, in the order given.
+    transfers : mapping of str to TransferFunction
+        Each action's transfer function on orientations, by action name.
+    cost : CostModel
+    goal : Goal
+    accuracy : float
+        Accuracy of the gripper's turns, radians.
 
     Examples
     --------
@@ -217,14 +155,16 @@ class Problem:
     """
 
     part: Part
+    states: TransferFunction
+    diameter: DiameterFunction
     prior: Prior
-    transfers: dict[str, TransferFunction]
+    actions: tuple[Action, ...]
+    transfers: Mapping[str, TransferFunction]
     cost: CostModel
     goal: Goal
-    action_kinds: tuple[str, ...]
     accuracy: float = 0.0
-    _classes: dict[str, ActionClasses] = field(default_factory=dict, repr=False)
-    _memo: dict[str, int] = field(default_factory=dict, repr=False)
+    # Derived values computed on first use (the action classes, the goal's group order).
+    _cache: dict[Any, Any] = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(
@@ -233,7 +173,7 @@ class Problem:
         prior: Prior | None = None,
         cost: CostModel | None = None,
         goal: Goal | None = None,
-        actions: tuple[str, ...] = ("squeeze",),
+        actions: str | Iterable[str | Action] = ("squeeze",),
         accuracy: float = 0.0,
     ) -> Problem:
         """Set up the six-tuple for a part.
@@ -247,8 +187,9 @@ class Problem:
             Default: every action 1, verification 1.
         goal : Goal, optional
             Default: a single final orientation.
-        actions : tuple of str
-            Action types available: ``"squeeze"`` and/or ``"push-grasp"``.
+        actions : str or iterable of str or Action
+            Action kinds available (names from :data:`~.actions.ACTIONS`, e.g.
+            ``"squeeze"`` and/or ``"push-grasp"``, or a comma-separated string).
         accuracy : float
             Accuracy of the gripper's turns, radians (default 0): every relative rotation
             ``alpha_2..alpha_k`` may err by less than this. The exact and guaranteed planners
@@ -277,29 +218,52 @@ class Problem:
             raise PlanningError(
                 f"`accuracy` must be a finite number of radians >= 0; got {accuracy!r}"
             )
-        if not actions:
-            raise PlanningError("at least one action type is needed")
-        transfers: dict[str, TransferFunction] = {"squeeze": squeeze_function(part.hull)}
-        for kind in actions:
-            if kind == "push-grasp":
-                from ..geometry.push import push_grasp_function
-
-                transfers[kind] = push_grasp_function(part, transfers["squeeze"])
-            elif kind != "squeeze":
-                raise PlanningError(
-                    f"unknown action type {kind!r}; expected 'squeeze' or 'push-grasp'"
-                )
-        kinds = tuple(dict.fromkeys(actions))
+        acts = parse_actions(actions)
+        if not isinstance(part, Part):
+            raise PlanningError(f"`part` must be a Part; got {type(part).__name__}")
+        if prior is not None and not isinstance(prior, Prior):
+            raise PlanningError(f"`prior` must be a Prior; got {type(prior).__name__}")
+        if cost is not None and not isinstance(cost, CostModel):
+            raise PlanningError(f"`cost` must be a CostModel; got {type(cost).__name__}")
+        if goal is not None and not isinstance(goal, Goal):
+            raise PlanningError(f"`goal` must be a Goal; got {type(goal).__name__}")
+        d = diameter_function(part.hull)
+        states = squeeze_function(d)
+        transfers = {SQUEEZE.name: states}
+        for a in acts:
+            transfers[a.name] = a.build(part, states)
         cost = cost or CostModel()
-        cost.check_positive(kinds)
+        cost.check_positive(a.name for a in acts)
         return cls(
-            part, prior or UniformPrior(), transfers, cost, goal or Goal(), kinds, float(accuracy)
+            part,
+            states,
+            d,
+            prior or UniformPrior(),
+            acts,
+            MappingProxyType(transfers),
+            cost,
+            goal or Goal(),
+            float(accuracy),
         )
 
     @property
-    def states(self) -> TransferFunction:
-        """The squeeze function, whose stable orientations are the states."""
-        return self.transfers["squeeze"]
+    def action_kinds(self) -> tuple[str, ...]:
+        """Names of the available actions, in order."""
+        return tuple(a.name for a in self.actions)
+
+    def action(self, name: str | Action) -> Action:
+        """The action of that name (also one the problem does not use)."""
+        return get_action(name)
+
+    def transfer(self, name: str | Action) -> TransferFunction:
+        """The transfer function on orientations of one action of the problem."""
+        key = name.name if isinstance(name, Action) else name
+        try:
+            return self.transfers[key]
+        except KeyError:
+            raise PlanningError(
+                f"action {key!r} is not one of this problem's ({', '.join(self.action_kinds)})"
+            ) from None
 
     @property
     def n_states(self) -> int:
@@ -307,28 +271,49 @@ class Problem:
         return self.states.n_states
 
     @property
+    def widths(self) -> NDArray[np.float64]:
+        """The jaw opening at each state, ``d(S_i)`` (part units): what a gripper reads."""
+        if "widths" not in self._cache:
+            self._cache["widths"] = self.diameter(self.states.stable)
+        return np.asarray(self._cache["widths"], dtype=np.float64)
+
+    @property
     def goal_group(self) -> int:
-        """Number of orientations the goal counts as one (computed once)."""
-        if "goal_group" not in self._memo:
-            self._memo["goal_group"] = self.goal.group_order(self.part.hull.symmetry_order)
-        return self._memo["goal_group"]
+        """Number of orientations the goal counts as one (the part's symmetry only if asked)."""
+        if "goal_group" not in self._cache:
+            self._cache["goal_group"] = self.goal.group_order(self.part.hull.symmetry_order)
+        return int(self._cache["goal_group"])
 
-    def classes(self, kind: str) -> ActionClasses:
-        """The action classes of one action type (computed once)."""
-        if kind not in self._classes:
-            period = math.pi if kind == "squeeze" else TWO_PI
-            self._classes[kind] = action_classes(self.states, self.transfers[kind], period)
-        return self._classes[kind]
+    def success_states(self, final_orientation: float) -> NDArray[np.bool_]:
+        """Which states succeed when a plan ends at ``final_orientation`` (see :class:`Goal`)."""
+        return self.goal.success_states(self.states, final_orientation, self.goal_group)
 
-    def state_distribution(self, first_angle: float = 0.0, kind: str = "squeeze") -> np.ndarray:
+    def transition(self, name: str | Action) -> ActionClasses:
+        """The action classes (and their transition matrices) of one action (computed once)."""
+        action = get_action(name)
+        key = ("classes", action.name)
+        if key not in self._cache:
+            self._cache[key] = action_classes(
+                self.states, self.transfer(action), action.gripper_period
+            )
+        return self._cache[key]  # type: ignore[no-any-return]
+
+    def classes(self, name: str | Action) -> ActionClasses:
+        """Alias of :meth:`transition`."""
+        return self.transition(name)
+
+    def state_distribution(
+        self, first_angle: float = 0.0, kind: str | Action = "squeeze"
+    ) -> NDArray[np.float64]:
         """Probability of each state after the first action made at gripper angle ``first_angle``.
 
         The part at world orientation ``theta`` is at ``theta - first_angle`` in the gripper
-        frame; state ``i`` collects the prior mass of its basin shifted by ``first_angle``.
+        frame; state ``i`` collects the prior mass of the basins of the action's transfer
+        function that end there, shifted by ``first_angle``.
         """
-        f = self.transfers[kind]
+        f = self.transfer(kind)
         masses = self.prior.mass(f.basin_lo + first_angle, f.basin_hi + first_angle)
-        if kind == "squeeze":
+        if f is self.states:
             return np.asarray(masses, dtype=np.float64)
         idx = nearest_state(self.states, f.stable)
-        return np.bincount(idx, weights=masses, minlength=self.n_states)
+        return np.bincount(idx, weights=masses, minlength=self.n_states).astype(np.float64)
