@@ -30,12 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..angles import TWO_PI
 from ..errors import BayesGraspError
 from .polygon import ConvexPolygon
 
 __all__ = ["DiameterFunction", "diameter_function"]
 
-TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 

@@ -59,13 +59,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..angles import TWO_PI
 from ..errors import BayesGraspError
 from .polygon import ConvexPolygon, Part
 from .transfer import TransferFunction, detect_period, squeeze_function, transfer_from_extrema
 
 __all__ = ["RadiusFunction", "push_function", "push_grasp_function", "radius_function"]
 
-TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 

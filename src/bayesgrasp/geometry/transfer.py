@@ -22,13 +22,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..angles import TWO_PI
 from ..errors import BayesGraspError
 from .diameter import DiameterFunction, diameter_function
 from .polygon import ConvexPolygon
 
 __all__ = ["TransferFunction", "detect_period", "squeeze_function", "transfer_from_extrema"]
 
-TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..angles import TWO_PI
 from ..errors import PriorError
 
 __all__ = [
@@ -35,7 +36,6 @@ __all__ = [
     "von_mises",
 ]
 
-TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 
 

@@ -26,6 +26,7 @@ computed on first use inside it; callers never prepare anything.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -231,7 +232,9 @@ class Problem:
         states = squeeze_function(d)
         transfers = {SQUEEZE.name: states}
         for a in acts:
-            transfers[a.name] = a.build(part, states)
+            f = a.build(part, states)
+            # A transfer function is named by its action (two actions may move alike).
+            transfers[a.name] = f if f.kind == a.name else dataclasses.replace(f, kind=a.name)
         cost = cost or CostModel()
         cost.check_positive(a.name for a in acts)
         return cls(
