@@ -12,6 +12,7 @@ Examples
 [6.3, 6.0]
 """
 
+from . import shapes
 from .errors import (
     BayesGraspError,
     CostError,
@@ -88,6 +89,7 @@ __all__ = [
     "radius_function",
     "read_part",
     "resolve_part",
+    "shapes",
     "squeeze_function",
     "von_mises",
 ]

@@ -18,6 +18,7 @@ from bayesgrasp.model.actions import (
     get_action,
     parse_actions,
     register_action,
+    unregister_action,
 )
 from bayesgrasp.model.states import nearest_state
 from bayesgrasp.shapes import load
@@ -143,6 +144,7 @@ def test_a_new_action_kind_plans_end_to_end() -> None:
                 atol=1e-12,
             )
     finally:
-        from bayesgrasp.model import actions
-
-        actions._REGISTRY.pop("station-2-squeeze")
+        unregister_action("station-2-squeeze")
+    assert "station-2-squeeze" not in ACTIONS
+    with pytest.raises(PlanningError, match="the built-in action 'squeeze' cannot be removed"):
+        unregister_action("squeeze")

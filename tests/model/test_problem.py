@@ -92,7 +92,9 @@ def test_plans_that_cost_nothing_are_refused() -> None:
     Problem.build(part, cost=CostModel({"squeeze": 0.0}, verify=0.0, retry=1.0))
     Problem.build(part, cost=CostModel({"squeeze": 0.0}, verify=0.0, first={"squeeze": 1.0}))
     # A push-grasp cost does not count for squeeze-only plans.
-    with pytest.raises(CostError, match="`verify`, `retry`, `squeeze` must be positive; got all zero"):
+    with pytest.raises(
+        CostError, match="`verify`, `retry`, `squeeze` must be positive; got all zero"
+    ):
         Problem.build(part, cost=CostModel({"squeeze": 0.0, "push-grasp": 5.0}, verify=0.0))
 
 
@@ -125,7 +127,10 @@ def test_build_defaults_and_actions() -> None:
 
 @pytest.mark.parametrize(
     ("actions", "match"),
-    [((), "at least one action type is needed"), (("poke",), "unknown action 'poke'; expected one of 'squeeze', 'push-grasp'")],
+    [
+        ((), "at least one action type is needed"),
+        (("poke",), "unknown action 'poke'; expected one of 'squeeze', 'push-grasp'"),
+    ],
 )
 def test_build_rejects_bad_actions(actions: tuple[str, ...], match: str) -> None:
     with pytest.raises(PlanningError, match=match):

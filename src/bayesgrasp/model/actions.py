@@ -41,6 +41,7 @@ __all__ = [
     "get_action",
     "parse_actions",
     "register_action",
+    "unregister_action",
 ]
 
 TransferBuilder = Callable[["Part", "TransferFunction"], "TransferFunction"]
@@ -147,6 +148,19 @@ def register_action(action: Action) -> Action:
             )
     _REGISTRY[action.name] = action
     return action
+
+
+def unregister_action(name: str) -> None:
+    """Remove an action kind added with :func:`register_action` (the built-ins stay).
+
+    Raises
+    ------
+    PlanningError
+        If ``name`` is a built-in action.
+    """
+    if name in (SQUEEZE.name, PUSH_GRASP.name):
+        raise PlanningError(f"the built-in action {name!r} cannot be removed")
+    _REGISTRY.pop(name, None)
 
 
 def get_action(name: str | Action) -> Action:

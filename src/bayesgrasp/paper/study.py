@@ -207,7 +207,6 @@ def run_study(
                 t_plan += time.perf_counter() - t0
         res = None
         if with_bfs:
-            problem.classes("squeeze")  # set-up shared with any planner using classes
             t0 = time.perf_counter()
             res = search_bfs(problem, node_limit=limit)
             dt = time.perf_counter() - t0
