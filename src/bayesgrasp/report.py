@@ -1,12 +1,20 @@
-"""Reports: plain dictionaries for ``--json`` and text tables for people.
+"""Reports for people, and the JSON documents of squeezes, pushes and simulations.
 
 Everything here turns library values into output; nothing is computed that the library does
 not already know. JSON angles are radians (``*_rad``); tables show degrees.
+
+- Text tables: :func:`squeeze_table`, :func:`push_table`, :func:`plan_table`,
+  :func:`guaranteed_text`, :func:`simulate_table`.
+- JSON documents: ``bayesgrasp.squeeze/1`` (:func:`squeeze_json`), ``bayesgrasp.push/1``
+  (:func:`push_json`) and ``bayesgrasp.simulate/1`` (:func:`simulate_json`). Plan documents
+  (``bayesgrasp.plan/1`` and ``plan/2``) are written and read by :mod:`bayesgrasp.io.plans`,
+  as is the ``part`` object every document embeds.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -14,8 +22,15 @@ import numpy as np
 from .geometry.polygon import Part
 from .geometry.push import RadiusFunction
 from .geometry.transfer import TransferFunction
+from .io.plans import (
+    guaranteed_document,
+    json_float,
+    option_document,
+    part_document,
+    plan_document,
+)
+from .model.actions import ACTIONS, Action, get_action
 from .model.prior import Prior, UniformPrior
-from .model.problem import Problem
 from .planning.guaranteed import GuaranteedPlan
 from .planning.result import PlanOption, PlanReport
 
@@ -23,10 +38,7 @@ if TYPE_CHECKING:
     from .sim.kinematic import SimulationResult
 
 __all__ = [
-    "guaranteed_json",
     "guaranteed_text",
-    "part_json",
-    "plan_json",
     "plan_table",
     "push_json",
     "push_table",
@@ -37,25 +49,11 @@ __all__ = [
     "transfer_json",
 ]
 
-
-def _f(x: float | None) -> float | None:
-    """A float for JSON (``None`` for missing or non-finite values)."""
-    if x is None or not math.isfinite(x):
-        return None
-    return float(x)
-
-
-def part_json(part: Part) -> dict[str, Any]:
-    """The ``part`` object shared by every schema."""
-    out: dict[str, Any] = {
-        "name": part.name,
-        "vertices": part.hull.vertices.tolist(),
-        "n_sides": part.hull.n_sides,
-        "symmetry_order": part.hull.symmetry_order,
-    }
-    if part.units is not None:
-        out["units"] = part.units
-    return out
+# The plan documents moved to bayesgrasp.io.plans; these names are kept for the transition.
+part_json = part_document
+option_json = option_document
+plan_json = plan_document
+guaranteed_json = guaranteed_document
 
 
 def transfer_json(f: TransferFunction, prior: Prior) -> dict[str, Any]:
@@ -73,7 +71,7 @@ def squeeze_json(part: Part, f: TransferFunction, prior: Prior | None = None) ->
     """The ``bayesgrasp.squeeze/1`` document."""
     return {
         "schema": "bayesgrasp.squeeze/1",
-        "part": part_json(part),
+        "part": part_document(part),
         **transfer_json(f, prior or UniformPrior()),
     }
 
@@ -93,60 +91,14 @@ def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -
     return "\n".join(lines)
 
 
-def option_json(o: PlanOption) -> dict[str, Any]:
-    """One plan option (``bayesgrasp.plan/2`` form, which includes the plan/1 fields)."""
-    return {
-        "squeezes": o.n_actions,
-        "actions_rad": list(o.alphas),
-        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in o.steps],
-        "first_squeeze_rad": o.first_angle,
-        "final_orientation_rad": o.final_orientation,
-        "success_probability": o.success_probability,
-        "expected_cost": _f(o.expected_cost),
-        "tolerance_rad": _f(o.tolerance),
-    }
-
-
-def plan_json(report: PlanReport, schema: str = "bayesgrasp.plan/1") -> dict[str, Any]:
-    """The ``bayesgrasp.plan/1`` document (top-level fields follow the Bayes plan)."""
-    pb: Problem = report.problem
-    bayes = report.bayes_plan
-    out: dict[str, Any] = {
-        "schema": schema,
-        "part": part_json(pb.part),
-        "method": report.method,
-        "stable_orientations_rad": pb.states.stable.tolist(),
-        "stable_probabilities": pb.state_distribution(
-            bayes.first_angle, bayes.steps[0].kind
-        ).tolist(),
-        "period_rad": float(pb.states.period),
-        "first_squeeze_rad": bayes.first_angle,
-        "options": [option_json(o) for o in report.options],
-        "bayes": report.bayes,
-        "most_certain": report.most_certain,
-    }
-    if report.nodes is not None:
-        out["nodes"] = report.nodes
-    if pb.accuracy > 0:
-        out["accuracy_rad"] = pb.accuracy
-    return out
-
-
-def guaranteed_json(g: GuaranteedPlan) -> dict[str, Any]:
-    """The ``"guaranteed"`` option of ``bayesgrasp.plan/2``: an option plus its period."""
-    return {**option_json(g.option), "period_rad": float(g.period)}
-
-
 def guaranteed_text(g: GuaranteedPlan) -> str:
     """One paragraph: the guaranteed plan's steps, period, final orientation and tolerance."""
     o = g.option
-    steps = " ".join(
-        f"{'S' if s.kind == 'squeeze' else 'P'}({math.degrees(s.alpha):+.2f})" for s in o.steps
-    )
+    steps = " ".join(f"{get_action(s.kind).tag}({math.degrees(s.alpha):+.2f})" for s in o.steps)
     tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f} deg"
     return (
         f"guaranteed plan: {o.n_actions} action(s) {steps}\n"
-        "  (S = squeeze, P = push-grasp; the first angle in the world frame, then turns)\n"
+        f"  ({_tags(ACTIONS.values())}; the first angle in the world frame, then turns)\n"
         f"  sends every orientation to {math.degrees(o.final_orientation):.2f} deg modulo "
         f"{math.degrees(g.period):.4g} deg; tolerance {tol}\n"
         f"  for the goal: P(success) {o.success_probability:.4f}, "
@@ -173,7 +125,7 @@ def push_json(
     edges = _stable_edges(radius, push)
     return {
         "schema": "bayesgrasp.push/1",
-        "part": part_json(part),
+        "part": part_document(part),
         "center_of_mass": radius.center_of_mass.tolist(),
         **transfer_json(push, pr),
         "stable_edges": [[e, (e + 1) % n] for e in edges],
@@ -205,14 +157,18 @@ def push_table(
     return "\n".join(lines)
 
 
+def _tags(actions: Iterable[Action]) -> str:
+    """The legend of step tags: ``S = squeeze, P = push-grasp``."""
+    return ", ".join(f"{a.tag} = {a.name}" for a in actions)
+
+
 def _plan_text(o: PlanOption, mixed: bool) -> str:
-    """The relative turns in degrees; with push-grasps each step is tagged S or P."""
+    """The relative turns in degrees; with several action kinds each step is tagged."""
     if not mixed:
         alphas = ", ".join(f"{math.degrees(a):+.2f}" for a in o.alphas)
         return f"[{alphas}]" if alphas else "-"
-    tag = {"squeeze": "S", "push-grasp": "P"}
-    first = tag[o.steps[0].kind]
-    rest = [f"{tag[s.kind]}{math.degrees(s.alpha):+.2f}" for s in o.steps[1:]]
+    first = get_action(o.steps[0].kind).tag
+    rest = [f"{get_action(s.kind).tag}{math.degrees(s.alpha):+.2f}" for s in o.steps[1:]]
     return " ".join([first, *rest])
 
 
@@ -234,7 +190,8 @@ def plan_table(report: PlanReport) -> str:
         "gripper frame",
     ]
     if mixed:
-        lines.append("steps: S = squeeze, P = push-grasp, each after its gripper turn")
+        used = [a for a in ACTIONS.values() if a.name in pb.action_kinds]  # registry order
+        lines.append(f"steps: {_tags(used)}, each after its gripper turn")
     lines.append(
         f"{'k':>3} {'first (deg)':>11}  {head:<{width}} {'final (deg)':>11} "
         f"{'P(success)':>10} {'E[cost]':>8} {'tol (deg)':>9}"
@@ -263,7 +220,8 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
 
     ``observed`` per orientation is the fraction of all trials (jammed trials end in none).
     """
-    plan = {k: (_f(v) if isinstance(v, float) else v) for k, v in option_json(res.option).items()}
+    doc = option_document(res.option)
+    plan = {k: (json_float(v) if isinstance(v, float) else v) for k, v in doc.items()}
     lo, hi = res.ci95
     out: dict[str, Any] = {
         "schema": "bayesgrasp.simulate/1",
@@ -291,7 +249,7 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
         "seconds": res.seconds,
     }
     if part is not None:
-        out["part"] = part_json(part)
+        out["part"] = part_document(part)
     return out
 
 

@@ -1,0 +1,175 @@
+"""The options the commands share, declared once: part, problem and planner.
+
+The problem options are the prior, costs, goal, actions and accuracy; the planner options
+the method and the longest plan. A command takes each group as one value
+(:mod:`.specs`): a parameter ``part: PartSpec`` under :func:`part_options`, ``spec:
+ProblemSpec`` under :func:`problem_options`; the decorator puts the options in the
+command's signature (typer reads it) and builds the value. The cost options come from the
+action registry: ``--NAME-cost`` and ``--first-NAME-cost`` for every action kind registered
+when the command is loaded.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+from collections.abc import Callable
+from typing import Annotated, Any, TypeVar
+
+import typer
+
+from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+PartArg = Annotated[
+    str,
+    typer.Argument(help="Catalogue name or part file (.json, .csv, .wkt, .geojson, .svg, .dxf)."),
+]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON for machines.")]
+PlanChoiceOpt = Annotated[
+    str,
+    typer.Option("--plan", metavar="PLAN", help="bayes | most-certain | guaranteed | FILE.json"),
+]
+
+
+FORMAT_HELP = "Format of the part file (default: from its extension)."
+ELEMENT_HELP = (
+    "Which outline when the file has several: SVG element id, GeoJSON feature name or id, "
+    "or polygon index (GeoJSON, WKT)."
+)
+FLATTEN_HELP = (
+    "Chordal tolerance for flattening curves, in the file's units "
+    "(default: 0.1% of the drawing's diagonal)."
+)
+PRIOR_HELP = (
+    "Prior on the initial orientation: uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE "
+    "(bin weights over [0, 360) deg) | sample:FILE (observed angles, deg)."
+)
+PriorOpt = Annotated[str, typer.Option(help=PRIOR_HELP)]
+GOAL_HELP = "single: one final orientation; symmetry: up to symmetry."
+ACTIONS_HELP = (
+    "Action types a plan may use, comma-separated: {} (the pushing jaw is on the gripper's "
+    "-x side)."
+)
+ACCURACY_HELP = (
+    "Gripper accuracy: each turn between actions may err by up to DEG degrees; only plans "
+    "whose tolerance is at least DEG are returned (exact planner)."
+)
+
+
+def command_app() -> typer.Typer:
+    """The typer app of one command module (settings as the main app's)."""
+    return typer.Typer(add_completion=False, pretty_exceptions_enable=False, rich_markup_mode=None)
+
+
+def _opt(name: str, kind: Any, default: Any, *decls: str, **info: Any) -> inspect.Parameter:
+    """A keyword-only parameter ``name: Annotated[kind, typer.Option(*decls, **info)]``."""
+    hint = Annotated[kind, typer.Option(*decls, **info)]
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=hint)
+
+
+def _part_params() -> list[inspect.Parameter]:
+    part = inspect.Parameter("part", inspect.Parameter.KEYWORD_ONLY, annotation=PartArg)
+    return [
+        part,
+        _opt("fmt", PartFormat | None, None, "--format", help=FORMAT_HELP),
+        _opt("element", str | None, None, metavar="ID", help=ELEMENT_HELP),
+        _opt("layer", str | None, None, help="DXF: read only this layer."),
+        _opt("flatten_tol", float | None, None, help=FLATTEN_HELP),
+    ]
+
+
+def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Parameter]:
+    cost = [
+        _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", min=0, help=f"Cost of a {n}.")
+        for i, n in enumerate(names)
+    ]
+    first_help = "Cost of the first {} (default: as others)."
+    first = [
+        _opt(
+            f"first_{i}", float | None, None, f"--first-{n}-cost", min=0, help=first_help.format(n)
+        )
+        for i, n in enumerate(names)
+    ]
+    kinds = ACTIONS_HELP.format(", ".join(names))
+    params = [
+        inspect.Parameter(
+            "prior", inspect.Parameter.KEYWORD_ONLY, default="uniform", annotation=PriorOpt
+        ),
+        cost[0],
+        _opt("verify_cost", float, 1.0, min=0, help="Cost of the verification."),
+        *first,
+        _opt("retry_cost", float, 0.0, min=0, help="Overhead paid on each failed verification."),
+        *cost[1:],
+        _opt("goal", GoalKind, GoalKind.single, help=GOAL_HELP),
+        _opt("actions", str, "squeeze", metavar="KINDS", help=kinds),
+        _opt("accuracy", float, 0.0, min=0, metavar="DEG", help=ACCURACY_HELP),
+        _opt("method", Method, Method.exact, help="exact planner or the seed's search."),
+        _opt("max_squeezes", int | None, None, min=1, help="Longest plan to consider."),
+    ]
+    if push_grasp_alias:  # the old spelling of simulate and plot, kept working
+        alias = "Same as --actions squeeze,push-grasp."
+        params.append(_opt("push_grasp", bool, False, "--push-grasp", hidden=True, help=alias))
+    return params
+
+
+def _problem_spec(names: list[str], values: dict[str, Any]) -> ProblemSpec:
+    from ..model.actions import PUSH_GRASP, SQUEEZE
+
+    actions = [a.strip() for a in values["actions"].split(",") if a.strip()]
+    if values.get("push_grasp"):  # exactly --actions squeeze,push-grasp (order breaks ties)
+        actions = [SQUEEZE.name, PUSH_GRASP.name, *actions]
+    first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
+    return ProblemSpec(
+        prior=values["prior"],
+        costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
+        first={n: c for n, c in first.items() if c is not None},
+        verify=values["verify_cost"],
+        retry=values["retry_cost"],
+        goal=values["goal"],
+        actions=tuple(dict.fromkeys(actions)),
+        accuracy_deg=values["accuracy"],
+        method=values["method"],
+        max_actions=values["max_squeezes"],
+    )
+
+
+def _replace(func: F, name: str, params: list[inspect.Parameter], make: Callable[..., Any]) -> F:
+    """``func`` with its parameter ``name`` replaced by ``params``, whose values ``make`` joins."""
+    sig = inspect.signature(func, eval_str=True)
+    new: list[inspect.Parameter] = []
+    for p in sig.parameters.values():  # keyword-only: typer passes every value by name
+        new += params if p.name == name else [p.replace(kind=inspect.Parameter.KEYWORD_ONLY)]
+    own = [p.name for p in params]
+
+    @functools.wraps(func)
+    def command(**kwargs: Any) -> Any:
+        values = {k: kwargs.pop(k) for k in own}
+        return func(**kwargs, **{name: make(values)})
+
+    command.__signature__ = sig.replace(parameters=new)  # type: ignore[attr-defined]
+    command.__annotations__ = {p.name: p.annotation for p in new}
+    command.__annotations__["return"] = sig.return_annotation
+    return command  # type: ignore[return-value]
+
+
+def part_options(func: F) -> F:
+    """Give a command PART and the part-file options, as its parameter ``part: PartSpec``."""
+    return _replace(func, "part", _part_params(), lambda values: PartSpec(**values))
+
+
+def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:
+    """Give a command the problem and planner options, as its parameter ``spec: ProblemSpec``.
+
+    ``push_grasp_alias`` adds the hidden ``--push-grasp`` (``--actions squeeze,push-grasp``).
+    """
+
+    def decorate(func: F) -> F:
+        from ..model.actions import ACTIONS
+
+        names = list(ACTIONS)  # the kinds registered now: one cost option each
+        params = _problem_params(names, push_grasp_alias)
+        return _replace(func, "spec", params, functools.partial(_problem_spec, names))
+
+    return decorate

@@ -1,0 +1,69 @@
+"""``plot``: figures of a part and a plan, and the plan's animation."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .common import IMAGE_FORMATS, chosen_plan, emit_json
+from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .specs import PartSpec, ProblemSpec
+
+app = command_app()
+
+OutOpt = Annotated[
+    Path, typer.Option("--out", metavar="DIR", help="Folder for the figures (created).")
+]
+FormatsOpt = Annotated[str, typer.Option("--image-formats", help="Comma-separated: png, svg, pdf.")]
+AnimationOpt = Annotated[
+    bool,
+    typer.Option("--animation/--no-animation", help="Also write the plan's animation (plan.gif)."),
+]
+FramesOpt = Annotated[int, typer.Option(min=4, max=240, help="Animation frames per plan step.")]
+
+
+@app.command()
+@part_options
+@problem_options(push_grasp_alias=True)
+def plot(
+    part: PartSpec,
+    spec: ProblemSpec,
+    out: OutOpt = Path("figures"),
+    which: PlanChoiceOpt = "bayes",
+    image_formats: FormatsOpt = "png,svg",
+    animation: AnimationOpt = True,
+    frames: FramesOpt = 20,
+    as_json: JsonOpt = False,
+) -> None:
+    """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif."""
+    from ..figures.plots import write_figures
+    from ..model.actions import PUSH_GRASP
+
+    formats = [f.strip().lower() for f in image_formats.split(",") if f.strip()]
+    if not formats or any(f not in IMAGE_FORMATS for f in formats):
+        raise typer.BadParameter(
+            f"expected a comma-separated list of png, svg, pdf; got {image_formats!r}",
+            param_hint="--image-formats",
+        )
+    pb, option, label = chosen_plan(which, spec, part.load())
+    try:
+        files = write_figures(
+            pb,
+            option,
+            out,
+            label=label,
+            formats=formats,
+            push_grasp=PUSH_GRASP.name in pb.action_kinds,
+            animation=animation,
+            frames_per_step=frames,
+        )
+    except OSError as exc:
+        reason = exc.strerror or exc
+        raise typer.BadParameter(f"cannot write into {out}: {reason}", param_hint="--out") from None
+    if as_json:
+        emit_json({"schema": "bayesgrasp.plot/1", "files": [str(f) for f in files]})
+    else:
+        for f in files:
+            typer.echo(str(f))
