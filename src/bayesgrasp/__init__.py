@@ -12,7 +12,9 @@ Examples
 [6.3, 6.0]
 """
 
-from . import shapes
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .errors import (
     BayesGraspError,
     CostError,
@@ -23,33 +25,93 @@ from .errors import (
     PlanningError,
     PriorError,
 )
-from .geometry.diameter import DiameterFunction, diameter_function
-from .geometry.polygon import ConvexPolygon, Part
-from .geometry.push import RadiusFunction, push_function, push_grasp_function, radius_function
-from .geometry.transfer import TransferFunction, squeeze_function
-from .io import read_part, resolve_part
-from .model.prior import (
-    DensityPrior,
-    HistogramPrior,
-    Prior,
-    SamplePrior,
-    UniformPrior,
-    parse_prior,
-    von_mises,
-)
-from .model.problem import CostModel, Goal, Problem
-from .planning import (
-    GuaranteedPlan,
-    PlanOption,
-    PlanReport,
-    PlanStep,
-    execute_plan,
-    plan_exact,
-    plan_guaranteed,
-)
-from .tolerance import DEFAULT_TOLERANCE, Tolerance
+
+if TYPE_CHECKING:  # pragma: no cover
+    from . import shapes
+    from .geometry.diameter import DiameterFunction, diameter_function
+    from .geometry.polygon import ConvexPolygon, Part
+    from .geometry.push import RadiusFunction, push_function, push_grasp_function, radius_function
+    from .geometry.transfer import TransferFunction, squeeze_function
+    from .io import read_part, resolve_part
+    from .model.prior import (
+        DensityPrior,
+        HistogramPrior,
+        Prior,
+        SamplePrior,
+        UniformPrior,
+        parse_prior,
+        von_mises,
+    )
+    from .model.problem import CostModel, Goal, Problem
+    from .planning import (
+        GuaranteedPlan,
+        PlanOption,
+        PlanReport,
+        PlanStep,
+        execute_plan,
+        plan_exact,
+        plan_guaranteed,
+    )
+    from .tolerance import DEFAULT_TOLERANCE, Tolerance
+
 
 __version__ = "0.1.0"
+
+# Names are imported on first use: ``bayesgrasp --help`` and light scripts do not pay for
+# numpy and every layer up front.
+_LAZY = {
+    "ConvexPolygon": "geometry.polygon",
+    "CostModel": "model.problem",
+    "DEFAULT_TOLERANCE": "tolerance",
+    "DensityPrior": "model.prior",
+    "DiameterFunction": "geometry.diameter",
+    "Goal": "model.problem",
+    "GuaranteedPlan": "planning",
+    "HistogramPrior": "model.prior",
+    "Part": "geometry.polygon",
+    "PlanOption": "planning",
+    "PlanReport": "planning",
+    "PlanStep": "planning",
+    "Prior": "model.prior",
+    "Problem": "model.problem",
+    "RadiusFunction": "geometry.push",
+    "SamplePrior": "model.prior",
+    "Tolerance": "tolerance",
+    "TransferFunction": "geometry.transfer",
+    "UniformPrior": "model.prior",
+    "diameter_function": "geometry.diameter",
+    "execute_plan": "planning",
+    "parse_prior": "model.prior",
+    "plan_exact": "planning",
+    "plan_guaranteed": "planning",
+    "push_function": "geometry.push",
+    "push_grasp_function": "geometry.push",
+    "radius_function": "geometry.push",
+    "read_part": "io",
+    "resolve_part": "io",
+    "squeeze_function": "geometry.transfer",
+    "von_mises": "model.prior",
+    "shapes": "",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first use (PEP 562)."""
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'bayesgrasp' has no attribute {name!r}")
+    if module == "":
+        value = importlib.import_module(f".{name}", __name__)
+    else:
+        value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The public names."""
+    return sorted(__all__)
+
 
 __all__ = [
     "DEFAULT_TOLERANCE",

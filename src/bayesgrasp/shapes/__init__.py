@@ -24,11 +24,12 @@ import json
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ..errors import PartError
-from ..geometry.polygon import Part, as_points, polygon_area_centroid
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..geometry.polygon import Part
 
 __all__ = ["CatalogueEntry", "describe", "entry", "load", "names"]
 
@@ -71,6 +72,8 @@ def _parse(filename: str, text: str) -> CatalogueEntry:
             f"catalogue file {filename!r} must be an object with keys {', '.join(_KEYS)}; "
             f"got {sorted(data) if isinstance(data, dict) else type(data).__name__}"
         )
+    from ..geometry.polygon import as_points
+
     pts = as_points(data["vertices"], f"vertices of catalogue part {data['name']!r}")
     return CatalogueEntry(
         str(data["name"]),
@@ -103,7 +106,25 @@ def names() -> list[str]:
     >>> names()[:3]
     ['triangle', 'rectangle', 'ic-chip']
     """
-    return list(_entries())
+    return list(_index())
+
+
+@cache
+def _index() -> dict[str, int]:
+    """Name and Table-1 position of each data file, read without validating the outlines.
+
+    ``--help`` lists the names: this keeps numpy out of it (a broken file is still reported
+    by :func:`entry` and :func:`load`).
+    """
+    out: dict[str, int] = {}
+    for item in resources.files(__package__).iterdir():
+        if item.name.endswith(".json"):
+            try:
+                data = json.loads(item.read_text(encoding="utf-8"))
+                out[str(data["name"])] = int(data["order"])
+            except (ValueError, KeyError, TypeError):
+                out[item.name.removesuffix(".json")] = 10**9
+    return dict(sorted(out.items(), key=lambda kv: (kv[1], kv[0])))
 
 
 def entry(name: str) -> CatalogueEntry:
@@ -191,6 +212,10 @@ def load(name: str) -> Part:
     True
     """
     e = entry(name)
+    import numpy as np
+
+    from ..geometry.polygon import Part, polygon_area_centroid
+
     outline = np.array(e.vertices, dtype=np.float64)
     _, com = polygon_area_centroid(outline)
     return Part.from_points(outline, name=e.name, center_of_mass=com, units=e.units)
