@@ -1,0 +1,234 @@
+"""An HTML report of a sweep's results: one self-contained file (figures inline).
+
+Sections: the run (options, versions), a summary table (parts, planned, no guaranteed
+plan, errors by class, Bayes cost and plan length statistics), histograms of the Bayes
+plan's expected cost and of its length, predicted against observed success in simulation
+(with each part's 95% interval), the parts where physics disagrees with the model (the
+predicted success outside the observed 95% interval), each with its outline drawn, and the
+parts that failed, with their messages.
+
+Figures are drawn with matplotlib (extra ``plot``) as inline SVG.
+"""
+
+from __future__ import annotations
+
+import html
+import io
+import json
+import math
+import statistics
+from collections import Counter
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from ..errors import MissingExtraError
+from .results import read_metadata, read_results
+
+__all__ = ["disagreements", "report_html", "write_report"]
+
+
+def _pyplot() -> Any:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise MissingExtraError("matplotlib", "plot") from None
+    return plt
+
+
+def _svg(fig: Any) -> str:
+    """A figure as inline SVG (closed afterwards)."""
+    plt = _pyplot()
+    buf = io.StringIO()
+    fig.savefig(buf, format="svg", bbox_inches="tight")
+    plt.close(fig)
+    text = buf.getvalue()
+    return text[text.index("<svg") :]
+
+
+def _histogram(values: Sequence[float], xlabel: str, integer: bool = False) -> str:
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5, 3))
+    if integer:
+        lo, hi = min(values), max(values)
+        ax.hist(values, bins=[v - 0.5 for v in range(int(lo), int(hi) + 2)], rwidth=0.8)
+        ax.set_xticks(range(int(lo), int(hi) + 1))
+    else:
+        ax.hist(values, bins=min(40, max(5, len(values) // 5)))
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("parts")
+    return _svg(fig)
+
+
+def _scatter(rows: Sequence[dict[str, Any]]) -> str:
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(4.5, 4.5))
+    x = [r["sim_predicted"] for r in rows]
+    y = [r["sim_observed"] for r in rows]
+    lo = [r["sim_observed"] - r["sim_ci_low"] for r in rows]
+    hi = [r["sim_ci_high"] - r["sim_observed"] for r in rows]
+    bad = {id(r) for r in disagreements(rows)}
+    colors = ["tab:red" if id(r) in bad else "tab:blue" for r in rows]
+    ax.errorbar(x, y, yerr=[lo, hi], fmt="none", ecolor="0.7", lw=0.8)
+    ax.scatter(x, y, c=colors, s=12, zorder=3)
+    ax.plot([0, 1], [0, 1], "k--", lw=0.8)
+    ax.set(xlim=(0, 1), ylim=(0, 1), xlabel="predicted success", ylabel="observed success")
+    ax.set_aspect("equal")
+    return _svg(fig)
+
+
+def _outline(row: dict[str, Any]) -> str:
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(2, 2))
+    pts = json.loads(row["outline"]) if row.get("outline") else []
+    if pts:
+        xs, ys = zip(*[*pts, pts[0]], strict=True)
+        ax.fill(xs, ys, color="0.85", ec="k", lw=1)
+    ax.set_aspect("equal")
+    ax.axis("off")
+    return _svg(fig)
+
+
+def disagreements(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Simulated parts whose predicted success is outside the observed 95% interval.
+
+    The largest gap first.
+
+    Examples
+    --------
+    >>> rows = [{"sim_predicted": 0.5, "sim_observed": 0.3, "sim_ci_low": 0.25,
+    ...          "sim_ci_high": 0.35}, {"sim_predicted": 0.5, "sim_observed": 0.49,
+    ...          "sim_ci_low": 0.45, "sim_ci_high": 0.53}]
+    >>> len(disagreements(rows))
+    1
+    """
+    out = [
+        r
+        for r in rows
+        if r.get("sim_observed") is not None
+        and not r["sim_ci_low"] <= r["sim_predicted"] <= r["sim_ci_high"]
+    ]
+    return sorted(out, key=lambda r: -abs(r["sim_predicted"] - r["sim_observed"]))
+
+
+def _table(head: Sequence[str], body: Sequence[Sequence[Any]]) -> str:
+    cells = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
+    lines = [f"<table><tr>{cells}</tr>"]
+    for row in body:
+        tds = "".join(
+            f"<td>{c}</td>" if str(c).startswith("<svg") else f"<td>{html.escape(str(c))}</td>"
+            for c in row
+        )
+        lines.append(f"<tr>{tds}</tr>")
+    return "\n".join([*lines, "</table>"])
+
+
+def _num(x: float | None, digits: int = 4) -> str:
+    return "-" if x is None or not math.isfinite(x) else f"{x:.{digits}g}"
+
+
+def report_html(
+    rows: Sequence[dict[str, Any]], metadata: Sequence[dict[str, Any]] = (), *, limit: int = 50
+) -> str:
+    """The report of a results table, as one HTML document.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Rows as :func:`~bayesgrasp.sweep.results.read_results` gives them.
+    metadata : sequence of dict
+        The runs' metadata (:func:`~bayesgrasp.sweep.results.read_metadata`).
+    limit : int
+        Most parts listed (and drawn) among those where physics disagrees, and errors.
+    """
+    planned = [r for r in rows if r["status"] in ("ok", "no-plan")]
+    failed = [r for r in rows if r["status"] == "error"]
+    costs = [r["bayes_cost"] for r in planned if r["bayes_cost"] is not None]
+    lengths = [r["bayes_actions"] for r in planned if r["bayes_actions"] is not None]
+    sims = [r for r in planned if r.get("sim_observed") is not None]
+    parts: list[str] = [
+        "<!DOCTYPE html><html><head><meta charset='utf-8'><title>bayesgrasp sweep</title>",
+        "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}"
+        "td,th{border:1px solid #ccc;padding:2px 8px;text-align:left}</style></head><body>",
+        "<h1>bayesgrasp sweep</h1>",
+    ]
+    if metadata:
+        last = metadata[-1]
+        parts.append(
+            f"<p>bayesgrasp {html.escape(str(last.get('bayesgrasp_version')))}, "
+            f"{len(metadata)} run(s), last started {html.escape(str(last.get('started')))}; "
+            f"options <code>{html.escape(json.dumps(last.get('options')))}</code></p>"
+        )
+    summary: list[tuple[str, Any]] = [
+        ("parts", len(rows)),
+        ("planned", len(planned)),
+        ("no guaranteed plan", sum(r["status"] == "no-plan" for r in rows)),
+        ("errors", len(failed)),
+    ]
+    summary += [
+        (f"errors: {k}", v) for k, v in Counter(r["error_class"] for r in failed).most_common()
+    ]
+    if costs:
+        summary += [
+            ("Bayes cost: mean", _num(statistics.fmean(costs))),
+            ("Bayes cost: median", _num(statistics.median(costs))),
+            ("Bayes cost: max", _num(max(costs))),
+            ("Bayes plan length: mean", _num(statistics.fmean(lengths), 3)),
+        ]
+    if sims:
+        summary += [
+            ("simulated parts", len(sims)),
+            (
+                "physics disagrees (predicted outside the observed 95% interval)",
+                len(disagreements(sims)),
+            ),
+        ]
+    parts += ["<h2>Summary</h2>", _table(["", ""], summary)]
+    if costs:
+        parts += [
+            "<h2>Bayes plans</h2>",
+            _histogram(costs, "expected cost of the Bayes plan"),
+            _histogram(lengths, "actions in the Bayes plan", integer=True),
+        ]
+    if sims:
+        parts += ["<h2>Predicted against observed success</h2>", _scatter(sims)]
+        bad = disagreements(sims)[:limit]
+        if bad:
+            parts.append("<h2>Parts where physics disagrees with the model</h2>")
+            parts.append(
+                _table(
+                    ["part", "outline", "predicted", "observed", "95% interval", "jams"],
+                    [
+                        (
+                            r["path"],
+                            _outline(r),
+                            _num(r["sim_predicted"]),
+                            _num(r["sim_observed"]),
+                            f"[{_num(r['sim_ci_low'])}, {_num(r['sim_ci_high'])}]",
+                            r["sim_jams"],
+                        )
+                        for r in bad
+                    ],
+                )
+            )
+    if failed:
+        parts += [
+            "<h2>Parts that failed</h2>",
+            _table(
+                ["part", "error", "message"],
+                [(r["path"], r["error_class"], r["error_message"]) for r in failed[:limit]],
+            ),
+        ]
+    parts.append("</body></html>")
+    return "\n".join(parts)
+
+
+def write_report(results: str | Path, out: str | Path, *, limit: int = 50) -> Path:
+    """Write the HTML report of a results file (Parquet folder or CSV); returns ``out``."""
+    path = Path(out)
+    text = report_html(read_results(results), read_metadata(results), limit=limit)
+    path.write_text(text, encoding="utf-8")
+    return path

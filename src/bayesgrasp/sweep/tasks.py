@@ -1,0 +1,642 @@
+"""The work of one part, as a worker runs it: read, plan, optionally simulate, one row.
+
+Nothing here imports Dask: a task is a plain function of plain values (a
+:class:`PartSource` holds a path, or a path and the file's bytes; :class:`SweepOptions`
+holds the planning options), so it runs the same in a Dask worker, a process pool or a
+test. A part that cannot be read or planned is a row with its error class and message,
+never an exception: one bad file must not stop a sweep of a catalogue.
+
+The row's ``plan_json`` is the document ``bayesgrasp plan PATH --json`` prints with the
+same options (:meth:`SweepOptions.plan_args` gives those options as command-line
+arguments), and its error message is the one the command prints after
+``bayesgrasp: error:``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import socket
+import tempfile
+import threading
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Literal, cast
+
+from ..errors import BayesGraspError, NoPlanError
+from ..model.prior import Prior, parse_prior
+
+__all__ = [
+    "ENGINES",
+    "GOALS",
+    "METHODS",
+    "ROW_COLUMNS",
+    "ChunkResult",
+    "PartSource",
+    "SweepError",
+    "SweepOptions",
+    "error_rows",
+    "part_id",
+    "plan_part",
+    "run_chunk",
+    "timeout_row",
+]
+
+#: Planners a sweep may use (the ``plan`` command's ``--method``).
+METHODS = ("exact", "bfs")
+#: Goals (the ``plan`` command's ``--goal``).
+GOALS = ("single", "symmetry")
+#: Execution checks of each part's Bayes plan (the ``simulate`` command's ``--engine``).
+ENGINES = ("kinematic", "mujoco")
+#: Default trials of each engine (as ``bayesgrasp simulate``).
+DEFAULT_TRIALS = {"kinematic": 1_000_000, "mujoco": 200}
+
+
+class SweepError(BayesGraspError, ValueError):
+    """Bad sweep settings, or a results file that cannot be written or resumed."""
+
+
+def _number(name: str, value: float | None, *, optional: bool = False) -> None:
+    """Refuse a negative or non-finite option (``None`` allowed when ``optional``)."""
+    if value is None and optional:
+        return
+    if not isinstance(value, int | float) or not math.isfinite(value) or value < 0:
+        raise SweepError(f"`{name}` must be a finite number >= 0; got {value!r}")
+
+
+@dataclass(frozen=True, slots=True)
+class SweepOptions:
+    """The options applied to every part of a sweep (those of ``plan`` and ``simulate``).
+
+    Parameters
+    ----------
+    prior : str
+        Prior on the initial orientation, as ``--prior`` (``uniform``,
+        ``vonmises:MEAN_DEG,KAPPA``, ``histogram:FILE``, ``sample:FILE``).
+    squeeze_cost, push_grasp_cost, verify_cost, retry_cost : float
+        Costs of a squeeze, a push-grasp, the verification and a failed verification.
+    first_squeeze_cost, first_push_grasp_cost : float, optional
+        Cost of a squeeze or push-grasp that is the first action (default: as the others).
+    goal : {"single", "symmetry"}
+    actions : tuple of str
+        Action names a plan may use (``("squeeze",)`` or ``("squeeze", "push-grasp")``).
+    accuracy_deg : float
+        Gripper accuracy in degrees (``--accuracy``).
+    method : {"exact", "bfs"}
+    max_actions : int, optional
+        Longest plan to consider (``--max-squeezes``).
+    guaranteed : bool
+        Also plan the shortest guaranteed plan (``--guaranteed``); on by default, since a
+        row reports its length.
+    simulate : {"kinematic", "mujoco"}, optional
+        Execute each part's Bayes plan ``trials`` times with this engine.
+    trials : int, optional
+        Default: 1,000,000 kinematic, 200 mujoco (as ``bayesgrasp simulate``).
+    seed : int
+        Seed of every part's simulation (each part uses the same seed, so its row equals
+        ``bayesgrasp simulate PART --seed SEED``, whatever worker runs it and when).
+    noise_deg : float
+        Gripper angle error (standard deviation or bound), degrees.
+    noise_kind : {"normal", "uniform"}
+    offset_mm : float
+        MuJoCo: the part's centre off the gripper centre along the squeeze axis (mm).
+    layer : str, optional
+        DXF: read only this layer.
+    flatten_tol : float, optional
+        Chordal tolerance of curve flattening, in each file's units.
+
+    Examples
+    --------
+    >>> o = SweepOptions(actions=("squeeze", "push-grasp"), accuracy_deg=1.0)
+    >>> o.plan_args()
+    ['--json', '--actions', 'squeeze,push-grasp', '--accuracy', '1.0', '--guaranteed']
+    >>> len(o.key)
+    16
+    """
+
+    prior: str = "uniform"
+    squeeze_cost: float = 1.0
+    push_grasp_cost: float = 1.0
+    verify_cost: float = 1.0
+    first_squeeze_cost: float | None = None
+    first_push_grasp_cost: float | None = None
+    retry_cost: float = 0.0
+    goal: str = "single"
+    actions: tuple[str, ...] = ("squeeze",)
+    accuracy_deg: float = 0.0
+    method: str = "exact"
+    max_actions: int | None = None
+    guaranteed: bool = True
+    simulate: str | None = None
+    trials: int | None = None
+    seed: int = 0
+    noise_deg: float = 0.0
+    noise_kind: str = "normal"
+    offset_mm: float = 0.0
+    layer: str | None = None
+    flatten_tol: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("squeeze_cost", "push_grasp_cost", "verify_cost", "retry_cost"):
+            _number(name, getattr(self, name))
+        _number("first_squeeze_cost", self.first_squeeze_cost, optional=True)
+        _number("first_push_grasp_cost", self.first_push_grasp_cost, optional=True)
+        _number("accuracy_deg", self.accuracy_deg)
+        _number("noise_deg", self.noise_deg)
+        _number("offset_mm", self.offset_mm)
+        _number("flatten_tol", self.flatten_tol, optional=True)
+        if self.goal not in GOALS:
+            raise SweepError(f"`goal` must be one of {', '.join(GOALS)}; got {self.goal!r}")
+        if self.method not in METHODS:
+            raise SweepError(f"`method` must be one of {', '.join(METHODS)}; got {self.method!r}")
+        if isinstance(self.actions, str) or not self.actions:
+            raise SweepError(
+                f"`actions` must be a non-empty tuple of action names; got {self.actions!r}"
+            )
+        from ..model.actions import parse_actions
+
+        parse_actions(self.actions)  # unknown names: PlanningError naming the known ones
+        if self.simulate is not None and self.simulate not in ENGINES:
+            raise SweepError(
+                f"`simulate` must be None or one of {', '.join(ENGINES)}; got {self.simulate!r}"
+            )
+        if self.noise_kind not in ("normal", "uniform"):
+            raise SweepError(f"`noise_kind` must be 'normal' or 'uniform'; got {self.noise_kind!r}")
+        for name in ("max_actions", "trials"):
+            v = getattr(self, name)
+            if v is not None and (not isinstance(v, int) or isinstance(v, bool) or v < 1):
+                raise SweepError(f"`{name}` must be None or an integer >= 1; got {v!r}")
+        if self.offset_mm > 0 and self.simulate != "mujoco":
+            raise SweepError("`offset_mm` applies to simulate='mujoco' only")
+
+    @property
+    def n_trials(self) -> int:
+        """Trials of the simulation (0 without one)."""
+        if self.simulate is None:
+            return 0
+        return self.trials or DEFAULT_TRIALS[self.simulate]
+
+    def to_json(self) -> dict[str, Any]:
+        """The options as a JSON object (recorded in the results' metadata)."""
+        out = asdict(self)
+        out["actions"] = list(self.actions)
+        return out
+
+    @classmethod
+    def from_json(cls, doc: dict[str, Any]) -> SweepOptions:
+        """Options from :meth:`to_json`."""
+        known = {k: v for k, v in doc.items() if k in cls.__dataclass_fields__}
+        if "actions" in known:
+            known["actions"] = tuple(known["actions"])
+        return cls(**known)
+
+    @property
+    def key(self) -> str:
+        """16 hex digits identifying the options (rows of other options are not resumed)."""
+        text = json.dumps(self.to_json(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def plan_args(self) -> list[str]:
+        """The ``bayesgrasp plan PART`` arguments that give the same plan document."""
+        args = ["--json"]
+        if self.prior != "uniform":
+            args += ["--prior", self.prior]
+        defaults = SweepOptions()
+        flags = (
+            ("squeeze_cost", "--squeeze-cost"),
+            ("verify_cost", "--verify-cost"),
+            ("first_squeeze_cost", "--first-squeeze-cost"),
+            ("first_push_grasp_cost", "--first-push-grasp-cost"),
+            ("retry_cost", "--retry-cost"),
+            ("push_grasp_cost", "--push-grasp-cost"),
+            ("goal", "--goal"),
+            ("method", "--method"),
+            ("max_actions", "--max-squeezes"),
+            ("layer", "--layer"),
+            ("flatten_tol", "--flatten-tol"),
+        )
+        for name, flag in flags:
+            v = getattr(self, name)
+            if v != getattr(defaults, name):
+                args += [flag, str(v)]
+        if self.actions != defaults.actions:
+            args += ["--actions", ",".join(self.actions)]
+        if self.accuracy_deg:
+            args += ["--accuracy", str(self.accuracy_deg)]
+        if self.guaranteed:
+            args.append("--guaranteed")
+        return args
+
+
+@dataclass(frozen=True, slots=True)
+class PartSource:
+    """One part file as the client sends it: its path, and its bytes or not.
+
+    Attributes
+    ----------
+    path : str
+        The path as the sweep found it (relative paths are relative to the client's working
+        directory); the row's ``path`` and the name in error messages.
+    sha256 : str
+        Hex digest of the bytes the client hashed (``""`` when it could not read them).
+    data : bytes, optional
+        The file's bytes (for workers that do not share the client's file system); without
+        them the worker reads ``path``.
+    """
+
+    path: str
+    sha256: str = ""
+    data: bytes | None = field(default=None, repr=False)
+
+    @property
+    def size(self) -> int:
+        """Bytes sent (0 for a path)."""
+        return 0 if self.data is None else len(self.data)
+
+
+def part_id(path: str, sha256: str) -> str:
+    """The stable id of a part: its path and the first 16 hex digits of its hash.
+
+    Examples
+    --------
+    >>> part_id("parts/a.json", "0123456789abcdef0123")
+    'parts/a.json#0123456789abcdef'
+    """
+    return f"{path}#{sha256[:16]}"
+
+
+#: The columns of a row, in order, with their types (``str``, ``int``, ``float``, ``bool``);
+#: every column may be missing (``None``), as for a part that failed.
+ROW_COLUMNS: tuple[tuple[str, type], ...] = (
+    ("part_id", str),
+    ("path", str),
+    ("sha256", str),
+    ("options_key", str),
+    ("status", str),  # ok | no-plan (no guaranteed plan: `plan` exits 1) | error
+    ("error_class", str),
+    ("error_message", str),
+    ("name", str),
+    ("units", str),
+    ("sides", int),
+    ("symmetry_order", int),
+    ("states", int),
+    ("period_rad", float),
+    ("method", str),
+    ("plans", int),
+    ("bayes_actions", int),
+    ("bayes_cost", float),
+    ("bayes_probability", float),
+    ("bayes_tolerance_rad", float),
+    ("bayes_first_rad", float),
+    ("bayes_final_rad", float),
+    ("bayes_steps", str),  # JSON: [{"type": ..., "alpha_rad": ...}, ...]
+    ("most_certain_actions", int),
+    ("most_certain_probability", float),
+    ("guaranteed_actions", int),
+    ("guaranteed_missing", str),
+    ("sim_engine", str),
+    ("sim_trials", int),
+    ("sim_predicted", float),
+    ("sim_observed", float),
+    ("sim_ci_low", float),
+    ("sim_ci_high", float),
+    ("sim_p_value", float),
+    ("sim_jams", int),
+    ("sim_seconds", float),
+    ("plan_seconds", float),
+    ("outline", str),  # JSON: the outline's points (for the report's drawings)
+    ("plan_json", str),  # the document `bayesgrasp plan PATH --json` prints
+    ("sim_json", str),  # the document `bayesgrasp simulate PATH --json` prints
+    ("worker", str),
+)
+
+#: Most outline points a row keeps for drawing (evenly spaced beyond that).
+MAX_OUTLINE_POINTS = 2000
+
+
+def _empty_row(path: str, sha256: str, options: SweepOptions) -> dict[str, Any]:
+    row: dict[str, Any] = dict.fromkeys(name for name, _ in ROW_COLUMNS)
+    row.update(
+        part_id=part_id(path, sha256),
+        path=path,
+        sha256=sha256 or None,  # None: the bytes could not be read
+        options_key=options.key,
+        worker=f"{socket.gethostname()}:{os.getpid()}",
+    )
+    return row
+
+
+def _error(row: dict[str, Any], exc: BaseException) -> dict[str, Any]:
+    """Fill the error columns: the class and the message the CLI prints, on one line."""
+    row["status"] = "error"
+    row["error_class"] = type(exc).__name__
+    text = " ".join(str(exc).split("\n")).strip() or repr(exc)
+    row["error_message"] = text
+    return row
+
+
+def _read_bytes_part(path: str, data: bytes, options: SweepOptions) -> Any:
+    """Read a part from its bytes, with the messages reading ``path`` would give.
+
+    The bytes are written under the file's own name in a private folder and read there, so
+    the part's name and the reader are those of the file; messages naming the temporary
+    path are given back with ``path`` in its place.
+    """
+    from ..io import read_part
+
+    with tempfile.TemporaryDirectory(prefix="bayesgrasp-sweep-") as tmp:
+        local = Path(tmp) / (Path(path).name or "part")
+        local.write_bytes(data)
+        try:
+            return read_part(local, layer=options.layer, tolerance=options.flatten_tol)
+        except BayesGraspError as exc:
+            text = str(exc).replace(str(local), path)
+            if text == str(exc):
+                raise
+            err = type(exc).__new__(type(exc))
+            Exception.__init__(err, text)
+            raise err from None
+
+
+def _read_part(source: PartSource, options: SweepOptions) -> tuple[Any, str]:
+    """The part and the hash of the bytes it was read from."""
+    from ..io import resolve_part
+
+    if source.data is not None:
+        return _read_bytes_part(source.path, source.data, options), hashlib.sha256(
+            source.data
+        ).hexdigest()
+    try:
+        with open(source.path, "rb") as f:
+            digest = hashlib.file_digest(f, "sha256").hexdigest()
+    except OSError:
+        digest = ""  # the reader says why, in the CLI's words
+    part = resolve_part(source.path, layer=options.layer, tolerance=options.flatten_tol)
+    return part, digest
+
+
+def _outline(part: Any) -> str:
+    pts = part.outline
+    if len(pts) > MAX_OUTLINE_POINTS:
+        pts = pts[:: math.ceil(len(pts) / MAX_OUTLINE_POINTS)]
+    return json.dumps([[round(float(x), 9), round(float(y), 9)] for x, y in pts])
+
+
+def _plan(part: Any, options: SweepOptions, prior: Prior) -> tuple[Any, dict[str, Any], str]:
+    """Problem, plan report and plan document, as ``bayesgrasp plan --json`` makes them."""
+    from ..io.plans import plan_document
+    from ..model.cost import CostModel
+    from ..model.goal import Goal
+    from ..model.problem import Problem
+    from ..planning import plan_exact
+
+    first = {
+        name: c
+        for name, c in (
+            ("squeeze", options.first_squeeze_cost),
+            ("push-grasp", options.first_push_grasp_cost),
+        )
+        if c is not None
+    }
+    cost = CostModel(
+        {"squeeze": options.squeeze_cost, "push-grasp": options.push_grasp_cost},
+        verify=options.verify_cost,
+        first=first,
+        retry=options.retry_cost,
+    )
+    pb = Problem.build(
+        part,
+        prior,
+        cost,
+        Goal(cast(Literal["single", "symmetry"], options.goal)),
+        actions=options.actions,
+        accuracy=math.radians(options.accuracy_deg),
+    )
+    if options.method == "bfs":
+        from ..planning.bfs import plan_bfs
+
+        rep = plan_bfs(pb, max_actions=options.max_actions)
+    else:
+        rep = plan_exact(pb, max_actions=options.max_actions)
+    sure, missing = None, None
+    if options.guaranteed:
+        from ..planning.guaranteed import plan_guaranteed
+
+        try:
+            found = plan_guaranteed(pb)
+        except NoPlanError as exc:  # the planner before its no-plan result
+            missing = str(exc)
+        else:
+            if getattr(found, "status", "ok") == "ok":
+                sure = found
+            else:
+                missing = str(getattr(found, "reason", None) or "no guaranteed plan")
+    doc = plan_document(rep, guaranteed=sure, guaranteed_missing=missing)
+    return rep, doc, "ok" if missing is None else "no-plan"
+
+
+def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
+    """The ``bayesgrasp.simulate/1`` document of the Bayes plan's execution."""
+    from .. import report
+    from ..sim.kinematic import GripperNoise, simulate_kinematic
+
+    pb, option = rep.problem, rep.bayes_plan
+    noise = GripperNoise(options.noise_kind, math.radians(options.noise_deg))  # type: ignore[arg-type]
+    if options.simulate == "kinematic":
+        res = simulate_kinematic(pb, option, options.n_trials, noise, rng=options.seed)
+    else:
+        from ..sim import simulate_mujoco
+
+        res = simulate_mujoco(
+            pb,
+            option,
+            options.n_trials,
+            offset=options.offset_mm / 1000.0,  # millimetres to metres
+            noise=noise,
+            rng=options.seed,
+            workers=1,
+        )
+    return report.simulate_json(res, pb.part)
+
+
+def _fill(row: dict[str, Any], part: Any, doc: dict[str, Any]) -> None:
+    """The row's plan columns, all taken from the plan document."""
+    info = doc["part"]
+    bayes = doc["options"][doc["bayes"]]
+    sure = doc["options"][doc["most_certain"]]
+    row.update(
+        name=info["name"],
+        units=info.get("units"),
+        sides=info["n_sides"],
+        symmetry_order=info["symmetry_order"],
+        states=len(doc["stable_orientations_rad"]),
+        period_rad=doc["period_rad"],
+        method=doc["method"],
+        plans=len(doc["options"]),
+        bayes_actions=bayes["squeezes"],
+        bayes_cost=bayes["expected_cost"],
+        bayes_probability=bayes["success_probability"],
+        bayes_tolerance_rad=bayes["tolerance_rad"],
+        bayes_first_rad=bayes["first_squeeze_rad"],
+        bayes_final_rad=bayes["final_orientation_rad"],
+        bayes_steps=json.dumps(bayes["steps"], separators=(",", ":")),
+        most_certain_actions=sure["squeezes"],
+        most_certain_probability=sure["success_probability"],
+        guaranteed_missing=doc.get("guaranteed_missing"),
+        outline=_outline(part),
+        plan_json=json.dumps(doc, allow_nan=False, separators=(",", ":")),
+    )
+    if doc.get("guaranteed"):
+        row["guaranteed_actions"] = doc["guaranteed"]["squeezes"]
+
+
+def plan_part(
+    source: PartSource | str, options: SweepOptions, prior: Prior | None = None
+) -> dict[str, Any]:
+    """Read, plan and optionally simulate one part: one row, never an exception.
+
+    Parameters
+    ----------
+    source : PartSource or str
+        The part file (a path, or a path and its bytes).
+    options : SweepOptions
+    prior : Prior, optional
+        ``options.prior`` already parsed (the engine parses it once, on the client, so
+        that a prior file need not exist on the workers).
+
+    Returns
+    -------
+    dict
+        One value per column of :data:`ROW_COLUMNS`.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> f = Path(tempfile.mkdtemp()) / "plate.wkt"
+    >>> _ = f.write_text("POLYGON ((0 0, 4 0, 4 1, 1 1, 1 3, 0 3, 0 0))")
+    >>> row = plan_part(str(f), SweepOptions())
+    >>> row["status"], row["sides"], row["bayes_actions"]
+    ('ok', 5, 3)
+    >>> plan_part(str(f.with_name("missing.wkt")), SweepOptions())["error_class"]
+    'PartFileError'
+    """
+    if isinstance(source, str):
+        source = PartSource(source)
+    row = _empty_row(source.path, source.sha256, options)
+    t0 = time.perf_counter()
+    try:
+        part, digest = _read_part(source, options)
+        if digest:
+            row.update(sha256=digest, part_id=part_id(source.path, digest))
+        rep, doc, status = _plan(part, options, prior or parse_prior(options.prior))
+        _fill(row, part, doc)
+        row["status"] = status
+    except Exception as exc:  # a bad part is a row; a bug in it too, with its class
+        row["plan_seconds"] = time.perf_counter() - t0
+        return _error(row, exc)
+    row["plan_seconds"] = time.perf_counter() - t0
+    if options.simulate is not None:
+        t1 = time.perf_counter()
+        try:
+            sim = _simulate(rep, options)
+            row.update(
+                sim_engine=sim["engine"],
+                sim_trials=sim["trials"],
+                sim_predicted=sim["predicted_success"],
+                sim_observed=sim["observed_success"],
+                sim_ci_low=sim["ci95"][0],
+                sim_ci_high=sim["ci95"][1],
+                sim_p_value=sim["p_value"],
+                sim_jams=sim["jams"],
+                sim_json=json.dumps(sim, allow_nan=False, separators=(",", ":")),
+            )
+        except Exception as exc:
+            _error(row, exc)
+        row["sim_seconds"] = time.perf_counter() - t1
+    return row
+
+
+def timeout_row(source: PartSource, options: SweepOptions, timeout: float) -> dict[str, Any]:
+    """The error row of a part whose work took longer than ``timeout`` seconds."""
+    row = _empty_row(source.path, source.sha256, options)
+    return _error(
+        row,
+        TimeoutError(f"{source.path}: the part took longer than the timeout of {timeout:g} s"),
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class ChunkResult:
+    """What a task gives back: the rows done and the parts it could not get to.
+
+    Attributes
+    ----------
+    rows : list of dict
+    pending : tuple of PartSource
+        Parts left after a part timed out (its work may still be running: ``stuck``).
+    stuck : bool
+        A part's work outlived its timeout and still runs in this worker's process.
+    worker : str
+        Address of the Dask worker (``""`` outside Dask).
+    """
+
+    rows: list[dict[str, Any]]
+    pending: tuple[PartSource, ...] = ()
+    stuck: bool = False
+    worker: str = ""
+
+
+def _call_with_timeout(work: Callable[[], dict[str, Any]], timeout: float) -> dict[str, Any] | None:
+    """``work()`` in a thread, or ``None`` when it is not done in ``timeout`` seconds.
+
+    Python threads cannot be killed; the engine restarts the worker whose thread is stuck.
+    """
+    box: list[dict[str, Any]] = []
+    t = threading.Thread(target=lambda: box.append(work()), daemon=True)
+    t.start()
+    t.join(timeout)
+    return box[0] if box else None
+
+
+def run_chunk(
+    sources: Sequence[PartSource],
+    options: SweepOptions,
+    prior: Prior | None = None,
+    timeout: float | None = None,
+) -> ChunkResult:
+    """Plan a few parts (one task): a row each, stopping at the first that times out.
+
+    Examples
+    --------
+    >>> run_chunk([PartSource("no-such-part.json")], SweepOptions()).rows[0]["status"]
+    'error'
+    """
+    worker = ""
+    try:  # the worker's address, to restart it when a part's work is stuck
+        from distributed import get_worker
+
+        worker = get_worker().address
+    except (ImportError, ValueError):
+        pass
+    rows: list[dict[str, Any]] = []
+    for i, src in enumerate(sources):
+        if timeout is None:
+            rows.append(plan_part(src, options, prior))
+            continue
+        row = _call_with_timeout(lambda s=src: plan_part(s, options, prior), timeout)  # type: ignore[misc]
+        if row is None:
+            rows.append(timeout_row(src, options, timeout))
+            return ChunkResult(rows, tuple(sources[i + 1 :]), True, worker)
+        rows.append(row)
+    return ChunkResult(rows, (), False, worker)
+
+
+def error_rows(
+    sources: Sequence[PartSource], options: SweepOptions, exc: BaseException
+) -> list[dict[str, Any]]:
+    """Error rows for parts whose task failed as a whole (a worker died running it)."""
+    return [_error(_empty_row(s.path, s.sha256, options), exc) for s in sources]
