@@ -1,7 +1,7 @@
 """The ``bayesgrasp`` command line: parse, call the library, print. Nothing else.
 
 One module per command group: :mod:`.parts` (squeeze, push), :mod:`.plan`, :mod:`.plot`,
-:mod:`.simulate`, :mod:`.paper` (table1, study, demo); the options they share are in
+:mod:`.simulate`, :mod:`.sweep`, :mod:`.paper` (table1, study, demo); the options they share are in
 :mod:`.options`, the helpers in :mod:`.common`. A command's module is imported only when
 the command runs (or shows its help), and the library only inside the command's body, so
 ``bayesgrasp --help`` loads no planner, figure or simulation code.
@@ -31,6 +31,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "plan": ("plan", "The best plan of every length; the Bayes and most certain plans."),
     "plot": ("plot", "Figures of a part and a plan, and the plan's animation."),
     "simulate": ("simulate", "Execute a plan many times; compare with the prediction."),
+    "sweep": ("sweep", "Plan every part of a catalogue on Dask; one row a part."),
     "table1": ("paper", "The seed's Table 1 beside our expected costs."),
     "study": ("paper", "The seed's study: random polygons planned and counted."),
     "demo": ("paper", "The main job: Table 1, then the example part planned."),

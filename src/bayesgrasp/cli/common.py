@@ -50,7 +50,7 @@ def with_progress(description: str, total: int, work: Callable[[Any], Any]) -> A
         transient=True,
     ) as bar:
         task = bar.add_task(description, total=total)
-        return work(lambda done, _total: bar.update(task, completed=done))
+        return work(lambda done, total: bar.update(task, completed=done, total=total))
 
 
 def no_plan(reason: str) -> NoReturn:

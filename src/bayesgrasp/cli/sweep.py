@@ -1,0 +1,135 @@
+"""``sweep``: plan (and check in simulation) every part of a catalogue on Dask."""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from .common import emit_json, with_progress
+from .options import JsonOpt, command_app, problem_options
+from .specs import ProblemSpec
+
+app = command_app()
+
+
+class SimEngine(enum.StrEnum):
+    """Execution check of each part's Bayes plan."""
+
+    kinematic = "kinematic"
+    mujoco = "mujoco"
+
+
+class ResultFormat(enum.StrEnum):
+    """How the rows are stored."""
+
+    parquet = "parquet"
+    csv = "csv"
+
+
+PathsArg = Annotated[
+    list[str],
+    typer.Argument(help="Part files, folders (searched recursively) and globs."),
+]
+
+
+@app.command()
+@problem_options()
+def sweep(
+    paths: PathsArg,
+    spec: ProblemSpec,
+    out: Annotated[Path, typer.Option("--out", help="Results: a Parquet folder, or a CSV file.")],
+    fmt: Annotated[ResultFormat, typer.Option("--format", help="Results format.")] = (
+        ResultFormat.parquet
+    ),
+    simulate: Annotated[
+        SimEngine | None, typer.Option(help="Also execute each Bayes plan (kinematic or MuJoCo).")
+    ] = None,
+    trials: Annotated[
+        int | None, typer.Option(min=1, help="Executions a part (default 1,000,000 / 200).")
+    ] = None,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of every part's simulation.")] = 0,
+    workers: Annotated[
+        int | None, typer.Option(min=1, help="Local Dask worker processes (default: cores).")
+    ] = None,
+    scheduler: Annotated[
+        str | None, typer.Option(metavar="ADDRESS", help="Run on this Dask scheduler instead.")
+    ] = None,
+    timeout: Annotated[
+        float | None, typer.Option(min=0, help="Seconds a part may take (then an error row).")
+    ] = None,
+    resume: Annotated[bool, typer.Option(help="Skip parts already in RESULTS.")] = False,
+    force: Annotated[bool, typer.Option(help="Replace an existing RESULTS.")] = False,
+    report_file: Annotated[
+        Path | None, typer.Option("--report", metavar="FILE.html", help="Also write a report.")
+    ] = None,
+    guaranteed: Annotated[bool, typer.Option(help="Also find each part's guaranteed plan.")] = True,
+    as_json: JsonOpt = False,
+) -> None:
+    """Plan every part of a catalogue on a Dask cluster: one row a part in RESULTS.
+
+    PATH is a part file, a folder (searched recursively for every format the readers know)
+    or a glob. The planning options apply to every part; a part that cannot be read or
+    planned is a row with its error, never a stopped sweep. By default a local cluster of
+    worker processes runs the sweep; --scheduler ADDRESS uses an existing cluster
+    (`dask scheduler` / `dask worker`).
+    """
+    from ..sweep import SweepInterrupted, SweepOptions, run_sweep, write_report
+
+    options = SweepOptions(
+        prior=spec.prior,
+        squeeze_cost=(spec.costs or {}).get("squeeze", 1.0),
+        push_grasp_cost=(spec.costs or {}).get("push-grasp", 1.0),
+        verify_cost=spec.verify,
+        first_squeeze_cost=(spec.first or {}).get("squeeze"),
+        first_push_grasp_cost=(spec.first or {}).get("push-grasp"),
+        retry_cost=spec.retry,
+        goal=spec.goal.value,
+        actions=spec.actions,
+        accuracy_deg=spec.accuracy_deg,
+        method=spec.method.value,
+        max_actions=spec.max_actions,
+        guaranteed=guaranteed,
+        simulate=simulate.value if simulate else None,
+        trials=trials,
+        seed=seed,
+    )
+
+    def work(progress: Any) -> Any:
+        tick = None if progress is None else (lambda p: progress(p.done, p.total))
+        return run_sweep(
+            paths,
+            out,
+            options,
+            workers=workers,
+            scheduler=scheduler,
+            fmt=fmt.value,
+            resume=resume,
+            force=force,
+            timeout=timeout,
+            progress=tick,
+        )
+
+    try:
+        summary = with_progress("sweep", 0, work)
+    except SweepInterrupted as stop:
+        typer.echo(
+            f"bayesgrasp: stopped after {stop.summary.written} rows; run again with --resume",
+            err=True,
+        )
+        raise typer.Exit(130) from None
+    if report_file is not None:
+        write_report(out, report_file)
+    doc = {"schema": "bayesgrasp.sweep/1", **dataclasses.asdict(summary), "out": str(out)}
+    if as_json:
+        emit_json(doc)
+    else:
+        typer.echo(
+            f"{summary.found} parts found, {summary.skipped} already done, {summary.written} "
+            f"rows written to {out} ({summary.ok} planned, {summary.no_plan} without a "
+            f"guaranteed plan, {summary.errors} errors of which {summary.timeouts} timeouts) "
+            f"by {summary.workers} workers in {summary.seconds:.1f} s"
+        )

@@ -1,0 +1,39 @@
+"""``bayesgrasp sweep``: the command runs a sweep, refuses to overwrite, writes a report."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from bayesgrasp.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+@pytest.mark.dask
+def test_sweep_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    shutil.copy(EXAMPLES / "peanut.svg", parts)
+    (parts / "bad.json").write_text("{not json", encoding="utf-8")
+    out = tmp_path / "rows.csv"
+    argv = ["sweep", str(parts), "--out", str(out), "--format", "csv", "--workers", "1"]
+    assert main([*argv, "--report", str(tmp_path / "r.html"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert (doc["schema"], doc["found"], doc["written"], doc["ok"], doc["errors"]) == (
+        "bayesgrasp.sweep/1",
+        2,
+        2,
+        1,
+        1,
+    )
+    assert (tmp_path / "r.html").read_text(encoding="utf-8").startswith("<!DOCTYPE html>")
+    before = out.read_bytes()
+    assert main(argv) == 2
+    assert "exists; resume it (--resume) or replace it (--force)" in capsys.readouterr().err
+    assert out.read_bytes() == before  # nothing the user had is lost
+    assert main([*argv, "--resume", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["skipped"] == 2
