@@ -1,4 +1,7 @@
-"""Kinematic Monte Carlo of plans (bayesgrasp.sim.kinematic) and the `simulate` command with it."""
+"""Kinematic Monte Carlo of plans (bayesgrasp.sim) and the `simulate` command with it.
+
+Plan documents (read by ``simulate --plan FILE``) are tested in tests/io/test_plans.py.
+"""
 
 from __future__ import annotations
 
@@ -7,34 +10,27 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.stats import kstest
 
+from bayesgrasp.angles import TWO_PI, circle_distance
 from bayesgrasp.cli import main
+from bayesgrasp.errors import SimulationError
 from bayesgrasp.geometry.polygon import Part
 from bayesgrasp.model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior, von_mises
-from bayesgrasp.model.problem import Goal, Problem
+from bayesgrasp.model.problem import Problem
 from bayesgrasp.planning import PlanOption, PlanStep, execute_plan, plan_exact
-from bayesgrasp.report import option_json
 from bayesgrasp.shapes import load, names
-from bayesgrasp.sim.kinematic import (
+from bayesgrasp.sim import (
     GripperNoise,
-    SimulationError,
-    boundary_distance,
-    goal_states,
     goodness_of_fit,
-    plan_from_json,
     predicted_distribution,
     sample_prior,
     simulate_kinematic,
     wilson_interval,
 )
 from reference import descend
-from strategies import convex_points
 
-TWO_PI = 2.0 * math.pi
 P_MIN = 1e-3  # goodness-of-fit threshold at a fixed seed
 
 
@@ -105,82 +101,7 @@ def test_sample_prior_rejects_negative_counts() -> None:
         sample_prior(UniformPrior(), -1)
 
 
-# --- statistics ----------------------------------------------------------------------------
-
-
-def test_wilson_interval_known_values() -> None:
-    lo, hi = wilson_interval(0, 10)
-    assert lo == 0.0
-    assert_allclose(hi, 0.27753, atol=1e-5)
-    # Newcombe (1998), Statistics in Medicine 17, Table I: 81/263 and 15/148
-    assert_allclose(wilson_interval(81, 263), (0.2553, 0.3662), atol=1e-4)
-    assert_allclose(wilson_interval(15, 148), (0.0624, 0.1605), atol=1e-4)
-    assert wilson_interval(0, 0) == (0.0, 1.0)
-    with pytest.raises(SimulationError, match=r"`successes` must be in \[0, 3\]; got 4"):
-        wilson_interval(4, 3)
-
-
-def test_wilson_interval_covers_the_truth(rng: np.random.Generator) -> None:
-    p, n = 0.3, 200
-    hits = sum(
-        lo <= p <= hi for lo, hi in (wilson_interval(int(k), n) for k in rng.binomial(n, p, 2000))
-    )
-    assert 0.93 <= hits / 2000 <= 0.97
-
-
-def test_goodness_of_fit_cases() -> None:
-    assert goodness_of_fit([0, 0], [0.5, 0.5]) == 1.0
-    assert goodness_of_fit([10, 1], [1.0, 0.0]) == 0.0  # an impossible outcome happened
-    assert goodness_of_fit([100], [1.0]) == 1.0
-    assert goodness_of_fit([500, 500], [0.5, 0.5]) == 1.0
-    assert goodness_of_fit([700, 300], [0.5, 0.5]) < 1e-12
-    # small expected counts are pooled: 3 cells of expectation 1 become one of 3
-    assert_allclose(goodness_of_fit([97, 1, 1, 1], [0.97, 0.01, 0.01, 0.01]), 1.0, atol=1e-12)
-
-
-def test_boundary_distance_wraps() -> None:
-    b = np.array([0.5, 3.0])
-    assert_allclose(boundary_distance(b, [0.4, 1.0, 6.2, 3.0]), [0.1, 0.5, 0.5 + TWO_PI - 6.2, 0])
-
-
-def test_gripper_noise_validation() -> None:
-    with pytest.raises(SimulationError, match="`kind` must be 'normal' or 'uniform'; got 'x'"):
-        GripperNoise("x", 0.1)
-    with pytest.raises(SimulationError, match="`scale` must be a finite number >= 0; got -1"):
-        GripperNoise("normal", -1)
-    e = GripperNoise("normal", 0.2).draw((50_000,), 0)
-    assert_allclose(e.std(), 0.2, atol=0.005)
-    assert not GripperNoise().draw((4,), 0).any()
-
-
 # --- prediction ----------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize("name", names())
-def test_prediction_matches_the_planner(name: str) -> None:
-    pb = Problem.build(load(name))
-    for opt in plan_exact(pb).options:
-        pred = predicted_distribution(pb, opt.steps)
-        assert_allclose(pred.sum(), 1.0, atol=1e-12)
-        assert_allclose(pred[goal_states(pb, opt.final_orientation)].sum(),
-                        opt.success_probability, atol=1e-9)  # fmt: skip
-
-
-@settings(max_examples=30)
-@given(convex_points(), st.sampled_from(["uniform", "vonmises"]), st.booleans())
-def test_prediction_is_a_distribution_that_matches_the_planner(
-    points: np.ndarray, prior_kind: str, symmetry: bool
-) -> None:
-    prior = UniformPrior() if prior_kind == "uniform" else von_mises(0.7, 2.0, bins=360)
-    pb = Problem.build(
-        Part.from_points(points), prior, goal=Goal("symmetry" if symmetry else "single")
-    )
-    for opt in plan_exact(pb).options:
-        pred = predicted_distribution(pb, opt.steps)
-        assert np.all(pred >= 0)
-        assert_allclose(pred.sum(), 1.0, atol=1e-9)
-        got = pred[goal_states(pb, opt.final_orientation)].sum()
-        assert_allclose(got, opt.success_probability, atol=1e-7)
 
 
 def test_prediction_against_a_grid_walk() -> None:
@@ -190,7 +111,7 @@ def test_prediction_against_a_grid_walk() -> None:
         for opt in plan_exact(pb).options:
             grid = np.arange(1 << 16) * (TWO_PI / (1 << 16))
             end = brute_execute(part.hull.vertices, opt.steps, grid)
-            dist = np.abs(np.mod(end[:, None] - pb.states.stable + math.pi, TWO_PI) - math.pi)
+            dist = circle_distance(end[:, None], pb.states.stable)
             frac = np.bincount(dist.argmin(axis=1), minlength=pb.n_states) / len(grid)
             assert_allclose(frac, predicted_distribution(pb, opt.steps), atol=1e-3)
 
@@ -207,7 +128,7 @@ def test_kinematic_agrees_with_execute_plan_and_a_grid_walk(rng: np.random.Gener
             assert_allclose(res.final, execute_plan(pb, opt.steps, theta0), atol=0.0)
             # away from basin boundaries the grid walk lands on the same orientation
             walk = brute_execute(part.hull.vertices, opt.steps, theta0)
-            err = np.abs(np.mod(walk - res.final + math.pi, TWO_PI) - math.pi)
+            err = circle_distance(walk, res.final)
             assert np.mean(err < 1e-3) > 0.99
 
 
@@ -296,8 +217,8 @@ def test_noise_within_the_tolerance_changes_no_successful_trial() -> None:
         assert tol is not None
         theta0 = sample_prior(pb.prior, 20_000, 3)
         base = execute_plan(pb, opt.steps, theta0)
-        goal = goal_states(pb, opt.final_orientation)
-        idx = np.argmin(np.abs(np.mod(base[:, None] - pb.states.stable + 3.2, TWO_PI) - 3.2), 1)
+        goal = pb.success_states(opt.final_orientation)
+        idx = np.argmin(circle_distance(base[:, None], pb.states.stable), axis=1)
         ok = goal[idx]
         for sign in (-1.0, 1.0):
             steps = (
@@ -344,26 +265,6 @@ def test_push_grasp_plans_run_kinematically() -> None:
         res = simulate_kinematic(pb, opt, 50_000, rng=8)
         assert res.p_value > P_MIN
         assert_allclose(res.predicted_success, opt.success_probability, atol=1e-9)
-
-
-# --- plan files ----------------------------------------------------------------------------
-
-
-def test_plan_from_json_reads_options_and_plan_documents() -> None:
-    pb = Problem.build(load("triangle"))
-    rep = plan_exact(pb)
-    for opt in rep.options:
-        back = plan_from_json(option_json(opt))
-        assert back.steps == opt.steps
-        assert back.final_orientation == opt.final_orientation
-    doc = {"options": [option_json(o) for o in rep.options], "bayes": rep.bayes}
-    assert plan_from_json(doc).steps == rep.bayes_plan.steps
-    legacy = {"first_squeeze_rad": 0.1, "actions_rad": [0.5], "final_orientation_rad": 1.0}
-    assert plan_from_json(legacy).steps == (PlanStep("squeeze", 0.1), PlanStep("squeeze", 0.5))
-    with pytest.raises(SimulationError, match="a plan needs `steps` or `first_squeeze_rad`"):
-        plan_from_json({"x": 1})
-    with pytest.raises(SimulationError, match=r"step 1 must be .* got \{'type': 'squeeze'\}"):
-        plan_from_json({"steps": [{"type": "squeeze"}]})
 
 
 # --- the command line ----------------------------------------------------------------------

@@ -15,18 +15,24 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from bayesgrasp.angles import TWO_PI, circle_distance
 from bayesgrasp.cli import main
-from bayesgrasp.errors import MissingExtraError, PartError
+from bayesgrasp.errors import MissingExtraError, PartError, SimulationError
 from bayesgrasp.geometry.polygon import Part
 from bayesgrasp.geometry.transfer import squeeze_function
 from bayesgrasp.model.problem import Problem
 from bayesgrasp.planning import plan_exact
 from bayesgrasp.shapes import load
-from bayesgrasp.sim import SimParams, part_inertia, scene_xml, units_scale
-from bayesgrasp.sim.kinematic import boundary_distance, wilson_interval
+from bayesgrasp.sim import (
+    SimParams,
+    boundary_distance,
+    part_inertia,
+    scene_xml,
+    units_scale,
+    wilson_interval,
+)
 from bayesgrasp.sim.params import SimParamsError
 
-TWO_PI = 2.0 * math.pi
 HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
 needs_mujoco = pytest.mark.skipif(
     not HAVE_MUJOCO, reason="MuJoCo is not installed: pip install 'bayesgrasp[sim]'"
@@ -39,10 +45,6 @@ HEXAGON = Part.from_points(
     [(0.02 * math.cos(a), 0.012 * math.sin(a)) for a in np.linspace(0, TWO_PI, 7)[:-1] + 0.3],
     name="hexagon",
 )
-
-
-def angle_error(a: np.ndarray | float, b: np.ndarray | float) -> np.ndarray:
-    return np.abs(np.mod(np.asarray(a) - np.asarray(b) + math.pi, TWO_PI) - math.pi)
 
 
 # --- settings and scene (no MuJoCo needed) -------------------------------------------------
@@ -140,10 +142,11 @@ def test_single_squeezes_end_in_the_predicted_orientation(part: Part, scale: flo
     sq = Squeezer(part, scale)
     outs = [sq.act(float(t)) for t in starts]
     ends = np.array([o.end for o in outs])
-    ok = (angle_error(ends, f(starts)) < math.radians(1.0)) & np.array([o.settled for o in outs])
+    settled = np.array([o.settled for o in outs])
+    ok = (circle_distance(ends, f(starts)) < math.radians(1.0)) & settled
     assert ok.mean() >= 0.97, f"{ok.sum()}/{len(ok)} agree"
     # the part stops on the stable orientation, not merely near it
-    assert np.median(angle_error(ends[ok], f(starts[ok]))) < math.radians(0.3)
+    assert np.median(circle_distance(ends[ok], f(starts[ok]))) < math.radians(0.3)
 
 
 @pytest.mark.physics
@@ -165,7 +168,7 @@ def test_push_grasps_end_in_the_predicted_orientation() -> None:
     starts = starts[away][:20]
     sq = Squeezer(part, 1.0)
     ends = np.array([sq.act(float(t), push=True).end for t in starts])
-    ok = angle_error(ends, g(starts)) < math.radians(1.0)
+    ok = circle_distance(ends, g(starts)) < math.radians(1.0)
     assert ok.mean() >= 0.95, f"{ok.sum()}/{len(ok)} agree"
 
 
@@ -222,7 +225,7 @@ def test_an_offset_part_is_pushed_before_the_squeeze() -> None:
     starts = starts[boundary_distance(f.boundaries, starts) >= MARGIN][:30]
     sq = Squeezer(part, 1.0)
     ends = np.array([sq.act(float(t), offset=0.012).end for t in starts])
-    assert np.mean(angle_error(ends, f(starts)) < math.radians(1.0)) < 0.95
+    assert np.mean(circle_distance(ends, f(starts)) < math.radians(1.0)) < 0.95
 
 
 @pytest.mark.physics
@@ -247,7 +250,6 @@ def test_cli_simulate_mujoco_json(capsys: pytest.CaptureFixture[str]) -> None:
 @needs_mujoco
 def test_parts_outside_the_checked_sizes_are_refused() -> None:
     from bayesgrasp.sim import simulate_mujoco
-    from bayesgrasp.sim.kinematic import SimulationError
 
     pb = Problem.build(Part.from_points([(0, 0), (40, 0), (10, 30)]))  # no units: metres
     with pytest.raises(SimulationError, match=r"measures 50\.8 m across at 1 m per unit.*units"):

@@ -3,7 +3,7 @@
 The engine knows nothing of diameter or transfer functions: it gets the part's hull, a table
 with friction, two frictionless jaws and a yaw to start from, and reports the yaw where the
 part stops. The library then compares those yaws with the model's stable orientations
-(:func:`bayesgrasp.sim.kinematic.summarize`).
+(:func:`bayesgrasp.sim.result.summarize`).
 
 One action, in the gripper frame (which is the world frame of the scene):
 
@@ -14,7 +14,8 @@ One action, in the gripper frame (which is the world frame of the scene):
    trial's ``offset`` along x; the jaws start ``clearance`` outside it.
 2. *Squeeze.* Both jaw targets close at ``jaw_speed``; the force-limited position actuators
    push the part until both jaws are slower than ``settle_speed`` for ``settle_time``.
-   A push-grasp closes the -x jaw first: it pushes the part ``push_distance`` beyond first
+   An action that pushes first (:attr:`~bayesgrasp.model.actions.Action.pushes_first`, the
+   push-grasp) closes the -x jaw first: it pushes the part ``push_distance`` beyond first
    contact, then the +x jaw closes.
 3. *Read and open.* The part's yaw is read from the free joint's quaternion; opening the
    jaws is the next action's placement.
@@ -37,28 +38,30 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import MissingExtraError
+from ..angles import TWO_PI, circle_distance
+from ..errors import MissingExtraError, SimulationError
 from ..geometry.polygon import Part
+from ..model.actions import get_action
 from ..model.problem import Problem
 from ..planning.result import PlanOption
-from .kinematic import (
+from .kinematic import sample_prior
+from .noise import GripperNoise
+from .params import SimParams
+from .result import (
     DEFAULT_BOUNDARY_MARGIN,
-    GripperNoise,
     Progress,
-    SimulationError,
     SimulationResult,
     boundary_distance,
-    sample_prior,
+    check_steps,
+    check_trials,
     summarize,
 )
-from .params import SimParams
 from .scene import prism, scene_xml, units_scale
 
 __all__ = ["ActionOutcome", "Squeezer", "require_mujoco", "simulate_mujoco"]
 
 logger = logging.getLogger(__name__)
 
-TWO_PI = 2.0 * math.pi
 FloatArray = NDArray[np.float64]
 
 #: Part sizes (metres across, twice the hull's largest distance from its centroid) the
@@ -189,7 +192,7 @@ class Squeezer:
         offset : float
             Shift (metres) along x of the part's x-extent from the gripper's centre.
         push : bool
-            Close the -x jaw first (a push-grasp).
+            Close the -x jaw first (an action that ``pushes_first``, the push-grasp).
 
         Returns
         -------
@@ -340,6 +343,9 @@ def simulate_mujoco(
     ------
     MissingExtraError
         MuJoCo is not installed (extra ``sim``).
+    SimulationError
+        Bad ``trials``, ``workers`` or ``offset``, a step whose action the problem does not
+        have, or a part too small or too large for the physics settings.
 
     Examples
     --------
@@ -352,18 +358,12 @@ def simulate_mujoco(
     (5, 'mujoco')
     """
     require_mujoco()
-    if not isinstance(trials, int | np.integer) or trials < 1:
-        raise SimulationError(f"`trials` must be an integer >= 1; got {trials!r}")
+    check_trials(trials)
     if not isinstance(workers, int | np.integer) or workers < 1:
         raise SimulationError(f"`workers` must be an integer >= 1; got {workers!r}")
     if not (math.isfinite(offset) and offset >= 0):
         raise SimulationError(f"`offset` must be a finite distance >= 0 (metres); got {offset!r}")
-    for step in option.steps:
-        if step.kind not in ("squeeze", "push-grasp") or step.kind not in problem.transfers:
-            raise SimulationError(
-                f"the plan uses {step.kind!r} actions but the problem has only "
-                f"{', '.join(problem.transfers)}"
-            )
+    check_steps(problem, option.steps)
     params = params or SimParams()
     noise = noise or GripperNoise()
     sc = units_scale(problem.part.units) if scale is None else scale
@@ -380,7 +380,7 @@ def simulate_mujoco(
     alphas = np.array([s.alpha for s in option.steps])
     angles = alphas[None, :] + noise.draw((trials, k), gen)  # (T, k)
     signs = np.where(gen.random((trials, k)) < 0.5, -1.0, 1.0)
-    pushes = tuple(s.kind == "push-grasp" for s in option.steps)
+    pushes = tuple(get_action(s.kind).pushes_first for s in option.steps)
     tasks = [
         _Trial(float(theta0[i]), tuple(angles[i].tolist()), tuple((offset * signs[i]).tolist()),
                pushes)
@@ -400,10 +400,10 @@ def simulate_mujoco(
     near = np.zeros(trials, dtype=bool)
     jammed: NDArray[np.bool_] = np.asarray(~settled.all(axis=1), dtype=bool)
     for j, step in enumerate(option.steps):
-        near |= boundary_distance(problem.transfers[step.kind].boundaries, starts[:, j]) < (
+        near |= boundary_distance(problem.transfer(step.kind).boundaries, starts[:, j]) < (
             boundary_margin
         )
-        err = np.abs(np.mod(ends[:, j, None] - states.stable + math.pi, TWO_PI) - math.pi)
+        err = circle_distance(ends[:, j, None], states.stable)  # (T, K)
         jammed |= err.min(axis=1) > params.jam_tol
     final = np.where(settled[:, -1], ends[:, -1], np.nan)
     # A last action that did not settle is a jam: put it where no state is (a basin edge).
