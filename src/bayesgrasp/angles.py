@@ -51,8 +51,15 @@ def wrap_array(x: ArrayLike) -> NDArray[np.float64]:
 
 
 def mod_2pi(x: ArrayLike) -> NDArray[np.float64]:
-    """Angles in ``[0, 2 pi)`` (vectorised)."""
-    return np.asarray(np.mod(np.asarray(x, dtype=np.float64), TWO_PI), dtype=np.float64)
+    """Angles in ``[0, 2 pi)`` (vectorised; ``np.mod`` alone rounds a tiny negative to 2 pi).
+
+    Examples
+    --------
+    >>> mod_2pi([-1e-20, 7.0]).round(6).tolist()
+    [0.0, 0.716815]
+    """
+    out = np.mod(np.asarray(x, dtype=np.float64), TWO_PI)
+    return np.asarray(np.where(out >= TWO_PI, 0.0, out), dtype=np.float64)
 
 
 def circle_distance(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
