@@ -1,0 +1,91 @@
+"""Speed of the Bayes-policy planner (issue 10's targets), printed as figures.
+
+- exact-reading policies for the seed's 2000 random 10-point polygons, squeezes, depth <= 4
+  (target: under 5 s on one core);
+- noisy readings, SIGMA = 1% of each polygon's largest diameter, RES = SIGMA / 2
+  (target: under 60 s);
+- a 3-part recognition policy for catalogue parts (target: under 1 s).
+
+Run: ``python benchmarks/bench_policy.py [--polygons N] [--depth K]``. Times include building
+each problem; the second figure excludes it. ``plan_policy(..., sensorless=False)`` unless
+said (the sensorless Bayes plan is then not computed inside the planner).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import numpy as np
+
+from bayesgrasp import shapes
+from bayesgrasp.model import Problem
+from bayesgrasp.model.sensing import WidthSensor
+from bayesgrasp.paper.study import random_polygon
+from bayesgrasp.planning.policy import plan_policy
+
+
+def polygons(n: int, seed: int = 0) -> list[Problem]:
+    rng = np.random.default_rng(seed)
+    return [Problem.build(random_polygon(rng)) for _ in range(n)]
+
+
+def bench_random(n: int, depth: int, noisy: float | None, with_sensorless: bool) -> None:
+    t0 = time.perf_counter()
+    pbs = polygons(n)
+    t1 = time.perf_counter()
+    costs, sensorless, beliefs, iters = [], [], [], []
+    for pb in pbs:
+        if noisy is None:
+            sensor = WidthSensor()
+        else:
+            sigma = noisy * float(pb.diameter.lengths.max())
+            sensor = WidthSensor(sigma, sigma / 2)
+        pol = plan_policy(pb, sensor, depth, sensorless=with_sensorless)
+        costs.append(pol.expected_cost)
+        sensorless.append(math.nan if pol.sensorless_cost is None else pol.sensorless_cost)
+        beliefs.append(pol.beliefs)
+        iters.append(pol.iterations)
+    t2 = time.perf_counter()
+    label = "exact readings" if noisy is None else f"SIGMA {noisy:.0%} of diameter, RES SIGMA/2"
+    label += ", with the sensorless plan" if with_sensorless else ""
+    print(
+        f"{n} polygons, {label}, depth <= {depth}: {t2 - t0:.2f} s "
+        f"({t2 - t1:.2f} s planning, {t1 - t0:.2f} s building problems); "
+        f"mean cost {np.mean(costs):.4f} (sensorless {np.mean(sensorless):.4f}); "
+        f"beliefs/polygon mean {np.mean(beliefs):.1f} max {max(beliefs)}; "
+        f"parametric steps mean {np.mean(iters):.2f}"
+    )
+
+
+def bench_recognition(names: tuple[str, ...], depth: int, sensor: str) -> None:
+    t0 = time.perf_counter()
+    pbs = [Problem.build(shapes.load(n)) for n in names]
+    pol = plan_policy(pbs, sensor, depth)
+    t1 = time.perf_counter()
+    print(
+        f"recognition {'+'.join(names)}, {sensor}, depth <= {depth}: {t1 - t0:.3f} s; "
+        f"cost {pol.expected_cost:.4f}, success {pol.success_probability:.4f}, "
+        f"actions {pol.expected_actions:.3f}, beliefs {pol.beliefs}"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--polygons", type=int, default=2000)
+    ap.add_argument("--depth", type=int, default=4)
+    ap.add_argument("--noisy-polygons", type=int, default=None)
+    args = ap.parse_args()
+    for with_sensorless in (False, True):
+        bench_random(args.polygons, args.depth, None, with_sensorless)
+    bench_random(args.noisy_polygons or args.polygons, args.depth, 0.01, False)
+    parts = ("rectangle", "tuning-fork", "ic-chip")
+    for sensor in ("width", "width:0.5,0.1"):
+        bench_recognition(parts, 3, sensor)
+        bench_recognition(parts, 4, sensor)
+    bench_recognition(("triangle", "example", "allen-wrench"), 3, "width:0.5,0.1")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1004 @@
+"""Policies: branching plans that act on jaw-width readings, and the exact Bayes-policy planner.
+
+The seed's section 6.2: with a jaw-width sensor "the resulting plans would have branches,
+with different sensor values determining the actual path taken". A :class:`Policy` is a
+tree. A :class:`PolicyNode` is an action (its kind and gripper angle: the root's angle is the
+gripper's world angle, a later node's is the turn relative to the previous action, as in
+linear plans); its :class:`Branch` es are half-open reading intervals ``[lo, hi)`` that
+together cover every reading, each with its probability (given that the node is reached) and
+its next node or leaf. A leaf :class:`Declare` s a final orientation (in the last gripper
+frame; with several parts also which part) and then verifies, or :class:`Reject` s (the part
+goes back to the feeder without a verification). No path has more than ``max_actions``
+actions.
+
+Cost semantics
+--------------
+One *cycle* runs the policy once on a fresh part (a fresh draw from the part prior and the
+orientation prior). It pays the action costs on its path (the first action at its
+``CostModel.first`` cost), plus the verification cost ``v`` at a declaring leaf. It succeeds
+when the declared orientation (and part) is the true one under the problem's goal (with a
+symmetry goal, any symmetric copy). A cycle that does not succeed (a failed verification or
+a rejection) pays the retry overhead ``rho`` (``CostModel.retry``) and the next cycle starts.
+Cycles are independent, so the number of cycles is geometric with mean ``1 / P`` and
+
+    E[cost] = (E[C] + rho (1 - P)) / P = E[C] / P + rho (1 / P - 1),
+
+where ``C`` is the cost of one cycle (actions and verification) and ``P`` the probability
+that a cycle succeeds. For a linear plan this is :meth:`CostModel.expected_cost`, the seed's
+``C / p``. The reported figures are per cycle (``cycle_cost = E[C] + rho (1 - P)``,
+``success_probability = P``, ``reject_probability``, ``expected_actions`` = expected number
+of actions in one cycle) and over the whole process (``expected_cost``,
+``expected_total_actions = expected_actions / P``).
+
+The planner (exact)
+-------------------
+The Bayes policy minimises ``R(pi) = c(pi) / P(pi)`` (``c = E[C] + rho (1 - P)``) over all
+policies of at most ``max_actions`` actions. The ratio does not decompose over the tree, so
+the planner runs Dinkelbach's parametric search: for a price ``lambda`` of success,
+
+    h(lambda) = min over policies of  c(pi) - lambda P(pi),
+
+is concave and decreasing, and ``R* = min R`` is its root. Starting from the ratio
+``lambda_0`` of a known policy (the sensorless Bayes plan for one part, which is a policy
+that ignores its readings, or "one action, then declare the likeliest state"), each step
+solves ``h(lambda_n)`` exactly, takes its minimiser ``pi_n`` and sets ``lambda_{n+1} =
+R(pi_n)``; the ratios fall strictly until ``h(lambda_n) = 0``, when ``lambda_n = R*`` (every
+policy has ``c - lambda_n P >= 0``, i.e. ``R >= lambda_n``). The number of policies is
+finite, so this ends; in practice after two to four steps.
+
+For a fixed ``lambda`` the objective is additive over the leaves and ``h`` is a dynamic
+programme over *beliefs* (distributions over the states, or (part, orientation) pairs, after
+the last reading; :mod:`bayesgrasp.model.sensing`). Per unit of belief mass, with ``r``
+actions left:
+
+    V(q, 0) = min(rho,  v + rho - (lambda + rho) max_o s_o(q))       (reject | declare o)
+    V(q, r) = min(V(q, 0),  min over kinds t and classes a of
+                  c_t + sum_b P(b | q M_a) V(post(q M_a, b), r - 1))
+
+where ``s_o(q)`` is the success probability of declaring state ``o`` (its goal set's mass),
+``M_a`` the transition matrix of action class ``a`` (:meth:`Problem.transition`: finitely many
+classes of gripper turns per kind; for several parts, the common refinement of every part's
+classes) and ``post`` Bayes' rule with the reading bins of the sensor. The root must act:
+``h = min over first kinds t (and first gripper angles) of c^first_t + sum_b P(b) V(q_b,
+K - 1)``. Beliefs are memoised after rounding to multiples of ``2^-40`` (so values may carry
+errors of about ``1e-12``; the reported figures are recomputed exactly on the returned tree).
+
+The search is bounded by the depth and by branch and bound with an upper bound ``U(q)`` on
+the success probability any continuation can reach: when every action is symmetric under a
+turn of the gripper by pi (squeezes), the two states of a pi pair of one part have the same
+width and the same future up to pi, so a policy never separates them and
+``U(q) = sum over pairs max(q_i, q_i')`` (the sum when the goal counts both as one);
+otherwise ``U = 1``. A node whose leaf value is no worse than ``c_min + min(rho, v + rho -
+(lambda + rho) U(q))`` is a leaf; a class whose bound (its cost plus the children's bounds)
+cannot beat the best found is skipped, and one is abandoned as soon as its exact children so
+far plus the bounds of the rest cannot. Classes with the same effect on the belief's support
+are one (the widest is kept: the most margin for the turn). Ties go to fewer actions and to
+declaring over rejecting.
+
+First gripper angle: under the uniform prior it does not matter (0). Otherwise the root
+belief is linear in the angle between the angles where a basin boundary meets a breakpoint
+of the prior, and ``h`` is concave in the root belief, so the best angle is one of those (or,
+for a sample prior, a midpoint between them): the planner tries them all when there are at
+most ``max_first_angles`` (exact), else those of the sensorless exact plans plus a grid of
+360 (then ``Policy.first_angle_exact`` is False).
+
+The planner assumes exact gripper turns (``Problem.accuracy`` must be 0); each node's
+``margin`` is half the width of its action class, how far the turn may err without changing
+the effect on any state.
+
+Examples
+--------
+>>> from bayesgrasp.geometry import Part
+>>> from bayesgrasp.model import Problem
+>>> tri = Problem.build(Part.from_points([(0, 0), (3, 0), (1, 2)]))
+>>> pol = plan_policy(tri, "width", max_actions=2)
+>>> round(pol.expected_cost, 6), round(pol.success_probability, 6), pol.expected_actions
+(4.0, 0.5, 1.0)
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Any, cast
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..angles import TWO_PI, circle_distance, wrap, wrap_period
+from ..errors import PlanningError
+from ..model.prior import SamplePrior, UniformPrior
+from ..model.problem import ActionClasses, Problem, nearest_state
+from ..model.sensing import (
+    ReadingBins,
+    StateSpace,
+    WidthSensor,
+    entropy_bits,
+    parse_sensor,
+)
+from .result import PlanStep
+
+__all__ = [
+    "Branch",
+    "Declare",
+    "Policy",
+    "PolicyNode",
+    "Reject",
+    "joint_transition",
+    "plan_policy",
+    "policy_text",
+]
+
+logger = logging.getLogger(__name__)
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
+_QUANT = float(2**40)  # beliefs are memoised after rounding to multiples of 2**-40
+_EPS = 1e-12  # value comparisons (ties go to fewer actions)
+_DEFAULT_MAX_ACTIONS = 3
+
+
+@dataclass(frozen=True, slots=True)
+class Declare:
+    """A leaf that declares a final state, then verifies.
+
+    Attributes
+    ----------
+    part : int
+        Index of the declared part among the candidates.
+    part_name : str
+    orientation : float
+        The declared orientation of the part in the frame of the last action, ``[0, 2 pi)``.
+    success_probability : float
+        Probability that the declaration is right, given that the leaf is reached.
+    """
+
+    part: int
+    part_name: str
+    orientation: float
+    success_probability: float
+
+
+@dataclass(frozen=True, slots=True)
+class Reject:
+    """A leaf that sends the part back to the feeder without a verification."""
+
+
+@dataclass(frozen=True, slots=True)
+class Branch:
+    """Readings in ``[lo, hi)`` (part units; ``-inf`` / ``inf`` at the ends) lead to ``next``.
+
+    ``probability`` is the probability of such a reading given that the node is reached.
+    """
+
+    lo: float
+    hi: float
+    probability: float
+    next: PolicyNode | Declare | Reject
+
+
+@dataclass(frozen=True, slots=True)
+class PolicyNode:
+    """An action and its branches on the reading it yields.
+
+    Attributes
+    ----------
+    step : PlanStep
+        ``step.kind`` the action's name; ``step.alpha`` the world gripper angle (root) or the
+        turn relative to the previous action (radians).
+    branches : tuple of Branch
+        In increasing reading order, tiling the real line.
+    margin : float
+        Half the width of the action's class of turns (radians): an error in ``alpha`` of
+        less than this changes no state's outcome (the root's first angle: ``inf``).
+    """
+
+    step: PlanStep
+    branches: tuple[Branch, ...]
+    margin: float = math.inf
+
+    def branch(self, reading: float) -> Branch:
+        """The branch that a reading falls in."""
+        for b in self.branches:
+            if reading < b.hi:
+                return b
+        return self.branches[-1]
+
+
+Leaf = Declare | Reject
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Policy:
+    """The Bayes policy of a problem and sensor, and its figures (see the module notes).
+
+    Attributes
+    ----------
+    root : PolicyNode
+    parts : tuple of str
+        Names of the candidate parts.
+    part_prior : tuple of float
+    sensor : WidthSensor
+    max_actions : int
+    expected_cost : float
+        ``cycle_cost / success_probability``: the expected cost until a cycle succeeds.
+    success_probability : float
+        ``P``, per cycle.
+    cycle_cost : float
+        ``E[C] + rho (1 - P)``: the expected cost of one cycle, retry overhead included.
+    reject_probability : float
+        Probability that a cycle ends in a rejection.
+    expected_actions : float
+        Expected number of actions in one cycle.
+    expected_entropy : tuple of float
+        ``expected_entropy[l]``: the expected entropy (bits) of the belief over the states
+        after the reading of action ``l + 1`` (a path that ended earlier keeps its last
+        belief), for ``l`` up to the policy's depth minus one.
+    sensorless_cost : float or None
+        The sensorless Bayes plan's expected cost within ``max_actions`` (one part, when
+        asked for; else ``None``).
+    iterations : int
+        Parametric (Dinkelbach) steps taken.
+    beliefs : int
+        Distinct (belief, actions left) pairs evaluated in the last step.
+    first_angle_exact : bool
+        Every first gripper angle that can be optimal was tried (see the module notes).
+    units : str or None
+        Units of the readings (the parts' units).
+    """
+
+    root: PolicyNode
+    parts: tuple[str, ...]
+    part_prior: tuple[float, ...]
+    sensor: WidthSensor
+    max_actions: int
+    expected_cost: float
+    success_probability: float
+    cycle_cost: float
+    reject_probability: float
+    expected_actions: float
+    expected_entropy: tuple[float, ...]
+    sensorless_cost: float | None = None
+    iterations: int = 1
+    beliefs: int = 0
+    first_angle_exact: bool = True
+    units: str | None = None
+
+    @property
+    def expected_total_actions(self) -> float:
+        """Expected number of actions until a cycle succeeds (``expected_actions / P``)."""
+        return self.expected_actions / self.success_probability
+
+    @property
+    def depth(self) -> int:
+        """Most actions on any path."""
+        return _depth(self.root)
+
+    def leaves(self) -> Iterator[tuple[float, Declare | Reject]]:
+        """Every leaf with the probability of reaching it."""
+        yield from _leaves(self.root, 1.0)
+
+
+def _depth(node: PolicyNode) -> int:
+    return 1 + max(
+        (_depth(b.next) for b in node.branches if isinstance(b.next, PolicyNode)), default=0
+    )
+
+
+def _leaves(node: PolicyNode, p: float) -> Iterator[tuple[float, Declare | Reject]]:
+    for b in node.branches:
+        if isinstance(b.next, PolicyNode):
+            yield from _leaves(b.next, p * b.probability)
+        else:
+            yield p * b.probability, b.next
+
+
+# -- the joint transition ------------------------------------------------------------------
+
+
+def joint_transition(space: StateSpace, kind: str) -> ActionClasses:
+    """Classes of gripper turns of one action kind over the joint states of every part.
+
+    One part: :meth:`Problem.transition`. Several: the common refinement of each part's
+    classes (every part responds to the same turn with its own transfer function);
+    ``transfer[a, i]`` is a joint state index.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry import Part
+    >>> sq = Problem.build(Part.from_points([(0, 0), (1, 0), (1, 1), (0, 1)]))
+    >>> cl = joint_transition(StateSpace.build([sq, sq]), "squeeze")
+    >>> cl.transfer.shape
+    (2, 8)
+    """
+    return cast(ActionClasses, space.memo(("joint", kind), lambda: _joint(space, kind)))
+
+
+def _joint(space: StateSpace, kind: str) -> ActionClasses:
+    pbs = space.problems
+    if len(pbs) == 1:
+        return pbs[0].transition(kind)
+    period = pbs[0].action(kind).gripper_period
+    tol = max(p.states.angle_tol for p in pbs)
+    crit = np.unique(np.concatenate([np.mod(p.transition(kind).lo, period) for p in pbs]))
+    if len(crit) > 1:
+        keep = np.append(True, np.diff(crit) > tol)
+        if period - crit[-1] + crit[0] <= tol:
+            keep[0] = False
+        crit = crit[keep] if keep.any() else crit[:1]
+    lo = crit
+    hi = np.append(crit[1:], crit[0] + period)
+    mid = 0.5 * (lo + hi)
+    cols = []
+    for j, p in enumerate(pbs):
+        # Each part's transfer at the common class's turn (not at its own class's middle,
+        # which may lie a gripper period away and so relabel the states by pi).
+        after = p.transfer(kind)(p.states.stable[None, :] - mid[:, None])  # (A, K)
+        cols.append(nearest_state(p.states, after) + int(space.offsets[j]))
+    return ActionClasses(kind, lo, hi, mid, np.concatenate(cols, axis=1).astype(np.intp))
+
+
+# -- the solver ----------------------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class _Kind:
+    name: str
+    cost: float
+    first_cost: float
+    transfer: IntArray  # (A, N), classes ordered widest first
+    classes: IntArray  # (A,) original class index of each row
+    mid: FloatArray  # (A,)
+    half_width: FloatArray  # (A,)
+    pi_symmetric: bool
+
+
+@dataclass(slots=True)
+class _Solver:
+    space: StateSpace
+    bins: ReadingBins
+    kinds: list[_Kind]
+    verify: float
+    retry: float
+    goal: NDArray[np.bool_]  # (N, N) success matrix
+    goal_is_identity: bool
+    pair_a: IntArray
+    pair_b: IntArray
+    pair_both: NDArray[np.bool_]
+    use_pairs: bool
+    lam: float = 0.0
+    memo: dict[tuple[bytes, int], tuple[float, tuple[Any, ...], float, float]] = field(
+        default_factory=dict
+    )
+
+    @property
+    def c_min(self) -> float:
+        return min(k.cost for k in self.kinds)
+
+    # -- belief arithmetic (rows of unnormalised beliefs in the last axis) -----------
+    def success(self, m: FloatArray) -> tuple[FloatArray, IntArray]:
+        """Best declaration's success mass and its state, for beliefs ``m`` (..., N)."""
+        s = m if self.goal_is_identity else m @ self.goal.T.astype(np.float64)
+        return np.max(s, axis=-1), np.asarray(np.argmax(s, axis=-1), dtype=np.intp)
+
+    def bound(self, m: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Bounds on what any continuation from beliefs ``m`` (..., N) can reach.
+
+        Returns ``U``, the most success mass, and ``r``, the largest share of a pi pair's
+        mass in its likelier state: a declaring leaf of mass ``w`` succeeds with at most
+        ``r w`` (readings keep each pair's split, actions average splits).
+        """
+        total = np.asarray(m.sum(axis=-1), dtype=np.float64)
+        if not self.use_pairs:
+            return total, np.ones_like(total)
+        a, b = m[..., self.pair_a], m[..., self.pair_b]
+        pair = a + b
+        top = np.where(self.pair_both, pair, np.maximum(a, b))
+        share = top / np.maximum(pair, 1e-300)  # 0 where the pair holds no mass
+        return np.asarray(top.sum(axis=-1)), np.asarray(share.max(axis=-1))
+
+    def leaf_value(self, m: FloatArray) -> FloatArray:
+        """Best leaf value (unnormalised) of beliefs ``m`` (..., N)."""
+        total = m.sum(axis=-1)
+        s, _ = self.success(m)
+        lam, v, rho = self.lam, self.verify, self.retry
+        return np.asarray(np.minimum(rho * total, (v + rho) * total - (lam + rho) * s))
+
+    def act_bound(self, m: FloatArray) -> FloatArray:
+        """Lower bound (unnormalised) on acting at least once more from beliefs ``m``.
+
+        The leaves below hold the mass; those that declare hold ``D`` of it and succeed with
+        ``S <= min(U, r D)``, the rest reject: the value is at least
+        ``c_min + rho total + min over D of (v D - (lambda + rho) S)``
+        ``= c_min + rho total + min(0, U (v / r - lambda - rho))``.
+        """
+        total = m.sum(axis=-1)
+        u, r = self.bound(m)
+        lam, v, rho = self.lam, self.verify, self.retry
+        # r = 0 only where there is no mass (then u = 0 too); r >= 1/2 elsewhere.
+        gain = u * (v / np.maximum(r, 0.5) - lam - rho)
+        return np.asarray((self.c_min + rho) * total + np.minimum(0.0, gain))
+
+    def images(self, q: FloatArray, kind: _Kind) -> tuple[FloatArray, IntArray]:
+        """Distinct beliefs after each class of ``kind`` (M, N) and the row of each."""
+        supp = np.flatnonzero(q > 0)
+        t = kind.transfer[:, supp]  # (A, S)
+        _, first = np.unique(t, axis=0, return_index=True)
+        first = np.sort(first)  # widest class of each distinct effect, widest first
+        n = self.space.n_states
+        rows = t[first]
+        m = len(first)
+        idx = (rows + n * np.arange(m)[:, None]).ravel()
+        w = np.broadcast_to(q[supp], rows.shape).ravel()
+        out = np.bincount(idx, weights=w, minlength=m * n).reshape(m, n)
+        return np.asarray(out, dtype=np.float64), np.asarray(first, dtype=np.intp)
+
+    def joint(self, imgs: FloatArray) -> FloatArray:
+        """Joint (belief, reading) masses: (M, B, N)."""
+        return np.asarray(imgs[:, None, :] * self.bins.likelihood.T[None, :, :])
+
+    @staticmethod
+    def key(q: FloatArray) -> bytes:
+        return np.rint(q * _QUANT).astype(np.int64).tobytes()
+
+    # -- the programme -----------------------------------------------------------------
+    def leaf_figures(self, m: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Cycle cost and success mass of the leaf chosen for beliefs ``m`` (..., N).
+
+        Declares unless rejecting is strictly better (as :meth:`value` decides).
+        """
+        total = m.sum(axis=-1)
+        s, _ = self.success(m)
+        lam, v, rho = self.lam, self.verify, self.retry
+        declare = (v + rho) * total - (lam + rho) * s <= rho * total + _EPS * total
+        c = np.where(declare, v * total + rho * (total - s), rho * total)
+        return np.asarray(c), np.asarray(np.where(declare, s, 0.0))
+
+    def best_act(
+        self, imgs: FloatArray, cost: float, r_after: int, best: float
+    ) -> tuple[float, int, float, float]:
+        """Least value of acting into each image (``cost + children``) if below ``best``.
+
+        Returns the value, the image index (-1 when none beats ``best``), and the chosen
+        continuation's cycle cost and success probability (per unit mass).
+        """
+        j = self.joint(imgs)  # (M, B, N)
+        leaf = self.leaf_value(j)  # (M, B): children as leaves
+        ub = cost + leaf.sum(axis=1)
+        if r_after == 0:
+            i = int(np.argmin(ub))
+            if ub[i] < best - _EPS:
+                c, p = self.leaf_figures(j[i])
+                return float(ub[i]), i, cost + float(c.sum()), float(p.sum())
+            return best, -1, math.nan, math.nan
+        pick, pick_c, pick_p = -1, math.nan, math.nan
+        pm = j.sum(axis=2)  # (M, B)
+        act = self.act_bound(j)  # (M, B)
+        lb_child = np.minimum(leaf, act)
+        lb = cost + lb_child.sum(axis=1)
+        # A child whose leaf is no worse than acting's bound is a leaf (as `value` decides).
+        settled = leaf <= act + _EPS * pm
+        for i in np.argsort(ub, kind="stable"):
+            if lb[i] >= best - _EPS:
+                continue
+            done = settled[i]
+            total = cost + float(leaf[i, done].sum())
+            rest = float(lb_child[i, ~done].sum())
+            if total + rest >= best - _EPS:
+                continue
+            lc, lp = self.leaf_figures(j[i, done])
+            c_sum, p_sum = cost + float(lc.sum()), float(lp.sum())
+            aborted = False
+            for b in np.flatnonzero((pm[i] > 0) & ~done):
+                rest -= float(lb_child[i, b])
+                pb = float(pm[i, b])
+                val, cv, pv = self.value(j[i, b] / pb, r_after)
+                total += pb * val
+                c_sum += pb * cv
+                p_sum += pb * pv
+                if total + rest >= best - _EPS:
+                    aborted = True
+                    break
+            if not aborted and total < best - _EPS:
+                best, pick, pick_c, pick_p = total, int(i), c_sum, p_sum
+        return best, pick, pick_c, pick_p
+
+    def value(self, q: FloatArray, r: int) -> tuple[float, float, float]:
+        """``V(q, r)`` per unit mass (``q`` normalised), with its cycle cost and success.
+
+        Memoised with the decision that reaches it.
+        """
+        k = (self.key(q), r)
+        hit = self.memo.get(k)
+        if hit is not None:
+            return hit[0], hit[2], hit[3]
+        s, o = self.success(q)
+        lam, v, rho = self.lam, self.verify, self.retry
+        sf = float(s)
+        declare = v + rho - (lam + rho) * sf
+        best: float
+        decision: tuple[Any, ...]
+        if declare <= rho + _EPS:
+            best, decision, c, p = declare, ("declare", int(o)), v + rho * (1 - sf), sf
+        else:
+            best, decision, c, p = rho, ("reject",), rho, 0.0
+        if r > 0 and best > float(self.act_bound(q)) + _EPS:
+            for ti, kind in enumerate(self.kinds):
+                imgs, rows = self.images(q, kind)
+                val, i, ci, pi = self.best_act(imgs, kind.cost, r - 1, best)
+                if i >= 0:
+                    best, decision, c, p = val, ("act", ti, int(rows[i])), ci, pi
+        self.memo[k] = (best, decision, c, p)
+        return best, c, p
+
+    def decision(self, q: FloatArray, r: int) -> tuple[Any, ...]:
+        k = (self.key(q), r)
+        if k not in self.memo:
+            self.value(q, r)
+        return self.memo[k][1]
+
+
+# -- building the tree and its figures -----------------------------------------------------
+
+
+@dataclass(slots=True)
+class _Tally:
+    success: float = 0.0
+    action_cost: float = 0.0
+    verify_cost: float = 0.0
+    reject: float = 0.0
+    actions: float = 0.0
+    entropy: list[float] = field(default_factory=list)
+
+    def add_entropy(self, level: int, w: float, h: float) -> None:
+        """Entropy ``h`` of a belief of mass ``w`` after ``level`` readings, acted on."""
+        while len(self.entropy) < level:
+            self.entropy.append(0.0)
+        self.entropy[level - 1] += w * h
+
+
+@dataclass(slots=True)
+class _Builder:
+    solver: _Solver
+    max_actions: int
+    tally: _Tally = field(default_factory=_Tally)
+    leaves_at: list[tuple[int, float, float]] = field(default_factory=list)
+
+    def turn(self, kind: _Kind, alpha: float, carry: float) -> tuple[float, float]:
+        """The turn to command and the carry it leaves (see ``bfs._short_turns``).
+
+        A gripper with a pi-symmetric action turned by pi is the same gripper; the part then
+        lies pi further round in its frame, which later turns and the declared orientation
+        absorb.
+        """
+        a = wrap(alpha + carry)
+        if kind.pi_symmetric:
+            short = wrap_period(a, math.pi)
+            return short, a - short
+        return a, 0.0
+
+    def node(
+        self,
+        kind: _Kind,
+        alpha: float,
+        margin: float,
+        img: FloatArray,
+        mass: float,
+        r_after: int,
+        carry: float,
+        level: int,
+        first: bool,
+    ) -> PolicyNode:
+        """An action node whose action leaves the (normalised) belief ``img``."""
+        t = self.tally
+        t.actions += mass
+        t.action_cost += mass * (kind.first_cost if first else kind.cost)
+        turn, carry = self.turn(kind, alpha, carry)
+        lik = self.solver.bins.likelihood
+        joint = img[:, None] * lik  # (N, B)
+        p = joint.sum(axis=0)
+        kept = np.flatnonzero(p > 0)
+        raw: list[tuple[float, PolicyNode | Declare | Reject]] = []
+        for b in kept:
+            pb = float(p[b])
+            q = joint[:, b] / pb
+            raw.append((pb, self.after(q, mass * pb, r_after, carry, level)))
+        lo = [-math.inf, *(float(self.solver.bins.lo[b]) for b in kept[1:])]
+        hi = [*lo[1:], math.inf]
+        branches = _merge_leaves([Branch(lo[i], hi[i], pb, nxt) for i, (pb, nxt) in enumerate(raw)])
+        return PolicyNode(PlanStep(kind.name, turn), tuple(branches), margin)
+
+    def after(
+        self, q: FloatArray, mass: float, r: int, carry: float, level: int
+    ) -> PolicyNode | Declare | Reject:
+        """The subtree after a reading that leaves the belief ``q`` (mass ``mass``)."""
+        s = self.solver
+        h = entropy_bits(q)
+        dec = s.decision(q, r)
+        t = self.tally
+        if dec[0] == "act":
+            t.add_entropy(level, mass, h)
+            kind = s.kinds[dec[1]]
+            row = dec[2]
+            mapped = np.bincount(kind.transfer[row], weights=q, minlength=len(q))
+            return self.node(
+                kind,
+                float(kind.mid[row]),
+                float(kind.half_width[row]),
+                np.asarray(mapped, dtype=np.float64),
+                mass,
+                r - 1,
+                carry,
+                level + 1,
+                False,
+            )
+        self.leaves_at.append((level, mass, h))
+        if dec[0] == "reject":
+            t.reject += mass
+            return Reject()
+        o = int(dec[1])
+        succ = float(q[s.goal[o]].sum())
+        t.success += mass * succ
+        t.verify_cost += mass * s.verify
+        part, theta = s.space.stable(o)
+        orientation = float(np.mod(theta + carry, TWO_PI))
+        if orientation >= TWO_PI:  # pragma: no cover - rounding
+            orientation = 0.0
+        return Declare(part, s.space.names[part], orientation, succ)
+
+
+def _merge_leaves(branches: list[Branch]) -> list[Branch]:
+    """Join neighbouring branches that end in the same leaf (same declaration, or reject)."""
+    out: list[Branch] = []
+    for b in branches:
+        if out and _same_leaf(out[-1].next, b.next):
+            prev = out[-1]
+            p = prev.probability + b.probability
+            nxt: PolicyNode | Declare | Reject = prev.next
+            if isinstance(prev.next, Declare) and isinstance(b.next, Declare):
+                q = (
+                    prev.probability * prev.next.success_probability
+                    + b.probability * b.next.success_probability
+                ) / p
+                nxt = Declare(prev.next.part, prev.next.part_name, prev.next.orientation, q)
+            out[-1] = Branch(prev.lo, b.hi, p, nxt)
+        else:
+            out.append(b)
+    return out
+
+
+def _same_leaf(a: object, b: object) -> bool:
+    if isinstance(a, Reject) and isinstance(b, Reject):
+        return True
+    if isinstance(a, Declare) and isinstance(b, Declare):
+        return a.part == b.part and abs(wrap(a.orientation - b.orientation)) < 1e-12
+    return False
+
+
+# -- the planner ---------------------------------------------------------------------------
+
+
+def _first_angles(
+    space: StateSpace, kinds: Sequence[str], max_first_angles: int
+) -> tuple[list[float], bool]:
+    """Candidate world angles of the first action, and whether they are all that can matter."""
+    prior = space.problems[0].prior
+    if isinstance(prior, UniformPrior):
+        return [0.0], True
+    bp = np.mod(np.asarray(prior.breakpoints, dtype=np.float64), TWO_PI)
+    bounds = np.concatenate([p.transfer(k).boundaries for p in space.problems for k in kinds])
+    cand = np.unique(np.mod((bp[:, None] - bounds[None, :]).ravel(), TWO_PI))
+    if isinstance(prior, SamplePrior) and len(cand):
+        nxt = np.append(cand[1:], cand[0] + TWO_PI)
+        cand = np.mod(0.5 * (cand + nxt), TWO_PI)
+    if 0 < len(cand) <= max_first_angles:
+        return [float(c) for c in cand], True
+    from .exact import plan_exact
+
+    angles = set(np.round(np.linspace(0.0, TWO_PI, 360, endpoint=False), 12).tolist())
+    for p in space.problems:
+        angles.update(o.first_angle for o in plan_exact(p).options)
+    return sorted(float(a) for a in angles), False
+
+
+def _pairs(space: StateSpace) -> tuple[IntArray, IntArray, NDArray[np.bool_], bool]:
+    """The pi pairs of each part's states (each once), and whether they are all pairs."""
+    pa: list[int] = []
+    pb: list[int] = []
+    ok = True
+    for j, p in enumerate(space.problems):
+        s = p.states.stable
+        k = len(s)
+        if k % 2 or not np.all(
+            circle_distance(np.roll(s, -k // 2), s + math.pi) < 1e3 * p.states.angle_tol
+        ):
+            ok = False
+            break
+        o = int(space.offsets[j])
+        pa.extend(o + i for i in range(k // 2))
+        pb.extend(o + i + k // 2 for i in range(k // 2))
+    a = np.asarray(pa, dtype=np.intp)
+    b = np.asarray(pb, dtype=np.intp)
+    both = space.success_matrix()[a, b] if ok else np.zeros(0, dtype=bool)
+    return a, b, np.asarray(both, dtype=bool), ok
+
+
+def plan_policy(
+    problems: Problem | Iterable[Problem],
+    sensor: str | WidthSensor = "width",
+    max_actions: int = _DEFAULT_MAX_ACTIONS,
+    *,
+    part_prior: str | Sequence[float] | None = None,
+    first_angles: Sequence[float] | None = None,
+    max_first_angles: int = 512,
+    max_iterations: int = 50,
+    sensorless: bool = True,
+) -> Policy:
+    """The Bayes policy: least expected cost over all policies of at most ``max_actions``.
+
+    See the module notes for the cost semantics and the algorithm.
+
+    Parameters
+    ----------
+    problems : Problem or iterable of Problem
+        One problem, or one per candidate part (recognition). The actions, the cost model,
+        the orientation prior and the goal of the first are used for all (each part has its
+        own states, transfers and widths).
+    sensor : str or WidthSensor
+        ``"width"`` (exact), ``"width:SIGMA,RES"`` (part units), or a :class:`WidthSensor`.
+    max_actions : int
+        At most this many actions on any path (>= 1; default 3).
+    part_prior : str or sequence of float, optional
+        Prior weights of the candidate parts (default equal).
+    first_angles : sequence of float, optional
+        World gripper angles to try for the first action (default: see the module notes).
+    max_first_angles : int
+        Largest number of candidate first angles tried exhaustively.
+    max_iterations : int
+        Most parametric steps.
+    sensorless : bool
+        Also plan the sensorless Bayes plan (one part; :func:`plan_exact` within
+        ``max_actions``): its cost is reported (``Policy.sensorless_cost``) and starts the
+        parametric search. ``False`` skips it (faster when the caller has it already).
+
+    Returns
+    -------
+    Policy
+
+    Raises
+    ------
+    SensorError
+        On a bad sensor or part prior.
+    PlanningError
+        If ``max_actions < 1``, the problems' actions differ, or a problem has a gripper
+        ``accuracy`` (the planner assumes exact turns).
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.model import Problem
+    >>> sq = Problem.build(Part.from_points([(0, 0), (1, 0), (1, 1), (0, 1)]))
+    >>> round(plan_policy(sq, "width", 2).expected_cost, 6)  # all widths equal: no help
+    8.0
+    """
+    sens = parse_sensor(sensor)
+    if isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1:
+        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
+    space = StateSpace.build(problems, part_prior)
+    main = space.problems[0]
+    if any(p.accuracy > 0 for p in space.problems):
+        raise PlanningError(
+            "the policy planner assumes exact gripper turns: the problem's `accuracy` must be "
+            f"0; got {max(p.accuracy for p in space.problems)!r} rad"
+        )
+    cost = main.cost
+    kinds: list[_Kind] = []
+    for action in main.actions:
+        cl = joint_transition(space, action.name)
+        order = np.argsort(-(cl.hi - cl.lo), kind="stable")
+        kinds.append(
+            _Kind(
+                action.name,
+                cost.action_cost(action.name),
+                cost.action_cost(action.name, first=True),
+                np.ascontiguousarray(cl.transfer[order]),
+                np.asarray(order, dtype=np.intp),
+                cl.mid[order],
+                0.5 * (cl.hi - cl.lo)[order],
+                math.isclose(action.gripper_period, math.pi),
+            )
+        )
+    goal = space.success_matrix()
+    pa, pb, both, paired = _pairs(space)
+    solver = _Solver(
+        space,
+        space.bins(sens),
+        kinds,
+        cost.verify,
+        cost.retry,
+        goal,
+        bool(np.array_equal(goal, np.eye(space.n_states, dtype=bool))),
+        pa,
+        pb,
+        both,
+        paired and all(k.pi_symmetric for k in kinds),
+    )
+    if first_angles is not None:
+        angles = [float(a) for a in first_angles]
+        if not angles or not all(math.isfinite(a) for a in angles):
+            raise PlanningError(
+                f"`first_angles` must be a non-empty list of finite angles; got {first_angles!r}"
+            )
+        angles_exact = False
+    else:
+        angles, angles_exact = _first_angles(space, main.action_kinds, max_first_angles)
+    roots = np.array(
+        [space.initial(k.name, a) for k in kinds for a in angles]
+    )  # (R, N), kind-major
+    root_kind = [ti for ti in range(len(kinds)) for _ in angles]
+    root_angle = [a for _ in kinds for a in angles]
+
+    # A known policy's ratio starts the parametric search: one action then declare the
+    # likeliest state on every reading, or the sensorless Bayes plan (one part).
+    sensorless_cost: float | None = None
+    if sensorless and space.n_parts == 1:
+        from .exact import plan_exact
+
+        sensorless_cost = plan_exact(main, max_actions=max_actions).bayes_plan.expected_cost
+    joint = solver.joint(roots)  # (R, B, N)
+    s, _ = solver.success(joint)
+    p_succ = s.sum(axis=1)
+    c = np.array([kinds[ti].first_cost for ti in root_kind]) + cost.verify
+    ratios = (c + cost.retry * (1 - p_succ)) / p_succ
+    lam = float(np.min(ratios))
+    if sensorless_cost is not None and math.isfinite(sensorless_cost):
+        lam = min(lam, sensorless_cost)
+
+    def solve(lam: float) -> tuple[float, int, float]:
+        """``h(lambda)``, the best root, and the ratio of the policy that reaches it."""
+        solver.lam = lam
+        solver.memo.clear()
+        h, pick, ratio = math.inf, -1, math.inf
+        for ri in range(len(roots)):
+            k = kinds[root_kind[ri]]
+            val, i, c, p = solver.best_act(roots[ri : ri + 1], k.first_cost, max_actions - 1, h)
+            if i >= 0:
+                h, pick, ratio = val, ri, (c / p if p > 0 else math.inf)
+        return h, pick, ratio
+
+    best_lam, best_ratio, best_pick = lam, math.inf, -1
+    it = 0
+    for it in range(1, max_iterations + 1):
+        h, pick, ratio = solve(lam)
+        logger.debug(
+            "policy step %d: lambda %.12g, h %.3g, ratio %.12g, %d beliefs",
+            it,
+            lam,
+            h,
+            ratio,
+            len(solver.memo),
+        )
+        improved = ratio < best_ratio
+        if improved:
+            best_lam, best_ratio, best_pick = lam, ratio, pick
+        if h >= -_EPS * max(1.0, abs(lam)) or not improved:
+            break
+        lam = ratio
+    if solver.lam != best_lam:
+        _, best_pick, _ = solve(best_lam)
+    builder = _Builder(solver, max_actions)
+    k = kinds[root_kind[best_pick]]
+    root = builder.node(
+        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
+    )
+    return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+
+
+def _finish(
+    builder: _Builder,
+    root: PolicyNode,
+    space: StateSpace,
+    sensor: WidthSensor,
+    max_actions: int,
+    sensorless: float | None,
+    iterations: int,
+    angles_exact: bool,
+) -> Policy:
+    t = builder.tally
+    depth = _depth(root)
+    ent = [0.0] * depth
+    # Entropy after each level: paths that stopped earlier keep their last belief.
+    level_mass = [0.0] * depth
+    for lv, w, h in builder.leaves_at:
+        for x in range(lv, depth + 1):
+            ent[x - 1] += w * h
+            level_mass[x - 1] += w
+    for x, e in enumerate(t.entropy[:depth]):
+        ent[x] += e
+    p = t.success
+    rho = space.problems[0].cost.retry
+    cycle = t.action_cost + t.verify_cost + rho * (1.0 - p)
+    expected = cycle / p if p > 0 else math.inf
+    units = space.problems[0].part.units
+    return Policy(
+        root,
+        space.names,
+        tuple(float(w) for w in space.part_prior),
+        sensor,
+        max_actions,
+        expected,
+        p,
+        cycle,
+        t.reject,
+        t.actions,
+        tuple(ent),
+        sensorless,
+        iterations,
+        len(builder.solver.memo),
+        angles_exact,
+        units,
+    )
+
+
+# -- presentation --------------------------------------------------------------------------
+
+
+def policy_text(policy: Policy, units: str | None = None, digits: int = 2) -> str:
+    """The policy as an indented tree a person can follow (angles in degrees).
+
+    Parameters
+    ----------
+    policy : Policy
+    units : str, optional
+        Units of the readings (default: the policy's, else none).
+    digits : int
+        Decimals of readings and angles.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.model import Problem
+    >>> rect = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)], units="mm"))
+    >>> print(policy_text(plan_policy(rect, "width", 2)))
+    squeeze with the gripper at 0.00 deg
+      if the width reads in [-inf, 1.50) mm (p = 0.70): declare 90.00 deg (success 0.50)
+      if the width reads in [1.50, inf) mm (p = 0.30): declare 0.00 deg (success 0.50)
+    """
+    u = policy.units if units is None else units
+    unit = f" {u}" if u else ""
+    lines: list[str] = []
+    several = len(policy.parts) > 1
+
+    def num(x: float) -> str:
+        return "-inf" if x == -math.inf else "inf" if x == math.inf else f"{x:.{digits}f}"
+
+    def leaf(x: Declare | Reject) -> str:
+        if isinstance(x, Reject):
+            return "reject (back to the feeder)"
+        what = f"{math.degrees(x.orientation):.{digits}f} deg"
+        if several:
+            what = f"part {x.part_name!r} at {what}"
+        return f"declare {what} (success {x.success_probability:.{digits}f})"
+
+    def walk(node: PolicyNode, depth: int, first: bool) -> None:
+        pad = "  " * depth
+        ang = f"{math.degrees(node.step.alpha):.{digits}f} deg"
+        if first:
+            lines.append(f"{pad}{node.step.kind} with the gripper at {ang}")
+        else:
+            lines.append(f"{pad}turn {ang}, {node.step.kind}")
+        for b in node.branches:
+            cond = (
+                f"{pad}  if the width reads in [{num(b.lo)}, {num(b.hi)}){unit} "
+                f"(p = {b.probability:.{digits}f})"
+            )
+            if isinstance(b.next, PolicyNode):
+                lines.append(cond + ":")
+                walk(b.next, depth + 2, False)
+            else:
+                lines.append(f"{cond}: {leaf(b.next)}")
+
+    walk(policy.root, 0, True)
+    return "\n".join(lines)
