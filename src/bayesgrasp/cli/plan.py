@@ -21,6 +21,33 @@ GuaranteedOpt = Annotated[
         "(up to the transfer functions' period).",
     ),
 ]
+SenseOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--sense",
+        metavar="width[:SIGMA,RES]",
+        help="Plan a policy that branches on the jaw width read after each action: exact "
+        "readings (width), or read as RES * round((d + e) / RES), e ~ Normal(0, SIGMA^2), in "
+        "the part's units.",
+    ),
+]
+AlsoOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--also",
+        metavar="PART",
+        help="With --sense: another candidate part (repeat it); the policy also tells them apart.",
+    ),
+]
+PartPriorOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--part-prior", metavar="W1,W2,...", help="With --sense: weights of PART and each --also."
+    ),
+]
+MaxActionsOpt = Annotated[
+    int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
+]
 PlotOpt = Annotated[
     Path | None,
     typer.Option(
@@ -41,11 +68,24 @@ def plan(
     guaranteed: GuaranteedOpt = False,
     as_json: JsonOpt = False,
     plot_file: PlotOpt = None,
+    sense: SenseOpt = None,
+    also: AlsoOpt = None,
+    part_prior: PartPriorOpt = None,
+    max_actions: MaxActionsOpt = 3,
 ) -> None:
-    """Best squeeze plan of every length, the Bayes plan and the most certain plan."""
+    """Best squeeze plan of every length, the Bayes plan and the most certain plan.
+
+    With --sense: the policy of least expected cost that branches on the jaw widths read
+    after each action (and tells the candidate parts apart), beside the sensorless Bayes plan.
+    """
     from .. import report
     from ..io.plans import plan_document
 
+    if sense is not None:
+        _policy(part, spec, sense, also or [], part_prior, max_actions, as_json)
+        return
+    if also or part_prior is not None:
+        raise typer.BadParameter("--also and --part-prior need --sense")
     if plot_file is not None:
         check_figure_path(plot_file)
     pb = spec.build(part.load())
@@ -67,3 +107,36 @@ def plan(
         typer.echo(f"bayesgrasp: wrote {plot_file}", err=True)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)
+
+
+def _policy(
+    part: PartSpec,
+    spec: ProblemSpec,
+    sense: str,
+    also: list[str],
+    part_prior: str | None,
+    max_actions: int,
+    as_json: bool,
+) -> None:
+    """Plan and print a sensing policy over PART and the --also parts."""
+    import dataclasses
+
+    from ..io.policies import policy_document
+    from ..planning.policy import plan_policy, policy_text
+
+    parts = [part.load(), *(dataclasses.replace(part, part=p).load() for p in also)]
+    problems = [spec.build(p) for p in parts]
+    pol = plan_policy(problems, sensor=sense, max_actions=max_actions, part_prior=part_prior)
+    if as_json:
+        emit_json(policy_document(pol))
+    else:
+        typer.echo(policy_text(pol, units=parts[0].units))
+        entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
+        blind = pol.sensorless_cost
+        versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
+        typer.echo(
+            f"expected cost {pol.expected_cost:.4f}{versus}, "
+            f"success {pol.success_probability:.4f} a cycle, "
+            f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
+            f"(bits): {entropy}"
+        )
