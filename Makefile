@@ -5,7 +5,10 @@ BIN := $(VENV)/bin
 STAMP_RUN := $(VENV)/.installed-run
 STAMP_DEV := $(VENV)/.installed-dev
 
-.PHONY: demo test lint bench clean
+CHROMIUM := /usr/bin/chromium
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
+.PHONY: demo test lint bench clean browser-deps
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -21,13 +24,19 @@ $(STAMP_DEV): pyproject.toml | $(BIN)/python
 
 demo: $(STAMP_RUN)
 	$(BIN)/bayesgrasp demo
+	@echo "The web page: $(BIN)/bayesgrasp serve, then open http://127.0.0.1:8000/"
 
 lint: $(STAMP_DEV)
 	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/ruff format --check src tests benchmarks
 	$(BIN)/mypy src
 
-test: lint
+# The browser tests drive Debian's chromium (tests/web/test_browser.py skips them, saying why,
+# where it cannot be installed).
+browser-deps:
+	@test -x $(CHROMIUM) || { command -v apt-get >/dev/null && $(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; } || echo "bayesgrasp: could not install chromium; the browser tests will be skipped"
+
+test: lint browser-deps
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP_RUN)

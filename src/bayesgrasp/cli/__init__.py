@@ -32,6 +32,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "plot": ("plot", "Figures of a part and a plan, and the plan's animation."),
     "simulate": ("simulate", "Execute a plan many times; compare with the prediction."),
     "sweep": ("sweep", "Plan every part of a catalogue on Dask; one row a part."),
+    "serve": ("serve", "The web page and the JSON API on localhost (extra `web`)."),
     "table1": ("paper", "The seed's Table 1 beside our expected costs."),
     "study": ("paper", "The seed's study: random polygons planned and counted."),
     "demo": ("paper", "The main job: Table 1, then the example part planned."),

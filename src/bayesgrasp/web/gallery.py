@@ -1,0 +1,154 @@
+"""The gallery: the parts planned on this server, kept in SQLite, bounded in rows.
+
+One row a distinct (part, options) pair: its name, hull vertices, the options it was planned
+with and the Bayes plan's numbers. Planning the same pair again only refreshes its time; when
+there are more than ``max_rows`` rows the oldest go.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import sqlite3
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+__all__ = ["DEFAULT_MAX_ROWS", "Gallery", "default_data_dir"]
+
+DEFAULT_MAX_ROWS = 500
+"""Rows the gallery keeps by default."""
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS parts (
+    key TEXT PRIMARY KEY,
+    name TEXT NOT NULL,
+    vertices TEXT NOT NULL,
+    options TEXT NOT NULL,
+    success_probability REAL,
+    expected_cost REAL,
+    squeezes INTEGER,
+    updated REAL NOT NULL
+)
+"""
+
+
+def default_data_dir() -> Path:
+    """The user data folder: platformdirs' when installed, else ``$XDG_DATA_HOME/bayesgrasp``.
+
+    Examples
+    --------
+    >>> default_data_dir().name
+    'bayesgrasp'
+    """
+    try:
+        from platformdirs import user_data_dir
+    except ImportError:
+        base = os.environ.get("XDG_DATA_HOME") or str(Path.home() / ".local" / "share")
+        return Path(base) / "bayesgrasp"
+    return Path(user_data_dir("bayesgrasp", appauthor=False))
+
+
+class Gallery:
+    """The gallery database ``gallery.sqlite3`` in a data folder.
+
+    Parameters
+    ----------
+    data_dir : str or Path
+        Folder of the database (created).
+    max_rows : int
+        Most rows kept (the oldest go first).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> g = Gallery(tempfile.mkdtemp(), max_rows=1)
+    >>> g.add("a", [[0, 0], [1, 0], [0, 1]], {}, {"success_probability": 1.0})
+    >>> g.add("b", [[0, 0], [2, 0], [0, 1]], {}, {"success_probability": 1.0})
+    >>> [row["name"] for row in g.rows()]
+    ['b']
+    """
+
+    def __init__(self, data_dir: str | Path, max_rows: int = DEFAULT_MAX_ROWS) -> None:
+        if max_rows < 1:
+            raise ValueError(f"`max_rows` must be at least 1; got {max_rows}")
+        self.path = Path(data_dir) / "gallery.sqlite3"
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.max_rows = max_rows
+        self._lock = threading.Lock()
+        with self._connect() as db:
+            db.execute("PRAGMA journal_mode=WAL")  # readers do not wait for the writer
+            db.execute(_SCHEMA)
+
+    @contextlib.contextmanager
+    def _connect(self) -> Iterator[sqlite3.Connection]:
+        """A connection in a transaction (committed on success), closed afterwards."""
+        db = sqlite3.connect(self.path, timeout=10)
+        db.execute("PRAGMA synchronous=NORMAL")  # a lost last row on power loss is fine
+        try:
+            with db:
+                yield db
+        finally:
+            db.close()
+
+    def add(
+        self,
+        name: str,
+        vertices: list[list[float]],
+        options: dict[str, Any],
+        bayes: dict[str, Any],
+    ) -> None:
+        """Record a planned part (or refresh its time), then drop rows beyond ``max_rows``."""
+        verts = json.dumps(vertices, separators=(",", ":"))
+        opts = json.dumps(options, sort_keys=True, separators=(",", ":"))
+        key = hashlib.sha256(f"{verts}\n{opts}".encode()).hexdigest()
+        row = (
+            key,
+            name[:80],
+            verts,
+            opts,
+            bayes.get("success_probability"),
+            bayes.get("expected_cost"),
+            bayes.get("squeezes"),
+            time.time(),
+        )
+        with self._lock, self._connect() as db:
+            db.execute("INSERT OR REPLACE INTO parts VALUES (?, ?, ?, ?, ?, ?, ?, ?)", row)
+            db.execute(
+                "DELETE FROM parts WHERE key NOT IN "
+                "(SELECT key FROM parts ORDER BY updated DESC, rowid DESC LIMIT ?)",
+                (self.max_rows,),
+            )
+
+    def rows(self, limit: int | None = None) -> list[dict[str, Any]]:
+        """The rows, newest first (at most ``limit``)."""
+        n = self.max_rows if limit is None else max(0, min(limit, self.max_rows))
+        with self._lock, self._connect() as db:
+            cur = db.execute(
+                "SELECT key, name, vertices, options, success_probability, expected_cost, "
+                "squeezes, updated FROM parts ORDER BY updated DESC, rowid DESC LIMIT ?",
+                (n,),
+            )
+            found = cur.fetchall()
+        return [
+            {
+                "id": key[:16],
+                "name": name,
+                "vertices": json.loads(verts),
+                "options": json.loads(opts),
+                "success_probability": p,
+                "expected_cost": c,
+                "squeezes": k,
+                "updated": t,
+            }
+            for key, name, verts, opts, p, c, k, t in found
+        ]
+
+    def __len__(self) -> int:
+        with self._lock, self._connect() as db:
+            (n,) = db.execute("SELECT COUNT(*) FROM parts").fetchone()
+        return int(n)

@@ -1,0 +1,568 @@
+// bayesgrasp page: plain JavaScript, no build step. State lives in the URL hash.
+"use strict";
+
+const API = "/api/v1";
+const SVGNS = "http://www.w3.org/2000/svg";
+const GRID = 20; // canvas pixels a grid cell
+const UNIT = 5; // part units (mm) a grid cell
+const SIZE = 400;
+const TWO_PI = 2 * Math.PI;
+const deg = (r) => (r * 180) / Math.PI;
+
+const state = {
+  vertices: [], // drawn or pasted [[x, y], ...] in part units
+  catalogue: "",
+  file: null, // {format, data_base64, name}
+  name: "drawn",
+  last: null, // {plan, squeeze, push}
+};
+
+const $ = (id) => document.getElementById(id);
+
+function el(tag, attrs, parent) {
+  const e = document.createElementNS(SVGNS, tag);
+  for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+  if (parent) parent.appendChild(e);
+  return e;
+}
+
+function setStatus(text, error) {
+  const s = $("status");
+  s.textContent = text;
+  s.className = error ? "error" : "";
+}
+
+// ---- drawing ---------------------------------------------------------------------------
+
+const toPart = (px, py) => [(px / GRID) * UNIT, ((SIZE - py) / GRID) * UNIT];
+const toCanvas = (x, y) => [(x / UNIT) * GRID, SIZE - (y / UNIT) * GRID];
+
+function canvasPoint(evt) {
+  const svg = $("canvas");
+  const r = svg.getBoundingClientRect();
+  let px = ((evt.clientX - r.left) * SIZE) / r.width;
+  let py = ((evt.clientY - r.top) * SIZE) / r.height;
+  if ($("snap").checked) {
+    px = Math.round(px / GRID) * GRID;
+    py = Math.round(py / GRID) * GRID;
+  }
+  return toPart(px, py).map((v) => Math.round(v * 1000) / 1000);
+}
+
+function hull(points) {
+  // Andrew's monotone chain (counter-clockwise); drawing only, the server computes its own.
+  const p = points.map((q) => q.slice()).sort((a, b) => a[0] - b[0] || a[1] - b[1]);
+  if (p.length < 3) return p;
+  const cross = (o, a, b) => (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+  const lower = [];
+  for (const q of p) {
+    while (lower.length >= 2 && cross(lower[lower.length - 2], lower[lower.length - 1], q) <= 0)
+      lower.pop();
+    lower.push(q);
+  }
+  const upper = [];
+  for (const q of p.slice().reverse()) {
+    while (upper.length >= 2 && cross(upper[upper.length - 2], upper[upper.length - 1], q) <= 0)
+      upper.pop();
+    upper.push(q);
+  }
+  return lower.slice(0, -1).concat(upper.slice(0, -1));
+}
+
+let undoStack = [];
+let dragging = -1;
+
+function drawCanvas() {
+  const svg = $("canvas");
+  svg.replaceChildren();
+  for (let i = 0; i <= SIZE; i += GRID) {
+    el("line", { x1: i, y1: 0, x2: i, y2: SIZE, class: "grid" }, svg);
+    el("line", { x1: 0, y1: i, x2: SIZE, y2: i, class: "grid" }, svg);
+  }
+  const pts = state.vertices.map((v) => toCanvas(v[0], v[1]));
+  if (pts.length >= 2) el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "poly" }, svg);
+  if (pts.length >= 3) {
+    const h = hull(state.vertices).map((v) => toCanvas(v[0], v[1]));
+    el("polygon", { points: h.map((p) => p.join(",")).join(" "), class: "hull" }, svg);
+  }
+  pts.forEach((p, i) => {
+    const c = el("circle", { cx: p[0], cy: p[1], r: 6, class: "vertex", "data-index": i }, svg);
+    c.addEventListener("pointerdown", (evt) => {
+      evt.stopPropagation();
+      undoStack.push(state.vertices.map((v) => v.slice()));
+      dragging = i;
+      svg.setPointerCapture(evt.pointerId);
+    });
+  });
+  $("coords").value = state.vertices.map((v) => `${v[0]}, ${v[1]}`).join("\n");
+}
+
+function setupCanvas() {
+  const svg = $("canvas");
+  svg.addEventListener("pointerdown", (evt) => {
+    undoStack.push(state.vertices.map((v) => v.slice()));
+    useVertices(state.vertices.concat([canvasPoint(evt)]), "drawn");
+  });
+  svg.addEventListener("pointermove", (evt) => {
+    if (dragging < 0) return;
+    state.vertices[dragging] = canvasPoint(evt);
+    drawCanvas();
+  });
+  svg.addEventListener("pointerup", () => {
+    if (dragging >= 0) {
+      dragging = -1;
+      useVertices(state.vertices, state.name);
+    }
+  });
+  $("undo").addEventListener("click", () => {
+    if (undoStack.length) useVertices(undoStack.pop(), state.name);
+  });
+  $("clear").addEventListener("click", () => {
+    undoStack.push(state.vertices.map((v) => v.slice()));
+    useVertices([], "drawn");
+  });
+  $("use-coords").addEventListener("click", () => {
+    const pts = [];
+    for (const line of $("coords").value.split(/\n|;/)) {
+      const nums = line.split(/[\s,]+/).filter((s) => s.length).map(Number);
+      if (nums.length === 0) continue;
+      if (nums.length !== 2 || nums.some((n) => !Number.isFinite(n))) {
+        setStatus(`cannot read the line ${JSON.stringify(line)}: expected x, y`, true);
+        return;
+      }
+      pts.push(nums);
+    }
+    undoStack.push(state.vertices.map((v) => v.slice()));
+    useVertices(pts, "pasted");
+  });
+}
+
+function useVertices(vertices, name) {
+  state.vertices = vertices;
+  state.catalogue = "";
+  state.file = null;
+  state.name = name || "drawn";
+  $("catalogue").value = "";
+  drawCanvas();
+  schedule();
+}
+
+// ---- options and the URL ---------------------------------------------------------------
+
+function options() {
+  const prior =
+    $("prior-kind").value === "vonmises"
+      ? `vonmises:${Number($("prior-mean").value)},${Number($("prior-kappa").value)}`
+      : "uniform";
+  const actions = ["squeeze", "push-grasp"].filter((a) => $(`act-${a}`).checked);
+  const o = {
+    prior,
+    actions: actions.join(",") || "squeeze",
+    costs: { squeeze: Number($("cost-squeeze").value), "push-grasp": Number($("cost-push-grasp").value) },
+    verify_cost: Number($("cost-verify").value),
+    retry_cost: Number($("cost-retry").value),
+    accuracy: Number($("accuracy").value),
+    goal: $("goal").value,
+    method: $("method").value,
+  };
+  if ($("max-actions").value) o.max_actions = Number($("max-actions").value);
+  return o;
+}
+
+function partBody() {
+  if (state.catalogue) return { catalogue: state.catalogue };
+  if (state.file) return { file: { format: state.file.format, data_base64: state.file.data_base64 }, name: state.file.name };
+  return { vertices: state.vertices, name: state.name };
+}
+
+function writeHash() {
+  const q = new URLSearchParams();
+  if (state.catalogue) q.set("part", state.catalogue);
+  else if (state.vertices.length) q.set("v", state.vertices.map((v) => v.join(",")).join(";"));
+  const o = options();
+  q.set("prior", o.prior);
+  q.set("actions", o.actions);
+  for (const k of ["verify_cost", "retry_cost", "accuracy", "goal", "method", "max_actions"])
+    if (o[k] !== undefined) q.set(k, o[k]);
+  q.set("squeeze_cost", o.costs.squeeze);
+  q.set("push_grasp_cost", o.costs["push-grasp"]);
+  window.history.replaceState(null, "", "#" + q.toString());
+}
+
+function readHash() {
+  const q = new URLSearchParams(window.location.hash.slice(1));
+  const prior = q.get("prior") || "uniform";
+  if (prior.startsWith("vonmises:")) {
+    const [m, k] = prior.slice(9).split(",");
+    $("prior-kind").value = "vonmises";
+    $("prior-mean").value = m;
+    $("prior-kappa").value = k;
+  } else $("prior-kind").value = "uniform";
+  const acts = (q.get("actions") || "squeeze").split(",");
+  $("act-squeeze").checked = acts.includes("squeeze");
+  $("act-push-grasp").checked = acts.includes("push-grasp");
+  const set = (id, key) => {
+    if (q.has(key)) $(id).value = q.get(key);
+  };
+  set("cost-verify", "verify_cost");
+  set("cost-retry", "retry_cost");
+  set("accuracy", "accuracy");
+  set("goal", "goal");
+  set("method", "method");
+  set("max-actions", "max_actions");
+  set("cost-squeeze", "squeeze_cost");
+  set("cost-push-grasp", "push_grasp_cost");
+  if (q.get("part")) {
+    state.catalogue = q.get("part");
+    $("catalogue").value = state.catalogue;
+    state.vertices = [];
+  } else if (q.get("v")) {
+    state.vertices = q.get("v").split(";").map((s) => s.split(",").map(Number));
+    state.name = "drawn";
+  }
+}
+
+// ---- calls -----------------------------------------------------------------------------
+
+async function post(path, body) {
+  const r = await fetch(API + path, {
+    method: "POST",
+    headers: { "content-type": "application/json" },
+    body: JSON.stringify(body),
+  });
+  const doc = await r.json();
+  if (!r.ok) throw new Error(doc.detail || `HTTP ${r.status}`);
+  return doc;
+}
+
+let timer = null;
+let generation = 0;
+function schedule() {
+  clearTimeout(timer);
+  timer = setTimeout(run, 150);
+}
+
+async function run() {
+  const part = partBody();
+  if (!state.catalogue && !state.file && state.vertices.length < 3) {
+    setStatus("add at least three vertices (or choose a part)");
+    return;
+  }
+  writeHash();
+  const gen = ++generation;
+  setStatus("planning...");
+  const o = options();
+  try {
+    const [plan, squeeze, push] = await Promise.all([
+      post("/plan", { part, ...o }),
+      post("/squeeze", { part, prior: o.prior }),
+      o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
+    ]);
+    if (gen !== generation) return;
+    state.last = { plan, squeeze, push };
+    if (state.file) {
+      // the uploaded part travels in the URL as its hull
+      state.vertices = plan.part.vertices;
+      state.file = null;
+      state.name = plan.part.name;
+      drawCanvas();
+      writeHash();
+    }
+    drawHull(plan.part);
+    drawDiameter(plan.part, squeeze);
+    drawTable(plan);
+    drawAnimationFrame(0);
+    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${plan.options.length} plans`);
+    document.body.dataset.planned = String(gen);
+    loadGallery();
+  } catch (err) {
+    if (gen !== generation) return;
+    setStatus(String(err.message || err), true);
+    document.body.dataset.planned = "error";
+  }
+}
+
+// ---- figures (drawn from the API's data) ---------------------------------------------------
+
+function rotate(points, theta) {
+  const c = Math.cos(theta), s = Math.sin(theta);
+  return points.map(([x, y]) => [c * x - s * y, s * x + c * y]);
+}
+
+function width(points, theta) {
+  const xs = rotate(points, theta).map((p) => p[0]);
+  return Math.max(...xs) - Math.min(...xs);
+}
+
+function fit(points, box, pad) {
+  const xs = points.map((p) => p[0]), ys = points.map((p) => p[1]);
+  const x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+  const k = (box - 2 * pad) / Math.max(x1 - x0, y1 - y0, 1e-9);
+  const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
+  return ([x, y]) => [box / 2 + (x - cx) * k, box / 2 - (y - cy) * k];
+}
+
+function drawHull(part) {
+  const svg = $("hull");
+  svg.replaceChildren();
+  const outline = state.vertices.length >= 3 ? state.vertices : part.vertices;
+  const f = fit(outline.concat(part.vertices), 240, 16);
+  el("polygon", { points: outline.map((p) => f(p).join(",")).join(" "), fill: "#9fb8d6", stroke: "#2f4b6e" }, svg);
+  el("polygon", { points: part.vertices.map((p) => f(p).join(",")).join(" "), fill: "none", stroke: "#d62728", "stroke-dasharray": "4 3", id: "hull-polygon" }, svg);
+}
+
+function drawDiameter(part, squeeze) {
+  const svg = $("diameter");
+  svg.replaceChildren();
+  const W = 480, H = 240, L = 40, R = 10, T = 10, B = 30;
+  const n = 721;
+  const ds = [];
+  for (let i = 0; i < n; i++) ds.push(width(part.vertices, (i / (n - 1)) * TWO_PI));
+  const dmax = Math.max(...ds) * 1.05;
+  const X = (t) => L + ((W - L - R) * t) / TWO_PI;
+  const Y = (d) => H - B - ((H - T - B) * d) / dmax;
+  squeeze.basins_rad.forEach(([lo, hi], i) => {
+    for (const k of [-1, 0, 1]) {
+      const a = Math.max(0, lo + k * TWO_PI), b = Math.min(TWO_PI, hi + k * TWO_PI);
+      if (b > a)
+        el("rect", { x: X(a), y: T, width: X(b) - X(a), height: H - T - B, fill: i % 2 ? "#eef3fa" : "#f9f4ea", class: "basin" }, svg);
+    }
+  });
+  const path = ds.map((d, i) => `${i ? "L" : "M"}${X((i / (n - 1)) * TWO_PI).toFixed(1)},${Y(d).toFixed(1)}`).join("");
+  el("path", { d: path, fill: "none", stroke: "#2f4b6e", "stroke-width": 1.5, id: "diameter-curve" }, svg);
+  squeeze.stable_orientations_rad.forEach((s, i) => {
+    const t = ((s % TWO_PI) + TWO_PI) % TWO_PI;
+    const c = el("circle", { cx: X(t), cy: Y(width(part.vertices, t)), r: 4, fill: "#d62728", class: "stable" }, svg);
+    el("title", {}, c).textContent = `stable ${deg(t).toFixed(2)} deg, p = ${squeeze.probabilities[i].toFixed(4)}`;
+  });
+  el("line", { x1: L, y1: H - B, x2: W - R, y2: H - B, stroke: "#555" }, svg);
+  for (let a = 0; a <= 360; a += 90) {
+    const t = el("text", { x: X((a * Math.PI) / 180), y: H - 12, "text-anchor": "middle", "font-size": 11 }, svg);
+    t.textContent = `${a}`;
+  }
+  const lbl = el("text", { x: 4, y: 14, "font-size": 11 }, svg);
+  lbl.textContent = "d(θ)";
+}
+
+function drawTable(plan) {
+  const body = $("plans").querySelector("tbody");
+  body.replaceChildren();
+  plan.options.forEach((o, i) => {
+    const tr = document.createElement("tr");
+    tr.dataset.index = i;
+    if (i === plan.bayes) tr.classList.add("bayes");
+    if (i === plan.most_certain) tr.classList.add("most-certain");
+    const tags = o.steps.map((s) => (s.type === "squeeze" ? "S" : "P")).join("");
+    const angles = o.steps.map((s) => deg(s.alpha_rad).toFixed(2)).join(", ");
+    const cells = [
+      [o.squeezes, `${o.squeezes} ${tags}`, "squeezes"],
+      [o.steps.map((s) => s.alpha_rad).join(","), angles, "angles"],
+      [o.final_orientation_rad, deg(o.final_orientation_rad).toFixed(2), "final"],
+      [o.success_probability, o.success_probability.toFixed(4), "success"],
+      [o.expected_cost, o.expected_cost === null ? "-" : o.expected_cost.toFixed(3), "cost"],
+      [o.tolerance_rad, o.tolerance_rad === null ? "-" : deg(o.tolerance_rad).toFixed(2), "tolerance"],
+    ];
+    for (const [value, text, key] of cells) {
+      const td = document.createElement("td");
+      td.textContent = text;
+      td.dataset.key = key;
+      td.dataset.value = value === null ? "null" : String(value);
+      tr.appendChild(td);
+    }
+    const mark = document.createElement("td");
+    mark.className = "mark";
+    mark.textContent = [i === plan.bayes ? "Bayes" : "", i === plan.most_certain ? "most certain" : ""].filter(Boolean).join(", ");
+    tr.appendChild(mark);
+    body.appendChild(tr);
+  });
+}
+
+// ---- animation of the Bayes plan -------------------------------------------------------------
+
+function transfer(theta, doc) {
+  // the step function of a transfer document: the stable orientation of theta's basin
+  const b = doc.basins_rad;
+  const lo = b[0][0], span = b[b.length - 1][1] - lo;
+  const k = Math.floor((theta - lo) / span);
+  const t = theta - k * span;
+  for (let i = 0; i < b.length; i++) if (t >= b[i][0] && t < b[i][1]) return doc.stable_orientations_rad[i] + k * span;
+  return doc.stable_orientations_rad[b.length - 1] + k * span;
+}
+
+function wrap(a) {
+  return a - TWO_PI * Math.round(a / TWO_PI);
+}
+
+function trajectories() {
+  const { plan, squeeze, push } = state.last;
+  const o = plan.options[plan.bayes];
+  const starts = [];
+  for (let i = 0; i < 8; i++) starts.push((i + 0.5) * (TWO_PI / 8) + 0.05);
+  const order = plan.part.symmetry_order || 1;
+  const goalPeriod = $("goal").value === "symmetry" ? TWO_PI / order : TWO_PI;
+  return starts.map((t0) => {
+    const keys = [t0];
+    let t = t0;
+    for (const s of o.steps) {
+      const doc = s.type === "squeeze" ? squeeze : push.push_grasp;
+      const turned = t - s.alpha_rad;
+      keys.push(turned);
+      t = transfer(turned, doc);
+      keys.push(t);
+    }
+    const gap = (t - o.final_orientation_rad) / goalPeriod;
+    const ok = Math.abs(gap - Math.round(gap)) * goalPeriod < 1e-6;
+    return { keys, ok };
+  });
+}
+
+const FRAMES = 12;
+let animTimer = null;
+
+function drawAnimationFrame(frame) {
+  if (!state.last) return;
+  const svg = $("anim");
+  svg.replaceChildren();
+  const runs = trajectories();
+  const segs = runs[0].keys.length - 1;
+  const last = segs * FRAMES;
+  const f = Math.min(frame, last);
+  const seg = Math.min(Math.floor(f / FRAMES), segs - 1);
+  const u = f >= last ? 1 : (f % FRAMES) / FRAMES;
+  const verts = state.last.plan.part.vertices;
+  const cx = verts.reduce((a, p) => a + p[0], 0) / verts.length;
+  const cy = verts.reduce((a, p) => a + p[1], 0) / verts.length;
+  const centred = verts.map(([x, y]) => [x - cx, y - cy]);
+  const r = Math.max(...centred.map(([x, y]) => Math.hypot(x, y)));
+  const k = 30 / r;
+  runs.forEach((run, i) => {
+    const ox = 40 + i * 78, oy = 80;
+    const done = f >= last;
+    el("rect", { x: ox - 36, y: oy - 70, width: 72, height: 150, rx: 6, class: done ? (run.ok ? "cell-ok" : "cell-fail") : "cell", "data-ok": run.ok, "data-start": run.keys[0], "data-final": run.keys[run.keys.length - 1] }, svg);
+    const t = run.keys[seg] + (run.keys[seg + 1] - run.keys[seg]) * u;
+    const pts = rotate(centred, t);
+    const xs = pts.map((p) => p[0]);
+    const squeezing = seg % 2 === 1; // odd segments close the jaws
+    const lo = Math.min(...xs), hi = Math.max(...xs);
+    const open = squeezing ? 1 - u : 1;
+    const gap = 8 * open;
+    el("polygon", { points: pts.map(([x, y]) => `${ox + x * k},${oy - y * k}`).join(" "), fill: "#9fb8d6", stroke: "#2f4b6e" }, svg);
+    for (const xj of [lo * k - gap, hi * k + gap]) el("line", { x1: ox + xj, y1: oy - 45, x2: ox + xj, y2: oy + 45, stroke: "#555", "stroke-width": 3 }, svg);
+    const label = el("text", { x: ox, y: oy + 70, "text-anchor": "middle", "font-size": 11 }, svg);
+    label.textContent = done ? (run.ok ? "✓ oriented" : "✗ other") : `${deg(run.keys[0]).toFixed(0)}°`;
+  });
+  $("anim-status").textContent = f >= last ? `${runs.filter((x) => x.ok).length} of ${runs.length} oriented` : `step ${Math.floor(seg / 2) + 1}`;
+  svg.dataset.frame = String(f);
+  svg.dataset.done = String(f >= last);
+  return f < last;
+}
+
+function play() {
+  clearInterval(animTimer);
+  let frame = 0;
+  animTimer = setInterval(() => {
+    if (!drawAnimationFrame(frame++)) clearInterval(animTimer);
+  }, 40);
+}
+
+async function showFigures() {
+  const body = { part: partBody(), ...options() };
+  for (const name of ["transfer", "plan"]) {
+    const r = await fetch(`${API}/figures/${name}.svg`, {
+      method: "POST",
+      headers: { "content-type": "application/json" },
+      body: JSON.stringify(body),
+    });
+    if (!r.ok) {
+      setStatus((await r.json()).detail, true);
+      return;
+    }
+    const img = $(`fig-${name}`);
+    if (img.src) URL.revokeObjectURL(img.src);
+    img.src = URL.createObjectURL(await r.blob());
+  }
+}
+
+// ---- catalogue, file, gallery --------------------------------------------------------------
+
+async function loadCatalogue() {
+  const r = await fetch(API + "/catalogue");
+  const doc = await r.json();
+  for (const p of doc.parts) {
+    const o = document.createElement("option");
+    o.value = p.name;
+    o.textContent = p.name;
+    $("catalogue").appendChild(o);
+  }
+  $("catalogue").value = state.catalogue;
+  $("catalogue").addEventListener("change", () => {
+    const name = $("catalogue").value;
+    if (!name) return;
+    const entry = doc.parts.find((p) => p.name === name);
+    undoStack.push(state.vertices.map((v) => v.slice()));
+    state.catalogue = name;
+    state.file = null;
+    state.vertices = [];
+    drawCanvas();
+    state.outline = entry.outline;
+    schedule();
+  });
+}
+
+function setupFile() {
+  $("file").addEventListener("change", async () => {
+    const f = $("file").files[0];
+    if (!f) return;
+    const ext = f.name.split(".").pop().toLowerCase();
+    const bytes = new Uint8Array(await f.arrayBuffer());
+    let bin = "";
+    for (let i = 0; i < bytes.length; i += 0x8000) bin += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
+    state.catalogue = "";
+    state.vertices = [];
+    state.file = { format: ext, data_base64: btoa(bin), name: f.name.replace(/\.[^.]*$/, "").replace(/[^A-Za-z0-9_. -]/g, "_").slice(0, 64) || "part" };
+    schedule();
+  });
+}
+
+async function loadGallery() {
+  try {
+    const r = await fetch(API + "/gallery?limit=20");
+    const doc = await r.json();
+    const ul = $("gallery");
+    ul.replaceChildren();
+    for (const row of doc.rows) {
+      const li = document.createElement("li");
+      const a = document.createElement("a");
+      const q = new URLSearchParams();
+      q.set("v", row.vertices.map((v) => v.join(",")).join(";"));
+      for (const [k, v] of Object.entries(row.options)) if (typeof v !== "object") q.set(k, v);
+      a.href = "#" + q.toString();
+      a.textContent = `${row.name}: ${row.squeezes} actions, p = ${row.success_probability === null ? "-" : row.success_probability.toFixed(3)}`;
+      a.addEventListener("click", () => setTimeout(() => { readHash(); drawCanvas(); schedule(); }, 0));
+      li.appendChild(a);
+      ul.appendChild(li);
+    }
+  } catch (err) {
+    /* the gallery is optional */
+  }
+}
+
+// ---- start -------------------------------------------------------------------------------
+
+function start() {
+  setupCanvas();
+  setupFile();
+  readHash();
+  drawCanvas();
+  $("plan").addEventListener("click", run);
+  $("play").addEventListener("click", play);
+  $("figures").addEventListener("click", showFigures);
+  $("options").addEventListener("change", schedule);
+  window.addEventListener("hashchange", () => { readHash(); drawCanvas(); schedule(); });
+  loadCatalogue().then(() => {
+    if (state.catalogue || state.vertices.length >= 3) run();
+  });
+  loadGallery();
+}
+
+start();

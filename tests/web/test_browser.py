@@ -1,0 +1,320 @@
+"""The page in real headless Chromium, against ``bayesgrasp serve`` on a free local port."""
+
+from __future__ import annotations
+
+import json
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+CHROMIUM = Path("/usr/bin/chromium")
+ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+]
+ROOT = Path(__file__).resolve().parents[2]
+SCREENSHOT = ROOT / "docs" / "figures" / "web.png"
+TRIANGLE_CLICKS = [(100, 300), (300, 300), (160, 120)]  # canvas pixels
+TRIANGLE = [[25.0, 25.0], [75.0, 25.0], [40.0, 70.0]]  # grid 20 px = 5 mm, y up
+
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.skipif(
+        not CHROMIUM.exists(),
+        reason=f"{CHROMIUM} is missing (apt-get install chromium); browser tests skipped",
+    ),
+]
+CliJson = Callable[..., tuple[int, Any]]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def _serve_command(port: int, data: Path) -> list[str]:
+    from bayesgrasp.cli import COMMANDS
+
+    args = ["--host", "127.0.0.1", "--port", str(port), "--data", str(data)]
+    if "serve" in COMMANDS:
+        return [sys.executable, "-m", "bayesgrasp.cli", "serve", *args]
+    # until the command is listed: run the command module itself
+    code = "import sys; from bayesgrasp.cli.serve import app; app(sys.argv[1:])"
+    return [sys.executable, "-c", code, *args]
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """The URL of a ``bayesgrasp serve`` started for these tests (stopped afterwards)."""
+    port = _free_port()
+    data = tmp_path_factory.mktemp("web-data")
+    log = data / "serve.log"
+    with log.open("wb") as out:
+        proc = subprocess.Popen(
+            _serve_command(port, data), stdout=out, stderr=subprocess.STDOUT, cwd=ROOT
+        )
+    url = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                with urllib.request.urlopen(f"{url}/api/v1/health", timeout=1) as r:
+                    if r.status == 200:
+                        break
+            except OSError:
+                if proc.poll() is not None or time.monotonic() > deadline:
+                    raise RuntimeError(f"serve did not start: {log.read_text()}") from None
+                time.sleep(0.1)
+        yield url
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    sync_api = pytest.importorskip("playwright.sync_api")
+    with sync_api.sync_playwright() as pw:
+        b = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS, headless=True)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+@pytest.fixture
+def page(browser: Any) -> Iterator[Any]:
+    context = browser.new_context(viewport={"width": 1280, "height": 1100})
+    pg = context.new_page()
+    errors: list[str] = []
+    pg.on("pageerror", lambda exc: errors.append(str(exc)))
+    try:
+        yield pg
+    finally:
+        context.close()
+    assert not errors, errors
+
+
+def table(page: Any) -> list[dict[str, str]]:
+    """The plan table's rows: raw values (data-value) by column, and the marks."""
+    return page.evaluate(
+        """() => [...document.querySelectorAll('#plans tbody tr')].map((tr) => {
+            const row = {};
+            tr.querySelectorAll('td[data-key]').forEach(
+                (td) => row[td.dataset.key] = td.dataset.value);
+            row.mark = tr.querySelector('td.mark').textContent;
+            return row;
+        })"""
+    )
+
+
+def expected_rows(doc: dict[str, Any]) -> list[dict[str, Any]]:
+    rows = []
+    for i, o in enumerate(doc["options"]):
+        marks = [
+            m for m, k in (("Bayes", "bayes"), ("most certain", "most_certain")) if doc[k] == i
+        ]
+        rows.append(
+            {
+                "squeezes": o["squeezes"],
+                "angles": [s["alpha_rad"] for s in o["steps"]],
+                "final": o["final_orientation_rad"],
+                "success": o["success_probability"],
+                "cost": o["expected_cost"],
+                "tolerance": o["tolerance_rad"],
+                "mark": ", ".join(marks),
+            }
+        )
+    return rows
+
+
+def parsed(rows: list[dict[str, str]]) -> list[dict[str, Any]]:
+    def num(s: str) -> float | None:
+        return None if s == "null" else float(s)
+
+    return [
+        {
+            "squeezes": int(r["squeezes"]),
+            "angles": [float(a) for a in r["angles"].split(",")],
+            "final": num(r["final"]),
+            "success": num(r["success"]),
+            "cost": num(r["cost"]),
+            "tolerance": num(r["tolerance"]),
+            "mark": r["mark"],
+        }
+        for r in rows
+    ]
+
+
+def wait_rows(page: Any, want: list[dict[str, Any]], timeout: float = 20.0) -> None:
+    """Wait until the table shows ``want`` (the page plans after a short pause)."""
+    deadline = time.monotonic() + timeout
+    got: list[dict[str, Any]] = []
+    while time.monotonic() < deadline:
+        got = parsed(table(page))
+        if got == want:
+            return
+        page.wait_for_timeout(100)
+    assert got == want
+
+
+def cli_plan(cli_json: CliJson, tmp_path: Path, vertices: Any, *args: str) -> dict[str, Any]:
+    path = tmp_path / "drawn.json"
+    path.write_text(json.dumps({"vertices": vertices}))
+    code, doc = cli_json("plan", str(path), *args)
+    assert code == 0
+    return dict(doc)
+
+
+def outcomes(page: Any) -> list[tuple[float, bool]]:
+    """The animation's starting orientations and whether each ended oriented."""
+    cells = page.evaluate(
+        """() => [...document.querySelectorAll('#anim rect')].map(
+            (r) => [Number(r.dataset.start), r.dataset.ok === 'true'])"""
+    )
+    return [(float(a), bool(b)) for a, b in cells]
+
+
+def library_outcomes(page: Any, vertices: Any, prior: str) -> list[tuple[float, bool]]:
+    """The same starts run through the library's transfer functions and goal."""
+    import numpy as np
+
+    from bayesgrasp.cli.specs import ProblemSpec
+    from bayesgrasp.geometry import Part
+    from bayesgrasp.model.problem import nearest_state
+
+    spec = ProblemSpec(prior=prior)
+    pb = spec.build(Part.from_points(np.array(vertices)))
+    option = spec.plan(pb).bayes_plan
+    starts = np.array([a for a, _ in outcomes(page)])
+    theta = starts.copy()
+    for s in option.steps:
+        theta = pb.transfer(s.kind)(theta - s.alpha)
+    mask = pb.goal.success_states(pb.states, option.final_orientation, pb.part.hull.symmetry_order)
+    ok = mask[nearest_state(pb.states, theta)]
+    return [(float(a), bool(b)) for a, b in zip(starts, ok, strict=True)]
+
+
+def draw_triangle(page: Any) -> None:
+    box = page.locator("#canvas").bounding_box()
+    for x, y in TRIANGLE_CLICKS:
+        page.mouse.click(box["x"] + x * box["width"] / 400, box["y"] + y * box["height"] / 400)
+
+
+def test_draw_change_prior_share_and_play(
+    server: str, page: Any, cli_json: CliJson, tmp_path: Path
+) -> None:
+    page.goto(server + "/")
+    draw_triangle(page)
+    assert page.locator("#coords").input_value().splitlines() == ["25, 25", "75, 25", "40, 70"]
+    uniform = cli_plan(cli_json, tmp_path, TRIANGLE)
+    wait_rows(page, expected_rows(uniform))
+    assert page.locator("#hull-polygon").count() == 1
+    assert page.locator("#diameter .stable").count() == len(uniform["stable_orientations_rad"])
+    assert page.locator("tr.bayes").count() == 1
+
+    # the prior: von Mises at 30 deg moves the first squeeze
+    page.select_option("#prior-kind", "vonmises")
+    page.fill("#prior-mean", "30")
+    page.fill("#prior-kappa", "4")
+    page.click("#plan")
+    peaked = cli_plan(cli_json, tmp_path, TRIANGLE, "--prior", "vonmises:30,4")
+    assert peaked["first_squeeze_rad"] != uniform["first_squeeze_rad"]
+    wait_rows(page, expected_rows(peaked))
+    bayes = parsed(table(page))[peaked["bayes"]]
+    assert bayes["angles"][0] == peaked["first_squeeze_rad"]
+
+    # the animation of the Bayes plan on eight starting orientations
+    page.click("#play")
+    page.wait_for_selector("#anim[data-done=true]", timeout=20_000)
+    ok = page.locator("#anim rect.cell-ok").count()
+    assert ok + page.locator("#anim rect.cell-fail").count() == 8
+    assert ok >= 1
+    assert outcomes(page) == library_outcomes(page, TRIANGLE, "vonmises:30,4")
+    assert "oriented" in page.locator("#anim-status").text_content()
+    page.screenshot(path=str(SCREENSHOT), full_page=True)
+    assert SCREENSHOT.stat().st_size > 10_000
+
+    # a shared link reproduces the view in a fresh page
+    shared = page.url
+    assert "v=" in shared and "vonmises" in shared
+    other = page.context.new_page()
+    other.goto(shared)
+    wait_rows(other, expected_rows(peaked))
+    assert other.locator("#prior-kind").input_value() == "vonmises"
+    other.close()
+
+
+def test_upload_a_dxf(server: str, page: Any, cli_json: CliJson, tmp_path: Path) -> None:
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.new()
+    doc.modelspace().add_lwpolyline(
+        [(0, 0), (40, 0), (40, 10), (10, 10), (10, 30), (0, 30)], close=True
+    )
+    path = tmp_path / "bracket.dxf"
+    doc.saveas(path)
+    code, want = cli_json("plan", str(path))
+    assert code == 0
+    page.goto(server + "/")
+    page.set_input_files("#file", str(path))
+    wait_rows(page, expected_rows(want))
+    assert "bracket" in page.locator("#status").text_content()
+
+
+def test_catalogue_and_gallery(server: str, page: Any, cli_json: CliJson) -> None:
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze,push-grasp")
+    _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#catalogue").input_value() == "house"
+    page.wait_for_function("document.querySelectorAll('#gallery li').length > 0")
+
+
+def test_bad_coordinates_show_the_message(server: str, page: Any) -> None:
+    page.goto(server + "/")
+    page.fill("#coords", "0, 0\n1, 1\n2, 2")
+    page.click("#use-coords")
+    page.wait_for_selector("#status.error")
+    assert "collinear" in page.locator("#status").text_content()
+
+
+def test_drag_undo_and_figures(server: str, page: Any) -> None:
+    page.goto(server + "/")
+    draw_triangle(page)
+    box = page.locator("#canvas").bounding_box()
+    x, y = box["x"] + 160 * box["width"] / 400, box["y"] + 120 * box["height"] / 400
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + 40, y - 40, steps=5)
+    page.mouse.up()
+    assert page.locator("#coords").input_value().splitlines()[2] == "50, 80"
+    page.click("#undo")
+    assert page.locator("#coords").input_value().splitlines()[2] == "40, 70"
+    page.click("#undo")
+    assert len(page.locator("#coords").input_value().splitlines()) == 2
+    page.click("#undo")
+    page.click("#undo")
+    page.click("#undo")
+    assert page.locator("#coords").input_value() == ""
+    page.goto(server + "/#part=key")
+    page.wait_for_selector("#plans tbody tr")
+    page.click("#figures")
+    page.wait_for_function(
+        "document.getElementById('fig-plan').naturalWidth > 0"
+        " && document.getElementById('fig-transfer').naturalWidth > 0"
+    )

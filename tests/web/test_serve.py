@@ -1,0 +1,41 @@
+"""The ``serve`` command module and the gallery's defaults."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from bayesgrasp.cli.serve import app
+from bayesgrasp.web.gallery import Gallery, default_data_dir
+
+
+def test_serve_help_names_the_options() -> None:
+    result = CliRunner().invoke(app, ["--help"])
+    assert result.exit_code == 0
+    for option in ("--host", "--port", "--data", "--gallery-rows", "--time-limit"):
+        assert option in result.output
+    assert "127.0.0.1" in result.output
+
+
+def test_serve_refuses_a_bad_port() -> None:
+    result = CliRunner().invoke(app, ["--port", "70000"])
+    assert result.exit_code == 2
+
+
+def test_default_data_dir(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))
+    assert default_data_dir().name == "bayesgrasp"
+
+
+def test_gallery_refreshes_a_repeated_part(tmp_path: Path) -> None:
+    g = Gallery(tmp_path, max_rows=2)
+    tri = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
+    g.add("a", tri, {}, {"success_probability": 0.5, "expected_cost": 4.0, "squeezes": 1})
+    g.add("b", [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]], {}, {})
+    g.add("a", tri, {}, {"success_probability": 0.5, "expected_cost": 4.0, "squeezes": 1})
+    assert [r["name"] for r in g.rows()] == ["a", "b"]
+    assert len(g) == 2
+    with pytest.raises(ValueError, match="max_rows"):
+        Gallery(tmp_path, max_rows=0)
