@@ -101,6 +101,7 @@ def browser() -> Iterator[Any]:
 @pytest.fixture
 def page(browser: Any) -> Iterator[Any]:
     context = browser.new_context(viewport={"width": 1280, "height": 1100})
+    context.set_default_timeout(60_000)  # a loaded CI machine; the waits end on conditions
     pg = context.new_page()
     errors: list[str] = []
     pg.on("pageerror", lambda exc: errors.append(str(exc)))
@@ -162,7 +163,7 @@ def parsed(rows: list[dict[str, str]]) -> list[dict[str, Any]]:
     ]
 
 
-def wait_rows(page: Any, want: list[dict[str, Any]], timeout: float = 20.0) -> None:
+def wait_rows(page: Any, want: list[dict[str, Any]], timeout: float = 60.0) -> None:
     """Wait until the table shows ``want`` (the page plans after a short pause)."""
     deadline = time.monotonic() + timeout
     got: list[dict[str, Any]] = []
@@ -242,7 +243,7 @@ def test_draw_change_prior_share_and_play(
 
     # the animation of the Bayes plan on eight starting orientations
     page.click("#play")
-    page.wait_for_selector("#anim[data-done=true]", timeout=20_000)
+    page.wait_for_selector("#anim[data-done=true]", timeout=60_000)
     ok = page.locator("#anim rect.cell-ok").count()
     assert ok + page.locator("#anim rect.cell-fail").count() == 8
     assert ok >= 1
