@@ -231,6 +231,8 @@ def write_parts() -> None:
     docs["lattice"] = {
         "name": "lattice",
         "vertices": [[int(q) for q in p] for p in corners + inside],
+        # Simple in file order, so it would read as an outline: the parallelogram's centre.
+        "center_of_mass": ((u + v) / 2).tolist(),
     }
     # Plan files for ``simulate --plan FILE`` on the house (made up, near its Bayes plans).
     docs["plan-squeeze"] = {

@@ -13,22 +13,35 @@ dxf        ``.dxf``             closed polylines, circles, ellipses, splines, an
                                 of lines and arcs
 =========  ===================  =====================================================
 
-Point lists (JSON, CSV) give the convex hull of their points. Outline formats (WKT,
-GeoJSON, SVG, DXF) give an ordered outline that may be non-convex, with holes: the gripper
-sees its convex hull, and the default centre of mass is the area centroid of the outline
-minus its holes (:meth:`bayesgrasp.geometry.Part.from_outline`). Coordinates keep the file's
-units, reported in :attr:`Part.units` (DXF ``$INSUNITS``; SVG millimetres when the document
-has a physical size, else user units ``"px"``; ``"units"`` members of JSON and GeoJSON).
+Outline formats (WKT, GeoJSON, SVG, DXF) give an ordered outline that may be non-convex,
+with holes: the gripper sees its convex hull, and the default centre of mass is the area
+centroid of the outline minus its holes (:meth:`bayesgrasp.geometry.Part.from_outline`).
+Point lists (JSON, CSV) are read in order: points that make a simple polygon in that order
+(edges meeting only at consecutive points) are an outline like the others (area centroid,
+no holes), so the same outline gives the same part from CSV, JSON and WKT; points that cross
+themselves in order are a *point cloud*, and the part is their convex hull with the hull's
+centroid as centre of mass (give ``"center_of_mass"`` in JSON when it is elsewhere). See
+:mod:`bayesgrasp.io.points`. Coordinates keep the file's units, reported in
+:attr:`Part.units` (DXF ``$INSUNITS``, ``None`` when the file has none; SVG millimetres when
+the document has a physical size, else user units ``"px"``; ``"units"`` members of JSON and
+GeoJSON).
 
 Curves (Bezier curves, arcs, circles, ellipses, splines) are flattened to a chordal
 tolerance: no point of the curve is farther than ``tolerance`` from the polyline (default
 0.1% of the drawing's diagonal). A file whose outlines flatten to more than ``max_points``
 points (default :data:`MAX_POINTS` = 100 000) is refused, before the points are made.
 
+Parts can also be read from memory (:func:`read_part_bytes`: an upload, a pipe; nothing is
+written to disk) and from standard input (``resolve_part("-", fmt)``, the command line's
+``-``).
+
 Every failure is a :class:`~bayesgrasp.errors.PartFileError` whose message starts with the
-file name and says why: missing, empty, truncated or of the wrong format, non-finite
-coordinates, no closed outline, several candidate outlines and no choice, a
-self-intersecting outline, too many points.
+file name and says why: missing, empty, not a regular file, too large, not UTF-8, truncated
+or of the wrong format, nested too deeply, non-finite or too large coordinates, no closed
+outline, several candidate outlines and no choice, a self-intersecting outline, too many
+points, entities or elements. The work a file can cause is bounded: see the limits
+:data:`MAX_BYTES`, :data:`MAX_COORDINATE`, :data:`MAX_ENTITIES`, :data:`MAX_NESTING` and
+:data:`MAX_POINTS`.
 
 The readers of WKT and GeoJSON need shapely, SVG needs svgelements and DXF needs ezdxf
 (the ``io`` extra: ``pip install 'bayesgrasp[io]'``).
@@ -36,47 +49,103 @@ The readers of WKT and GeoJSON need shapely, SVG needs svgelements and DXF needs
 
 from __future__ import annotations
 
+import numbers
+import os
+import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ..errors import PartFileError
 from ..geometry import Part
-from ._common import DEFAULT_RELATIVE_TOLERANCE, MAX_POINTS, ReadOptions, fail
+from ._common import (
+    DEFAULT_RELATIVE_TOLERANCE,
+    MAX_BYTES,
+    MAX_COORDINATE,
+    MAX_ENTITIES,
+    MAX_NESTING,
+    MAX_POINTS,
+    ReadOptions,
+    check_bytes,
+    fail,
+    quote,
+    read_bytes,
+)
 
 __all__ = [
     "DEFAULT_RELATIVE_TOLERANCE",
     "EXTENSIONS",
     "FORMATS",
+    "MAX_BYTES",
+    "MAX_COORDINATE",
+    "MAX_ENTITIES",
+    "MAX_NESTING",
     "MAX_POINTS",
+    "STDIN",
     "ReadOptions",
     "read_part",
+    "read_part_bytes",
     "resolve_part",
 ]
 
-Reader = Callable[[Path, ReadOptions], Part]
+#: The part path that means standard input (:func:`resolve_part`).
+STDIN = "-"
+
+Parser = Callable[[bytes, Path, ReadOptions], Part]
 
 
-def _reader(fmt: str) -> Reader:
-    """The reader of a format (modules are imported on demand)."""
+def _parser(fmt: str) -> Parser:
+    """The parser of a format: bytes to Part (modules are imported on demand)."""
     if fmt in ("json", "csv"):
         from . import points
 
-        return points.read_json if fmt == "json" else points.read_csv
+        return points.parse_json if fmt == "json" else points.parse_csv
     if fmt == "wkt":
-        from .wkt import read_wkt
+        from .wkt import parse_wkt
 
-        return read_wkt
+        return parse_wkt
     if fmt == "geojson":
-        from .geojson import read_geojson
+        from .geojson import parse_geojson
 
-        return read_geojson
+        return parse_geojson
     if fmt == "svg":
-        from .svg import read_svg
+        from .svg import parse_svg
 
-        return read_svg
-    from .dxf import read_dxf
+        return parse_svg
+    from .dxf import parse_dxf
 
-    return read_dxf
+    return parse_dxf
+
+
+def _options(element: Any, layer: Any, tolerance: Any, max_points: Any) -> ReadOptions:
+    """Validated reader options (PartFileError naming the parameter)."""
+    for what, value in (("element", element), ("layer", layer)):
+        if value is not None and not isinstance(value, str):
+            raise PartFileError(
+                f"`{what}` must be a string or None; got {type(value).__name__} ({value!r:.40})"
+            )
+    if tolerance is not None:
+        if isinstance(tolerance, bool) or not isinstance(tolerance, numbers.Real):
+            raise PartFileError(
+                f"`tolerance` must be a number > 0 or None; got {type(tolerance).__name__} "
+                f"({tolerance!r:.40})"
+            )
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 3:
+        raise PartFileError(f"`max_points` must be an integer >= 3; got {max_points!r:.40}")
+    return ReadOptions(element, layer, None if tolerance is None else float(tolerance), max_points)
+
+
+def _format(fmt: Any, path: Path | None) -> str:
+    """The format name: ``fmt``, or from the extension of ``path``."""
+    if fmt is not None and not isinstance(fmt, str):
+        raise PartFileError(f"`fmt` must be a string or None; got {type(fmt).__name__}")
+    suffix = path.suffix.lstrip(".") if path is not None else ""
+    kind = (fmt or EXTENSIONS.get(suffix.lower(), suffix)).lower()
+    if kind not in FORMATS:
+        shown = quote(kind) if kind else "(no extension)"
+        message = f"unknown part format {shown}; expected one of {', '.join(FORMATS)}"
+        raise fail(path, message) if path is not None else PartFileError(f"`fmt`: {message}")
+    return kind
 
 
 #: Format names, in the order the documentation lists them.
@@ -107,13 +176,15 @@ def read_part(
     Parameters
     ----------
     path : str or Path
+        A regular file of at most :data:`MAX_BYTES` bytes.
     fmt : str, optional
         One of :data:`FORMATS`; default from the extension.
     element : str, optional
         Which outline, when the file has several: an SVG element id, a GeoJSON feature
-        ``id`` or ``properties.name``, or a polygon's index (GeoJSON, WKT).
+        ``id`` or ``properties.name``, or a polygon's index (GeoJSON, WKT). Refused for
+        formats that have no such choice.
     layer : str, optional
-        DXF: read only this layer (case-insensitive).
+        DXF: read only this layer (case-insensitive). Refused for other formats.
     tolerance : float, optional
         Chordal tolerance of curve flattening, in the file's units (default 0.1% of the
         drawing's diagonal).
@@ -141,15 +212,82 @@ def read_part(
     >>> p.hull.n_sides, p.center_of_mass.round(4).tolist()
     (5, [1.5, 1.0])
     """
+    if not isinstance(path, str | os.PathLike):
+        raise PartFileError(f"`path` must be a str or Path; got {type(path).__name__}")
     p = Path(path)
-    kind = (fmt or EXTENSIONS.get(p.suffix.lstrip(".").lower(), p.suffix.lstrip("."))).lower()
-    if kind not in FORMATS:
-        shown = kind or "(no extension)"
-        raise fail(p, f"unknown part format {shown!r}; expected one of {', '.join(FORMATS)}")
-    if not isinstance(max_points, int) or max_points < 3:
-        raise PartFileError(f"`max_points` must be an integer >= 3; got {max_points!r}")
-    options = ReadOptions(element, layer, tolerance, max_points)
-    return _reader(kind)(p, options)
+    kind = _format(fmt, p)
+    options = _options(element, layer, tolerance, max_points)
+    return _parser(kind)(read_bytes(p), p, options)
+
+
+def read_part_bytes(
+    data: bytes,
+    fmt: str,
+    name: str = "<stdin>",
+    *,
+    element: str | None = None,
+    layer: str | None = None,
+    tolerance: float | None = None,
+    max_points: int = MAX_POINTS,
+) -> Part:
+    r"""Read a part from the contents of a part file, in memory.
+
+    Nothing is written to disk and ``name`` is never opened: it only names the part (its
+    stem, as a file's would) and starts the error messages. For uploads and pipes.
+
+    Parameters
+    ----------
+    data : bytes
+        The contents of a part file, at most :data:`MAX_BYTES` bytes.
+    fmt : str
+        One of :data:`FORMATS` (there is no extension to go by).
+    name : str, optional
+        A file name for messages and the part's default name.
+    element, layer, tolerance, max_points
+        As for :func:`read_part`.
+
+    Returns
+    -------
+    Part
+
+    Raises
+    ------
+    PartFileError
+        As for :func:`read_part`; the messages start with ``name``.
+    MissingExtraError
+        The format needs a package of the ``io`` extra that is not installed.
+
+    Examples
+    --------
+    >>> p = read_part_bytes(b"0,0\n4,0\n4,1\n1,1\n1,3\n0,3\n", "csv", "plate.csv")
+    >>> p.name, p.center_of_mass.round(4).tolist()
+    ('plate', [1.5, 1.0])
+    """
+    if not isinstance(name, str):
+        raise PartFileError(f"`name` must be a string; got {type(name).__name__}")
+    if fmt is None:
+        raise PartFileError(f"`fmt` is needed to read bytes; expected one of {', '.join(FORMATS)}")
+    kind = _format(fmt, None)
+    options = _options(element, layer, tolerance, max_points)
+    if not isinstance(data, bytes | bytearray | memoryview):
+        hint = " (encode text as UTF-8)" if isinstance(data, str) else ""
+        raise PartFileError(f"`data` must be bytes; got {type(data).__name__}{hint}")
+    p = Path(name)
+    return _parser(kind)(check_bytes(p, bytes(data)), p, options)
+
+
+def _read_stdin(fmt: str | None, **options: Any) -> Part:
+    """A part from standard input (at most :data:`MAX_BYTES` bytes)."""
+    if fmt is None:
+        raise PartFileError(
+            f"reading a part from standard input ({STDIN!r}) needs its format: give fmt "
+            f"(--format), one of {', '.join(FORMATS)}"
+        )
+    stream = getattr(sys.stdin, "buffer", None)
+    if stream is None:
+        raise PartFileError("standard input cannot be read as bytes")
+    data = stream.read(MAX_BYTES + 1)
+    return read_part_bytes(data, fmt, "<stdin>", **options)
 
 
 def resolve_part(
@@ -161,9 +299,10 @@ def resolve_part(
     tolerance: float | None = None,
     max_points: int = MAX_POINTS,
 ) -> Part:
-    """A catalogue name (see :func:`bayesgrasp.shapes.names`) or a part file.
+    """A catalogue name (see :func:`bayesgrasp.shapes.names`), a part file, or ``-``.
 
-    The keyword options are those of :func:`read_part`.
+    ``-`` (:data:`STDIN`) reads the part from standard input; it needs ``fmt``. The keyword
+    options are those of :func:`read_part`.
 
     Examples
     --------
@@ -172,15 +311,25 @@ def resolve_part(
     """
     from ..shapes import names
 
+    if not isinstance(spec, str | os.PathLike):
+        raise PartFileError(
+            f"a part must be a catalogue name or a file path; got {type(spec).__name__}"
+        )
+    options: dict[str, Any] = {
+        "element": element,
+        "layer": layer,
+        "tolerance": tolerance,
+        "max_points": max_points,
+    }
+    if spec == STDIN:
+        return _read_stdin(fmt, **options)
     if fmt is None and spec in names():
         from ..shapes import load
 
-        return load(spec)
+        return load(str(spec))
     p = Path(spec)
     if not p.suffix and not p.exists() and fmt is None:
         raise PartFileError(
-            f"{spec!r} is neither a catalogue part ({', '.join(names())}) nor a file"
+            f"{quote(str(spec))} is neither a catalogue part ({', '.join(names())}) nor a file"
         )
-    return read_part(
-        p, fmt, element=element, layer=layer, tolerance=tolerance, max_points=max_points
-    )
+    return read_part(p, fmt, **options)

@@ -1,9 +1,27 @@
-"""What every reader shares: options, errors naming the file, and outline assembly."""
+"""What every reader shares: options, limits, errors naming the file, and outline assembly.
+
+Limits on the work a file may cause, each refused with a message that names it:
+
+- :data:`MAX_BYTES` (64 MiB): the bytes read from a file or given in memory; only regular
+  files are read (a FIFO, a device such as ``/dev/zero`` or a socket is refused unopened);
+- :data:`MAX_COORDINATE` (1e150): coordinates beyond it in absolute value (areas and
+  cross products of such numbers overflow a float);
+- :data:`MAX_ENTITIES` (100 000): DXF entities after block references are expanded, and SVG
+  elements after ``<use>`` references are expanded;
+- :data:`MAX_NESTING` (100): nesting depth of JSON arrays and objects, XML elements and WKT
+  parentheses (part files need a handful of levels; parsers recurse, or crash, on deep ones);
+- ``max_points`` (:data:`MAX_POINTS`): the points the outlines flatten to, and the segments of
+  all the paths in an SVG file.
+"""
 
 from __future__ import annotations
 
+import errno
+import json
 import logging
 import math
+import os
+import stat
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,19 +36,31 @@ from ._flatten import Curve, FlattenBudget, TooManyPoints, join, predicted_point
 
 __all__ = [
     "DEFAULT_RELATIVE_TOLERANCE",
+    "MAX_BYTES",
+    "MAX_COORDINATE",
+    "MAX_ENTITIES",
+    "MAX_NESTING",
     "MAX_POINTS",
     "ReadOptions",
     "Ring",
     "assemble_part",
+    "brief",
+    "check_bytes",
+    "check_coordinates",
     "check_count",
     "chordal_tolerance",
+    "decode_text",
     "fail",
     "flatten_rings",
+    "load_json",
     "need",
+    "nesting_depth",
     "pick",
     "polygon_part",
+    "quote",
     "read_bytes",
     "read_text",
+    "refuse_options",
     "shapely_polygons",
 ]
 
@@ -45,6 +75,20 @@ MAX_POINTS = 100_000
 
 #: Default chordal tolerance, relative to the diagonal of the drawing's bounding box.
 DEFAULT_RELATIVE_TOLERANCE = 1e-3
+
+#: Largest part file, in bytes (64 MiB): read from disk or given in memory.
+MAX_BYTES = 64 * 1024 * 1024
+
+#: Largest coordinate magnitude: products of two coordinates (areas, cross products) must
+#: not overflow a float, so :class:`~bayesgrasp.geometry.Part` refuses larger ones too.
+MAX_COORDINATE = 1e150
+
+#: Largest number of DXF entities (after expanding block references) or SVG elements (after
+#: expanding ``<use>`` references) a file may hold.
+MAX_ENTITIES = 100_000
+
+#: Deepest nesting of JSON arrays and objects, XML elements or WKT parentheses.
+MAX_NESTING = 100
 
 
 @dataclass(frozen=True, slots=True)
@@ -83,8 +127,11 @@ class Ring:
 
 
 def fail(path: Path, reason: str) -> PartFileError:
-    """The error for a part file: ``"<path>: <reason>"``."""
-    return PartFileError(f"{path}: {reason}")
+    """The error for a part file: ``"<path>: <reason>"``, on one line.
+
+    Reasons quoting a parser (GEOS, ezdxf, expat) may hold line breaks; they become spaces.
+    """
+    return PartFileError(f"{path}: {' '.join(reason.split())}")
 
 
 def need(module: str) -> Any:
@@ -97,30 +144,192 @@ def need(module: str) -> Any:
         raise MissingExtraError(module, "io") from None
 
 
-def read_bytes(path: Path) -> bytes:
-    """The file's bytes; an empty or unreadable file is a PartFileError."""
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise fail(path, "no such file") from None
-    except IsADirectoryError:
-        raise fail(path, "is a directory, not a part file") from None
-    except OSError as exc:
-        raise fail(path, f"cannot read the file ({exc.strerror or exc})") from None
+def quote(text: str, limit: int = 60) -> str:
+    """``repr`` of a piece of the file for a message, cut to ``limit`` characters."""
+    return repr(text) if len(text) <= limit else repr(text[:limit]) + f" ... ({len(text)} chars)"
+
+
+def brief(value: Any, limit: int = 60) -> str:
+    """``repr`` of a value for a message, cut to ``limit`` characters."""
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + " ..."
+
+
+def refuse_options(
+    path: Path, options: ReadOptions, what: str, *, element: bool = False, layer: bool = False
+) -> None:
+    """Refuse ``element`` or ``layer`` for a file that has no such choice.
+
+    ``what`` names the kind of file in the message; ``element`` and ``layer`` say which
+    choices it has.
+    """
+    if options.element is not None and not element:
+        hint = "; in DXF choose a `layer`" if layer else " (it holds one part)"
+        raise fail(
+            path,
+            f"`element` applies to SVG, GeoJSON and WKT files, not to {what}{hint}; got "
+            f"element={quote(options.element)}",
+        )
+    if options.layer is not None and not layer:
+        hint = "; choose an outline with `element`" if element else ""
+        raise fail(
+            path,
+            f"`layer` applies to DXF files, not to {what}{hint}; got layer={quote(options.layer)}",
+        )
+
+
+def _too_large(path: Path) -> PartFileError:
+    return fail(
+        path,
+        f"the part file is larger than the limit of {MAX_BYTES} bytes ({MAX_BYTES / 2**20:g} MiB)",
+    )
+
+
+def check_bytes(path: Path, data: bytes) -> bytes:
+    """Refuse empty or oversized contents (:data:`MAX_BYTES`)."""
+    if len(data) > MAX_BYTES:
+        raise _too_large(path)
     if not data.strip():
         raise fail(path, "the file is empty")
     return data
 
 
-def read_text(path: Path) -> str:
-    """The file as UTF-8 text (a byte-order mark is allowed)."""
-    data = read_bytes(path)
+_KINDS = (
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def read_bytes(path: Path) -> bytes:
+    """The file's bytes: a regular file of at most :data:`MAX_BYTES` bytes, not empty.
+
+    The file is opened without blocking and checked before it is read, so a FIFO or a
+    device is refused at once instead of blocking or reading without end.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(path, flags)
+    except FileNotFoundError:
+        raise fail(path, "no such file") from None
+    except IsADirectoryError:
+        raise fail(path, "is a directory, not a part file") from None
+    except OSError as exc:
+        if exc.errno == errno.ENXIO:  # a FIFO without a writer, a socket
+            raise fail(path, "is not a regular file (a FIFO or a socket)") from None
+        raise fail(path, f"cannot read the file ({exc.strerror or exc})") from None
+    try:
+        info = os.fstat(fd)
+        mode = info.st_mode
+        if stat.S_ISDIR(mode):
+            raise fail(path, "is a directory, not a part file")
+        if not stat.S_ISREG(mode):
+            kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
+            raise fail(path, f"is {kind}, not a regular file; give a part file")
+        if info.st_size > MAX_BYTES:  # refused unread (the loop below also stops there)
+            raise _too_large(path)
+        chunks: list[bytes] = []
+        size = 0
+        while size <= MAX_BYTES:
+            chunk = os.read(fd, min(1 << 20, MAX_BYTES + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    except OSError as exc:
+        raise fail(path, f"cannot read the file ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
+    return check_bytes(path, b"".join(chunks))
+
+
+def decode_text(path: Path, data: bytes) -> str:
+    """The bytes as UTF-8 text (a byte-order mark is allowed)."""
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise fail(
-            path, f"not a text file (byte {exc.start} is not UTF-8); is the format right?"
+            path,
+            f"not UTF-8 text (byte {exc.start} is 0x{data[exc.start]:02x}); save the file as "
+            "UTF-8, or check the format",
         ) from None
+
+
+def read_text(path: Path) -> str:
+    """The file as UTF-8 text (a byte-order mark is allowed)."""
+    return decode_text(path, read_bytes(path))
+
+
+class _NumberTooLarge(ValueError):
+    """A JSON number beyond the range of a float."""
+
+
+def _json_int(text: str) -> int:
+    # Python refuses to convert more than 4300 digits to an int (ValueError), and a float
+    # cannot hold more than 308: such numbers are coordinates no part can have.
+    if len(text.lstrip("-")) > 300:
+        raise _NumberTooLarge(f"a number of {len(text.lstrip('-'))} digits")
+    return int(text)
+
+
+def _json_float(text: str) -> float:
+    value = float(text)
+    if math.isinf(value):
+        raise _NumberTooLarge(f"the number {quote(text)}")
+    return value
+
+
+def nesting_depth(data: Any) -> int:
+    """Depth of nested lists and dicts (iterative: safe on any depth)."""
+    if not isinstance(data, dict | list):
+        return 0
+    deepest = 0
+    stack: list[tuple[dict[str, Any] | list[Any], int]] = [(data, 1)]
+    while stack:
+        item, depth = stack.pop()
+        deepest = max(deepest, depth)
+        children = item.values() if isinstance(item, dict) else item
+        stack.extend((c, depth + 1) for c in children if isinstance(c, dict | list))
+    return deepest
+
+
+def load_json(path: Path, text: str) -> Any:
+    """Parse JSON text; malformed, too deeply nested or oversized numbers are errors."""
+    try:
+        data = json.loads(text, parse_int=_json_int, parse_float=_json_float)
+    except _NumberTooLarge as exc:
+        raise fail(path, f"coordinates too large: {exc} is beyond the range of a float") from None
+    except json.JSONDecodeError as exc:
+        raise fail(path, f"not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    except RecursionError:
+        raise fail(path, f"JSON nested deeper than the limit of {MAX_NESTING} levels") from None
+    except ValueError as exc:  # a number the parser cannot convert
+        raise fail(path, f"not valid JSON ({str(exc)[:120]})") from None
+    if nesting_depth(data) > MAX_NESTING:
+        raise fail(path, f"JSON nested deeper than the limit of {MAX_NESTING} levels")
+    return data
+
+
+def check_coordinates(path: Path, points: FloatArray, what: str) -> None:
+    """Refuse non-finite coordinates and coordinates beyond :data:`MAX_COORDINATE`."""
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    if np.isnan(pts).any():
+        raise fail(path, f"coordinates must be finite; {what} has a coordinate that is NaN")
+    if np.isinf(pts).any():
+        raise fail(
+            path,
+            f"coordinates too large: {what} has an infinite coordinate (beyond the range of a "
+            f"float); the limit is {MAX_COORDINATE:g} in absolute value",
+        )
+    if pts.size:
+        biggest = float(np.max(np.abs(pts)))
+        if biggest > MAX_COORDINATE:
+            raise fail(
+                path,
+                f"coordinates too large: {what} reaches {biggest:.3g}; the limit is "
+                f"{MAX_COORDINATE:g} in absolute value (rescale the drawing's units)",
+            )
 
 
 def chordal_tolerance(path: Path, options: ReadOptions, bounds: FloatArray) -> float:
@@ -155,9 +364,10 @@ def flatten_rings(
     curves = [c for r in rings for c in r.curves]
     predicted = sum(predicted_points(curves, tol)) + len(rings)
     if predicted > options.max_points:
+        count = f"{predicted}" if predicted < 10**12 else f"more than {10**12:.0e}"
         raise fail(
             path,
-            f"the curves flatten to {predicted} points at chordal tolerance {tol:.6g}; the "
+            f"the curves flatten to {count} points at chordal tolerance {tol:.6g}; the "
             f"limit is {options.max_points} (give a coarser tolerance)",
         )
     budget = FlattenBudget(options.max_points)
@@ -249,14 +459,18 @@ def assemble_part(
 
 def shapely_polygons(geom: Any) -> list[Any]:
     """The non-empty polygons of a shapely geometry, in order (collections flattened)."""
-    if geom is None or geom.is_empty:
-        return []
-    kind = geom.geom_type
-    if kind == "Polygon":
-        return [geom]
-    if kind in ("MultiPolygon", "GeometryCollection"):
-        return [p for g in geom.geoms for p in shapely_polygons(g)]
-    return []
+    out: list[Any] = []
+    stack = [geom]
+    while stack:
+        g = stack.pop()
+        if g is None or g.is_empty:
+            continue
+        kind = g.geom_type
+        if kind == "Polygon":
+            out.append(g)
+        elif kind in ("MultiPolygon", "GeometryCollection"):
+            stack.extend(reversed(list(g.geoms)))
+    return out
 
 
 def polygon_part(
@@ -266,6 +480,8 @@ def polygon_part(
     rings = [np.asarray(polygon.exterior.coords, dtype=np.float64)[:, :2]]
     rings += [np.asarray(r.coords, dtype=np.float64)[:, :2] for r in polygon.interiors]
     check_count(path, sum(len(r) for r in rings), options)
+    for k, r in enumerate(rings):
+        check_coordinates(path, r, f"the {'exterior ring' if k == 0 else f'hole {k}'}")
     try:
         return Part.from_outline(rings[0], rings[1:], name=name, units=units)
     except PartError as exc:
@@ -283,9 +499,10 @@ def pick(path: Path, labels: Sequence[str], options: ReadOptions, what: str) -> 
     if options.element is not None:
         if options.element in labels:
             return list(labels).index(options.element)
-        if options.element.isdigit() and int(options.element) < len(labels):
-            return int(options.element)
-        raise fail(path, f"no {what} {options.element!r}; found: {listed}")
+        index = options.element
+        if index.isascii() and index.isdigit() and len(index) < 10 and int(index) < len(labels):
+            return int(index)
+        raise fail(path, f"no {what} {quote(options.element)}; found: {listed}")
     if len(labels) > 1:
         raise fail(
             path,

@@ -43,6 +43,17 @@ FloatArray = NDArray[np.float64]
 #: least four chords per full turn, so a circle stays a polygon with area.
 MAX_ARC_STEP = math.pi / 2
 
+#: Chord counts are capped here: a tolerance absurdly small for the curve (whose count
+#: would overflow, or whose step underflows to zero) is refused by the point limit anyway.
+_MAX_COUNT = 2**62
+
+
+def _count(x: float) -> int:
+    """``ceil(x)`` of a chord count (at least 1), capped at ``_MAX_COUNT``."""
+    if not x < _MAX_COUNT:  # also inf and NaN
+        return _MAX_COUNT
+    return max(1, math.ceil(x - 1e-9))
+
 
 class TooManyPoints(Exception):  # an internal signal, turned into PartFileError
     """A curve (or the whole file) would flatten to more points than allowed."""
@@ -183,7 +194,7 @@ class EllipticArc(Curve):
     def n_segments(self, tol: float) -> int:
         sigma = self.sigma()
         step = MAX_ARC_STEP if sigma == 0 else min(math.sqrt(8.0 * tol / sigma), MAX_ARC_STEP)
-        return max(1, math.ceil(abs(self.span) / step - 1e-9))
+        return _count(abs(self.span) / step) if step > 0 else _MAX_COUNT
 
     def points(self, tol: float, budget: FlattenBudget, what: str) -> FloatArray:
         n = self.n_segments(tol)
@@ -233,7 +244,7 @@ class Bezier(Curve):
             return 1
         second = self.control[:-2] - 2.0 * self.control[1:-1] + self.control[2:]
         bound = d * (d - 1) * float(np.max(np.hypot(second[:, 0], second[:, 1])))
-        return max(1, math.ceil(math.sqrt(bound / (8.0 * tol)) - 1e-9))
+        return _count(math.sqrt(bound / (8.0 * tol)))
 
     def at(self, t: ArrayLike) -> FloatArray:
         """Points at parameters ``t`` in ``[0, 1]`` (Bernstein form, vectorised)."""

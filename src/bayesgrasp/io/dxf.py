@@ -8,14 +8,27 @@ outlines and are left out. Block references (INSERT) are expanded.
 
 The outer ring is the outline; rings inside it are holes (they move the centre of mass).
 Several separate outer rings need a choice: ``layer`` keeps the entities of one layer.
-Units come from the header's ``$INSUNITS`` (``None`` when unitless). Entities are
-projected onto the xy plane of the world coordinate system.
+Units come from the header's ``$INSUNITS`` (``None`` when it is 0, unknown, or not in the
+file: ezdxf would otherwise fill in its own default, metres). Entities are projected onto
+the xy plane of the world coordinate system. The file is parsed in memory (ASCII or binary
+DXF; the text encoding of old versions comes from ``$DWGCODEPAGE``).
+
+Limits, each refused with the limit named: at most
+:data:`~bayesgrasp.io._common.MAX_ENTITIES` entities, counted in the file before parsing and
+again as block references are expanded; blocks nest at most ``MAX_BLOCK_DEPTH`` deep and a
+block that inserts itself (directly or through others) is refused; SPLINE degree at most
+``MAX_SPLINE_DEGREE``. Also refused: an INSERT with a scale factor of 0, a CIRCLE or ARC
+without a positive radius, and coordinates that are not finite or larger than
+:data:`~bayesgrasp.io._common.MAX_COORDINATE`.
 """
 
 from __future__ import annotations
 
+import io
 import logging
 import math
+import re
+from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -23,20 +36,25 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..errors import PartFileError
 from ..geometry import Part
 from ._common import (
+    MAX_ENTITIES,
     ReadOptions,
     Ring,
     assemble_part,
+    check_coordinates,
     chordal_tolerance,
     fail,
     flatten_rings,
     need,
+    quote,
     read_bytes,
+    refuse_options,
 )
 from ._flatten import Adaptive, Bezier, Curve, EllipticArc, Polyline
 
-__all__ = ["INSUNITS", "read_dxf"]
+__all__ = ["INSUNITS", "MAX_BLOCK_DEPTH", "MAX_SPLINE_DEGREE", "parse_dxf", "read_dxf"]
 
 log = logging.getLogger("bayesgrasp.io")
 
@@ -70,7 +88,16 @@ INSUNITS = {
     24: "US mi",
 }
 
-_MAX_BLOCK_DEPTH = 8
+#: Deepest nesting of block references (an INSERT in a block inserted by an INSERT ...).
+MAX_BLOCK_DEPTH = 8
+
+#: Highest SPLINE degree (CAD programs draw degree 1 to 11; Bezier pieces of degree d cost
+#: O(d) per point).
+MAX_SPLINE_DEGREE = 25
+
+_BINARY_SENTINEL = b"AutoCAD Binary DXF\r\n\x1a\x00"
+# ``$INSUNITS`` as a header variable name (group code 9), ASCII or binary DXF.
+_HAS_INSUNITS = re.compile(rb"(?m)^[ \t]*9[ \t]*\r?\n[ \t]*\$INSUNITS[ \t]*\r?$|\$INSUNITS\x00")
 
 
 def _xy(v: Any) -> FloatArray:
@@ -190,6 +217,11 @@ def _clamped(bs: Any) -> Any:
 
 
 def _spline_curves(entity: Any) -> list[Curve]:
+    degree = entity.dxf.degree
+    if not 1 <= degree <= MAX_SPLINE_DEGREE:
+        raise _Refused(
+            f"{_source(entity)} has degree {degree}; the limit is 1 to {MAX_SPLINE_DEGREE}"
+        )
     bs = entity.construction_tool()
     if not bs.is_clamped:
         bs = _clamped(bs)
@@ -212,6 +244,12 @@ def _entity_curves(entity: Any) -> tuple[list[Curve], bool] | None:
         s, e = _xy(dxf.start), _xy(dxf.end)
         return ([Polyline(np.array([s, e]))] if not np.array_equal(s, e) else [], False)
     if kind in ("ARC", "CIRCLE"):
+        if not dxf.hasattr("radius"):
+            raise _Refused(f"{_source(entity)} has no radius (group code 40)")
+        if not (math.isfinite(dxf.radius) and dxf.radius >= 0):
+            raise _Refused(f"{_source(entity)} has radius {dxf.radius!r}; it must be >= 0")
+        if dxf.radius == 0:
+            return [], kind == "CIRCLE"  # a point
         frame = _Frame(entity)
         center = dxf.center
         if kind == "CIRCLE":
@@ -258,19 +296,101 @@ def _entity_curves(entity: Any) -> tuple[list[Curve], bool] | None:
     return None
 
 
-def _entities(msp: Any, layer: str | None) -> Iterator[Any]:
-    """Model-space entities of the layer, with block references expanded."""
+class _Refused(ValueError):
+    """An entity the reader refuses (turned into PartFileError with the file's name)."""
 
-    def expand(entity: Any, depth: int) -> Iterator[Any]:
-        if entity.dxftype() == "INSERT" and depth < _MAX_BLOCK_DEPTH:
-            for sub in entity.virtual_entities():
-                yield from expand(sub, depth + 1)
-        else:
+
+def _source(entity: Any) -> str:
+    return f"{entity.dxftype()} #{entity.dxf.handle} on layer {entity.dxf.layer}"
+
+
+def _check_blocks(msp: Any, layer: str | None) -> None:
+    """Refuse block references that expand too far, before anything is expanded.
+
+    The size and depth of each block's expansion are counted from the block definitions
+    (memoised, so a bomb of nested references costs one pass over its definitions).
+    """
+    doc = msp.doc
+    cap = MAX_ENTITIES + 1
+    memo: dict[str, tuple[int, int]] = {}  # block -> (entities once expanded, levels)
+
+    def expansion(name: str, chain: tuple[str, ...]) -> tuple[int, int]:
+        if name in memo:
+            return memo[name]
+        path = " -> ".join([*chain, name])
+        if name in chain:
+            raise _Refused(f"block {quote(name)} inserts itself ({path})")
+        if len(chain) >= MAX_BLOCK_DEPTH:
+            raise _Refused(f"block references nest deeper than {MAX_BLOCK_DEPTH} levels ({path})")
+        block = doc.blocks.get(name)
+        count, levels = 0, 1
+        for entity in block if block is not None else ():
+            count += 1
+            if entity.dxftype() == "INSERT":
+                n, depth = expansion(str(entity.dxf.name), (*chain, name))
+                count, levels = count + n, max(levels, depth + 1)
+            if count >= cap:
+                break
+        memo[name] = (min(count, cap), levels)
+        return memo[name]
+
+    total = 0
+    for entity in msp:
+        if layer is not None and str(entity.dxf.layer).lower() != layer.lower():
+            continue
+        total += 1
+        if entity.dxftype() == "INSERT":
+            total += expansion(str(entity.dxf.name), ())[0]
+        if total > MAX_ENTITIES:
+            raise _Refused(
+                f"more than {MAX_ENTITIES} entities with block references expanded "
+                f"(the limit is {MAX_ENTITIES})"
+            )
+
+
+def _entities(msp: Any, layer: str | None) -> Iterator[Any]:
+    """Model-space entities of the layer, with block references expanded.
+
+    At most :data:`MAX_ENTITIES` entities are yielded or expanded (counted from the block
+    definitions first, then again as ezdxf expands them); a block that inserts itself, or
+    references nested deeper than :data:`MAX_BLOCK_DEPTH`, are refused.
+    """
+    _check_blocks(msp, layer)
+    count = 0
+
+    def expand(entity: Any, chain: tuple[str, ...]) -> Iterator[Any]:
+        nonlocal count
+        count += 1
+        if count > MAX_ENTITIES:
+            raise _Refused(
+                f"more than {MAX_ENTITIES} entities with block references expanded "
+                f"(the limit is {MAX_ENTITIES})"
+            )
+        if entity.dxftype() != "INSERT":
             yield entity
+            return
+        dxf = entity.dxf
+        block = str(dxf.name)
+        if block in chain:
+            raise _Refused(f"block {quote(block)} inserts itself ({' -> '.join([*chain, block])})")
+        if len(chain) >= MAX_BLOCK_DEPTH:
+            raise _Refused(
+                f"block references nest deeper than {MAX_BLOCK_DEPTH} levels "
+                f"({' -> '.join([*chain, block])})"
+            )
+        for axis in ("xscale", "yscale", "zscale"):
+            factor = dxf.get(axis, 1.0)
+            if not math.isfinite(factor) or factor == 0:
+                raise _Refused(
+                    f"{_source(entity)} inserts block {quote(block)} with {axis} {factor!r}; "
+                    "scale factors must be finite and non-zero"
+                )
+        for sub in entity.virtual_entities():
+            yield from expand(sub, (*chain, block))
 
     for entity in msp:
         if layer is None or str(entity.dxf.layer).lower() == layer.lower():
-            yield from expand(entity, 0)
+            yield from expand(entity, ())
 
 
 def _chain(pieces: list[tuple[list[Curve], str, str]], gap: float) -> tuple[list[Ring], list[str]]:
@@ -287,22 +407,32 @@ def _chain(pieces: list[tuple[list[Curve], str, str]], gap: float) -> tuple[list
     node = np.array([nodes[k] for k in range(len(ends))]).reshape(-1, 2)  # (P, 2) node ids
     alive = np.ones(len(pieces), dtype=bool)
     notes: list[str] = []
-    while True:  # peel pieces at dangling ends (degree 1) and branches (degree > 2)
-        ids, counts = np.unique(node[alive].ravel(), return_counts=True)
-        degree = dict(zip(ids.tolist(), counts.tolist(), strict=True))
-        drop = [
-            int(k)
-            for k in np.flatnonzero(alive)
-            if degree[node[k, 0]] != 2 or degree[node[k, 1]] != 2
-        ]
-        if not drop:
-            break
-        for k in drop:
-            end = 0 if degree[node[k, 0]] != 2 else 1
+    # Peel pieces at dangling ends (degree 1) and branches (degree > 2), a queue of nodes
+    # whose degree changed: O(P) in all.
+    degree: dict[int, int] = {}
+    at_node: dict[int, list[int]] = {}
+    for k, (a, b) in enumerate(node.tolist()):
+        for n in (a, b):
+            degree[n] = degree.get(n, 0) + 1
+            at_node.setdefault(n, []).append(k)
+    queue = deque(n for n, d in degree.items() if d != 2)
+    while queue:
+        n = queue.popleft()
+        if degree[n] == 2:
+            continue
+        for k in at_node[n]:
+            if not alive[k]:
+                continue
+            end = 0 if int(node[k, 0]) == n else 1
             at = ends[2 * k + end]
-            why = "branches" if degree[node[k, end]] > 2 else "ends"
+            why = "branches" if degree[n] > 2 else "ends"
             notes.append(f"{pieces[k][1]}: its chain {why} at ({at[0]:.6g}, {at[1]:.6g})")
             alive[k] = False
+            for m in (int(node[k, 0]), int(node[k, 1])):
+                degree[m] -= 1
+                if m != n:
+                    queue.append(m)
+        degree[n] = 0
     incident: dict[int, list[int]] = {}
     for k in np.flatnonzero(alive).tolist():
         for n in node[k]:
@@ -338,6 +468,147 @@ def _chain(pieces: list[tuple[list[Curve], str, str]], gap: float) -> tuple[list
     return rings, notes
 
 
+def _entity_count(path: Path, data: bytes) -> None:
+    """Refuse an ASCII DXF with more than MAX_ENTITIES entities, before ezdxf parses it.
+
+    Every entity (and every VERTEX, table record, object) starts with group code 0; the
+    file alternates group-code lines and value lines.
+    """
+    if data.startswith(_BINARY_SENTINEL):
+        return
+    codes = data.splitlines()[0::2]
+    count = sum(1 for c in codes if c.strip() == b"0")
+    if count > MAX_ENTITIES:
+        raise fail(
+            path,
+            f"the file has {count} entities and records; the limit is {MAX_ENTITIES}",
+        )
+
+
+def _load(ezdxf: Any, path: Path, data: bytes) -> Any:
+    """Parse a DXF document from memory, as ``ezdxf.readfile`` does from a file."""
+    from ezdxf.document import Drawing
+    from ezdxf.filemanagement import dxf_stream_info
+    from ezdxf.lldxf.tagger import binary_tags_loader
+    from ezdxf.lldxf.validator import is_dxf_stream
+
+    if data.startswith(_BINARY_SENTINEL):
+        return Drawing.load(binary_tags_loader(data, errors="surrogateescape"))
+    probe = io.TextIOWrapper(io.BytesIO(data), encoding="utf-8", errors="ignore")
+    if not is_dxf_stream(probe):
+        raise ValueError("no DXF SECTION found")
+    info = dxf_stream_info(io.TextIOWrapper(io.BytesIO(data), encoding="utf-8", errors="ignore"))
+    try:
+        codec = info.encoding
+        "".encode(codec)
+    except LookupError:
+        codec = "cp1252"
+    return ezdxf.read(io.TextIOWrapper(io.BytesIO(data), encoding=codec, errors="surrogateescape"))
+
+
+def _units(path: Path, doc: Any, data: bytes) -> str | None:
+    """The unit name of ``$INSUNITS``, or None when the file does not give it."""
+    if _HAS_INSUNITS.search(data) is None:
+        return None  # ezdxf's default header would say metres
+    code = doc.header.get("$INSUNITS", 0)
+    if isinstance(code, bool) or not isinstance(code, int | float) or not math.isfinite(code):
+        log.info("%s: ignored $INSUNITS %r (not a unit code)", path, code)
+        return None
+    if code != int(code):
+        return None
+    return INSUNITS.get(int(code))
+
+
+def parse_dxf(data: bytes, path: Path, options: ReadOptions) -> Part:
+    """Read the outline of a DXF drawing from the file's bytes.
+
+    Examples
+    --------
+    >>> import ezdxf, io
+    >>> doc = ezdxf.new(units=4)
+    >>> _ = doc.modelspace().add_circle((0, 0), 5)
+    >>> text = io.StringIO()
+    >>> doc.write(text)
+    >>> p = parse_dxf(text.getvalue().encode(), Path("disc.dxf"), ReadOptions())
+    >>> p.units, p.hull.n_sides > 20
+    ('mm', True)
+    """
+    ezdxf = need("ezdxf")
+    refuse_options(path, options, "a DXF file", layer=True)
+    _entity_count(path, data)
+    try:
+        doc = _load(ezdxf, path, data)
+    except Exception as exc:  # ezdxf raises several types on malformed input
+        raise fail(
+            path, f"not a readable DXF file ({type(exc).__name__}: {str(exc)[:200]})"
+        ) from None
+    units = _units(path, doc, data)
+    msp = doc.modelspace()
+
+    closed_rings: list[Ring] = []
+    pieces: list[tuple[list[Curve], str, str]] = []
+    skipped: dict[str, int] = {}
+    try:
+        # Huge coordinates overflow in the transforms; the box check below says so.
+        with np.errstate(over="ignore", invalid="ignore"):
+            for entity in _entities(msp, options.layer):
+                layer = str(entity.dxf.layer)
+                source = f"{entity.dxftype()} #{entity.dxf.handle} on layer {layer}"
+                got = _entity_curves(entity)
+                if got is None:
+                    skipped[entity.dxftype()] = skipped.get(entity.dxftype(), 0) + 1
+                    continue
+                curves, closed = got
+                if not curves:
+                    continue
+                if closed:
+                    closed_rings.append(Ring(tuple(curves), source, layer))
+                else:
+                    pieces.append((curves, source, layer))
+    except _Refused as exc:
+        raise fail(path, str(exc)) from None
+    except PartFileError:
+        raise
+    except Exception as exc:  # ezdxf raises many types on malformed entities
+        raise fail(
+            path, f"an entity cannot be read ({type(exc).__name__}: {str(exc)[:200]})"
+        ) from None
+    if skipped:
+        log.info("%s: skipped entities that are not outlines: %s", path, skipped)
+
+    every = [c for r in closed_rings for c in r.curves] + [c for p in pieces for c in p[0]]
+    if not every:
+        layers = sorted({str(e.dxf.layer) for e in msp})
+        where = (
+            f" on layer {quote(options.layer)} (layers: {', '.join(layers)})"
+            if options.layer
+            else ""
+        )
+        raise fail(path, f"no lines, arcs, circles, ellipses, splines or polylines{where}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        boxes = np.array([c.bounds() for c in every])
+    check_coordinates(path, boxes.reshape(-1, 2), "the drawing")
+    bounds = np.array([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
+    tol = chordal_tolerance(path, options, bounds)
+    loops, notes = _chain(pieces, tol)
+    for note in notes[:20]:
+        log.info("%s: left out %s", path, note)
+    if len(notes) > 20:
+        log.info("%s: left out %d more pieces", path, len(notes) - 20)
+    rings = closed_rings + loops
+    if not rings:
+        detail = f"; {notes[0]}" if notes else ""
+        raise fail(path, f"no closed outline{detail}")
+    flat = flatten_rings(path, rings, tol, options)
+    layers = sorted({r.group for r in rings})
+    if options.layer is None and len(layers) > 1:
+        choose = f"choose one with --layer (layers: {', '.join(layers)})"
+    else:
+        choose = "keep one part per layer (or per file) and choose it with --layer"
+    name = path.stem if options.layer is None else f"{path.stem}:{options.layer}"
+    return assemble_part(path, flat, name, units, choose)
+
+
 def read_dxf(path: Path, options: ReadOptions) -> Part:
     """Read the outline of a DXF drawing.
 
@@ -353,65 +624,4 @@ def read_dxf(path: Path, options: ReadOptions) -> Part:
     >>> p.units, round(float(p.outline[:, 0].max()), 2)
     ('mm', 25.0)
     """
-    ezdxf = need("ezdxf")
-    read_bytes(path)
-    if options.element is not None:
-        raise fail(path, "`element` applies to SVG, GeoJSON and WKT; in DXF choose a `layer`")
-    try:
-        doc = ezdxf.readfile(str(path))
-    except Exception as exc:  # ezdxf raises several types on malformed input
-        raise fail(path, f"not a readable DXF file ({type(exc).__name__}: {exc})") from None
-    code = doc.header.get("$INSUNITS", 0)
-    units = INSUNITS.get(int(code)) if isinstance(code, int | float) else None
-    msp = doc.modelspace()
-
-    closed_rings: list[Ring] = []
-    pieces: list[tuple[list[Curve], str, str]] = []
-    skipped: dict[str, int] = {}
-    try:
-        for entity in _entities(msp, options.layer):
-            layer = str(entity.dxf.layer)
-            source = f"{entity.dxftype()} #{entity.dxf.handle} on layer {layer}"
-            got = _entity_curves(entity)
-            if got is None:
-                skipped[entity.dxftype()] = skipped.get(entity.dxftype(), 0) + 1
-                continue
-            curves, closed = got
-            if not curves:
-                continue
-            if closed:
-                closed_rings.append(Ring(tuple(curves), source, layer))
-            else:
-                pieces.append((curves, source, layer))
-    except (ValueError, TypeError, IndexError, ZeroDivisionError, ezdxf.DXFError) as exc:
-        raise fail(path, f"an entity cannot be read ({type(exc).__name__}: {exc})") from None
-    if skipped:
-        log.info("%s: skipped entities that are not outlines: %s", path, skipped)
-
-    every = [c for r in closed_rings for c in r.curves] + [c for p in pieces for c in p[0]]
-    if not every:
-        layers = sorted({str(e.dxf.layer) for e in msp})
-        where = (
-            f" on layer {options.layer!r} (layers: {', '.join(layers)})" if options.layer else ""
-        )
-        raise fail(path, f"no lines, arcs, circles, ellipses, splines or polylines{where}")
-    boxes = np.array([c.bounds() for c in every])
-    if not np.all(np.isfinite(boxes)):
-        raise fail(path, "coordinates must be finite; the drawing has NaN or infinite values")
-    bounds = np.array([boxes[:, 0].min(axis=0), boxes[:, 1].max(axis=0)])
-    tol = chordal_tolerance(path, options, bounds)
-    loops, notes = _chain(pieces, tol)
-    for note in notes:
-        log.info("%s: left out %s", path, note)
-    rings = closed_rings + loops
-    if not rings:
-        detail = f"; {notes[0]}" if notes else ""
-        raise fail(path, f"no closed outline{detail}")
-    flat = flatten_rings(path, rings, tol, options)
-    layers = sorted({r.group for r in rings})
-    if options.layer is None and len(layers) > 1:
-        choose = f"choose one with --layer (layers: {', '.join(layers)})"
-    else:
-        choose = "keep one part per layer (or per file) and choose it with --layer"
-    name = path.stem if options.layer is None else f"{path.stem}:{options.layer}"
-    return assemble_part(path, flat, name, units, choose)
+    return parse_dxf(read_bytes(path), path, options)

@@ -2,6 +2,8 @@
 
 A ``MULTIPOLYGON`` or ``GEOMETRYCOLLECTION`` with several polygons needs a choice:
 ``element`` is the polygon's index (0-based). Parsing is shapely's (GEOS). WKT has no units.
+Parentheses may nest at most :data:`~bayesgrasp.io._common.MAX_NESTING` deep (GEOS's parser
+recurses on them and crashes on very deep nesting, so the text is checked first).
 """
 
 from __future__ import annotations
@@ -11,9 +13,55 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry import Part
-from ._common import ReadOptions, fail, need, pick, polygon_part, read_text, shapely_polygons
+from ._common import (
+    MAX_NESTING,
+    ReadOptions,
+    decode_text,
+    fail,
+    need,
+    pick,
+    polygon_part,
+    read_bytes,
+    refuse_options,
+    shapely_polygons,
+)
 
-__all__ = ["read_wkt"]
+__all__ = ["parse_wkt", "read_wkt"]
+
+
+def _paren_depth(data: bytes) -> int:
+    """Deepest nesting of parentheses (a running sum over the bytes, vectorised)."""
+    b = np.frombuffer(data, dtype=np.uint8)
+    step = (b == ord("(")).astype(np.int64) - (b == ord(")")).astype(np.int64)
+    return int(np.cumsum(step).max()) if len(step) else 0
+
+
+def parse_wkt(data: bytes, path: Path, options: ReadOptions) -> Part:
+    """Read a WKT polygon from the file's bytes.
+
+    Examples
+    --------
+    >>> parse_wkt(b"POLYGON ((0 0, 4 0, 4 2, 0 0))", Path("t.wkt"), ReadOptions()).hull.n_sides
+    3
+    """
+    shapely = need("shapely")
+    text = decode_text(path, data)
+    refuse_options(path, options, "a WKT file", element=True)
+    depth = _paren_depth(data)
+    if depth > MAX_NESTING:
+        raise fail(path, f"parentheses nest {depth} deep; the limit is {MAX_NESTING}")
+    try:
+        with np.errstate(invalid="ignore", over="ignore"):  # NaN and inf: reported below
+            geom = shapely.from_wkt(text.strip())
+    except (shapely.errors.ShapelyError, ValueError) as exc:
+        raise fail(path, f"not valid WKT ({str(exc)[:200]})") from None
+    polygons = shapely_polygons(geom)
+    if not polygons:
+        kind = "an empty geometry" if geom is None or geom.is_empty else f"a {geom.geom_type}"
+        raise fail(path, f"no polygon: the file holds {kind}")
+    index = pick(path, [str(i) for i in range(len(polygons))], options, "polygon")
+    name = path.stem if len(polygons) == 1 else f"{path.stem}[{index}]"
+    return polygon_part(path, polygons[index], name, None, options)
 
 
 def read_wkt(path: Path, options: ReadOptions) -> Part:
@@ -28,17 +76,4 @@ def read_wkt(path: Path, options: ReadOptions) -> Part:
     >>> p.hull.n_sides, len(p.holes)
     (4, 1)
     """
-    shapely = need("shapely")
-    text = read_text(path)
-    try:
-        with np.errstate(invalid="ignore"):  # NaN coordinates are reported below
-            geom = shapely.from_wkt(text.strip())
-    except (shapely.errors.GEOSException, ValueError) as exc:
-        raise fail(path, f"not valid WKT ({exc})") from None
-    polygons = shapely_polygons(geom)
-    if not polygons:
-        kind = "an empty geometry" if geom is None or geom.is_empty else f"a {geom.geom_type}"
-        raise fail(path, f"no polygon: the file holds {kind}")
-    index = pick(path, [str(i) for i in range(len(polygons))], options, "polygon")
-    name = path.stem if len(polygons) == 1 else f"{path.stem}[{index}]"
-    return polygon_part(path, polygons[index], name, None, options)
+    return parse_wkt(read_bytes(path), path, options)
