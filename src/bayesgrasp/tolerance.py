@@ -7,7 +7,11 @@ so a part drawn in metres and the same part drawn in millimetres behave identica
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+import numbers
+from dataclasses import dataclass, fields
+
+from .errors import PartError
 
 __all__ = ["DEFAULT_TOLERANCE", "Tolerance"]
 
@@ -28,7 +32,13 @@ class Tolerance:
         A rotation maps the part onto itself when every vertex lands within
         ``symmetry * size`` of a vertex; looser than ``length`` because symmetric parts
         often come from rounded coordinates (7 significant digits move a vertex of a part
-        drawn a few sizes from the origin by up to about ``2e-6 * size``).
+        drawn a few sizes from the origin by up to about ``2e-6 * size``). A part symmetric
+        within this tolerance is exactly symmetric everywhere downstream: its diameter and
+        radius functions are built from its symmetrized vertices, so the squeeze period is
+        ``2 pi / (r (1 + r mod 2))``, the push period ``2 pi / r`` (centre of mass at the
+        centroid), and every period holds to ``angle``. A part not symmetric within it is
+        not symmetric at all: its periods are those its extrema have to ``angle`` (pi and
+        2 pi, unless by an exact coincidence).
     probability : float
         Probabilities closer than this are equal (ties between plans).
     barrier : float
@@ -38,6 +48,11 @@ class Tolerance:
         (their depth grows with the square of the rounding angle: up to about
         ``1.3e-10 * size`` for 7 significant digits); no squeeze resolves them. Among
         random 10-point polygons about 1 in 3000 has such a pair of its own.
+
+    Raises
+    ------
+    PartError
+        A tolerance that is not a finite real number >= 0.
 
     Examples
     --------
@@ -50,6 +65,18 @@ class Tolerance:
     symmetry: float = 1e-5
     probability: float = 1e-12
     barrier: float = 1e-9
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            x = getattr(self, f.name)
+            if (
+                isinstance(x, bool)
+                or not isinstance(x, numbers.Real)
+                or not math.isfinite(x)
+                or x < 0
+            ):
+                raise PartError(f"`{f.name}` must be a finite number >= 0; got {x!r}")
+            object.__setattr__(self, f.name, float(x))
 
     def length_for(self, size: float) -> float:
         """Absolute length tolerance for a part of the given size."""

@@ -11,8 +11,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
-from bayesgrasp.geometry import polygon as geometry
 from bayesgrasp.errors import BayesGraspError, PartError
+from bayesgrasp.geometry import polygon as geometry
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part, as_points, polygon_area_centroid
 from bayesgrasp.tolerance import Tolerance
 from reference import max_pair_distance, regular_polygon, rotate, round_significant

@@ -15,15 +15,29 @@ done as a binary search of the sorted edge normals: O(n log n) for all pieces.
 
 Extrema: ``d`` is the maximum of sinusoids, so it is concave inside a piece and has convex
 kinks at alignments. Minima can only be kinks whose left slope is negative and right slope
-positive; maxima are the points inside a piece where its chord lies along x. A minimum less
-than ``Tolerance.barrier`` times the part's size below an adjacent maximum is dropped with
-that maximum: rounded coordinates make parallel edges and perpendicular chords only nearly
-so, which splits one stable orientation into two a hair apart.
+positive; maxima are the points inside a piece where its chord lies along x, or kinks where
+the slopes on both sides are zero within the angle tolerance. Read around the circle, with
+the slopes that are zero within the tolerance left out, minima and maxima alternate and pair
+up by construction (see ``_pieces_numpy``). A minimum less than ``Tolerance.barrier`` times
+the part's size below an adjacent maximum is dropped with that maximum: rounded coordinates
+make parallel edges and perpendicular chords only nearly so, which splits one stable
+orientation into two a hair apart.
+
+Near-symmetric parts: a part whose ``symmetry_order`` is r >= 3 (every vertex lands within
+``Tolerance.symmetry`` times the size of another under a turn by ``2 pi / r``) is taken to be
+exactly symmetric. Its extrema are those of the symmetrized polygon
+(:meth:`~bayesgrasp.geometry.polygon.ConvexPolygon.symmetrized`) over one period, simplified
+there and repeated, so they have the period ``2 pi / (r (1 + r mod 2))`` exactly and the
+squeeze, push and push-grasp functions built on them agree with the symmetry order (a part
+with 1e-8 noise on a regular 1000-gon would otherwise break ``s(theta + T) = s(theta) + T``
+by 1e-5 rad, and shallow pairs could be dropped in some periods and not in others). The
+pieces stay those of the polygon itself: ``d(theta)`` is the part's own width.
 """
 
 from __future__ import annotations
 
 import bisect
+import heapq
 import math
 from dataclasses import dataclass
 
@@ -61,7 +75,9 @@ class DiameterFunction:
         Indices of the vertices touching the +x and -x jaws on each piece.
     minima : ndarray
         Local minima in ``[0, pi)`` (edge alignments where ``d`` is locally least), except
-        those shallower than ``polygon.tol.barrier * polygon.size``.
+        those shallower than ``polygon.tol.barrier * polygon.size``; for a part symmetric
+        within the tolerance (order 3 or more), those of its symmetrized vertices, exactly
+        periodic (see the module docstring).
     maxima : ndarray
         Local maxima in ``[0, pi)`` (unstable equilibria of a squeeze), alternating with
         the minima.
@@ -109,6 +125,14 @@ class DiameterFunction:
 def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     """Build the exact diameter function of a convex polygon in O(n log n).
 
+    The pieces (``breaks``, ``lengths``, ``phases``, ``pairs``) are those of the polygon.
+    The extrema are those of ``d`` too, except for a part that is r-fold symmetric within
+    ``tol.symmetry`` (``polygon.symmetry_order``, r >= 3): it is treated as exactly
+    symmetric, and its extrema are those of :meth:`ConvexPolygon.symmetrized` over one
+    period ``T = 2 pi / (r (1 + r mod 2))``, repeated every ``T``. They then have the period
+    exactly (to rounding), and lie within the part's own round-off (about ``tol.symmetry``
+    times the size over an edge length, in radians) of its own extrema.
+
     Parameters
     ----------
     polygon : ConvexPolygon
@@ -116,6 +140,11 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     Returns
     -------
     DiameterFunction
+
+    Raises
+    ------
+    BayesGraspError
+        An internal error (a bug): no extremum, or minima and maxima that do not pair up.
 
     Examples
     --------
@@ -126,18 +155,36 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     """
     v = polygon.vertices
     tol = polygon.tol.angle
-    if len(v) <= _SMALL:
-        breaks, lengths, phases, pairs, extrema = _pieces_python(v, tol)
-    else:
-        breaks, lengths, phases, pairs, extrema = _pieces_numpy(v, tol)
-    min_at, min_d, max_at, max_d = extrema
-    if len(max_at) != len(min_at) or len(min_at) == 0:  # pragma: no cover - a bug, not input
-        raise BayesGraspError(
-            f"internal error: {len(min_at)} minima and {len(max_at)} maxima of the diameter"
+    pieces = _pieces_python if len(v) <= _SMALL else _pieces_numpy
+    breaks, lengths, phases, pairs, extrema = pieces(v, tol, math.pi)
+    depth = polygon.tol.barrier_for(polygon.size)
+    r = polygon.symmetry_order_from(3)  # a half turn changes nothing: d has the period pi
+    periods = r * (1 + r % 2) // 2 if r > 1 else 1  # periods of d in [0, pi)
+    if periods > 1:
+        # One period of the exactly symmetric part, simplified as a periodic function and
+        # repeated: the shallow pairs go in every period or in none.
+        period = math.pi / periods
+        sym_breaks, _, _, _, one = pieces(polygon.symmetrized(), tol, period)
+        kept = _drop_shallow(_merged(one, float(sym_breaks[0]), period), depth)
+        origin = float(sym_breaks[0])
+        minima, maxima = (
+            np.sort(
+                np.array(
+                    [
+                        _wrap1(origin + at + k * period, math.pi)
+                        for at, _, top in kept
+                        if top is is_max
+                        for k in range(periods)
+                    ],
+                    dtype=np.float64,
+                )
+            )
+            for is_max in (False, True)
         )
-    minima, maxima = _drop_shallow(
-        min_at, min_d, max_at, max_d, polygon.tol.barrier_for(polygon.size)
-    )
+    else:
+        kept = _drop_shallow(_merged(extrema, 0.0, math.pi), depth)
+        minima = np.array([at for at, _, top in kept if not top], dtype=np.float64)
+        maxima = np.array([at for at, _, top in kept if top], dtype=np.float64)
     arrays = (breaks, lengths, phases, pairs, minima, maxima)
     for arr in arrays:
         arr.setflags(write=False)
@@ -145,16 +192,35 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
 
 
 # Below this many vertices plain Python floats beat numpy's cost per call; both paths make
-# the same decisions (tests/test_diameter.py compares them).
+# the same decisions (tests/geometry/test_diameter.py and test_numerics.py compare them).
 _SMALL = 40
 
 Extrema = tuple[list[float], list[float], list[float], list[float]]
+"""Angles and values of d at the minima, then angles and values at the maxima."""
+
+# How the extrema are found (both paths). Each piece has a slope sign at its start and at
+# its end: the sign of (phase - angle), zero when the chord is within the angle tolerance of
+# lying along x there (nearly flat). Around the circle these signs form one cyclic sequence
+# (start and end of piece 0, of piece 1, ...); d is concave inside a piece (the signs do not
+# rise there) and has convex kinks at the breaks. Dropping the zeros, each change from - to +
+# is a minimum and each change from + to - a maximum, so minima and maxima alternate and
+# pair up whatever the zeros (the 1e-10 noise of a regular 12-gon leaves opposite edges
+# parallel to about 1e-9 rad: a piece of that width between their alignments, flat at both
+# ends, on which the earlier rules lost a minimum). With i the entry of the last nonzero
+# sign before a change: a maximum with no zero between, inside piece i / 2 (i even), is at
+# that piece's phase; every other extremum is at the first break after entry i, the break
+# (i + 2) // 2 (d is flat to the angle tolerance across the zeros, so which break is moot).
 
 
 def _pieces_numpy(
-    v: FloatArray, tol: float
+    v: FloatArray, tol: float, period: float = math.pi
 ) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, Extrema]:
-    """Pieces and extrema (angles and values of d) by array operations, O(n log n)."""
+    """Pieces over ``[0, pi)`` and extrema over one period, by array operations, O(n log n).
+
+    ``period`` is ``pi`` or, for a symmetric polygon, ``pi / j``: the extrema are then those
+    of the pieces that start in ``[breaks[0], breaks[0] + period)``, read as one cyclic
+    sequence (the polygon must have that period).
+    """
     n = len(v)
     e = np.concatenate((v[1:], v[:1])) - v  # (n, 2) edge i runs from v_i to v_{i+1}
     normals = _wrap(np.arctan2(e[:, 1], e[:, 0]) - math.pi / 2, TWO_PI)  # outward, CCW hull
@@ -185,26 +251,32 @@ def _pieces_numpy(
     phases = mids - (np.mod(mids + gamma + math.pi, TWO_PI) - math.pi)
 
     # Slopes at the ends of each piece: sign of (phase - angle), zero within tolerance.
-    to_start, to_end = phases - breaks, phases - ends
-    slope_start = np.sign(to_start) * (np.abs(to_start) > tol)
-    slope_end = np.sign(to_end) * (np.abs(to_end) > tol)
-    interior_max = (slope_start > 0) & (slope_end < 0)
-    prev_end = np.concatenate((slope_end[-1:], slope_end[:-1]))  # slope before each break
-    kink_min = (prev_end < 0) & (slope_start > 0)
-    kink_max = (prev_end == 0) & (slope_start == 0)
-
-    at_break = lengths * np.cos(to_start)  # (P,) d at each break
+    w = _window(breaks.tolist(), period, tol)
+    to_start, to_end = phases[:w] - breaks[:w], phases[:w] - ends[:w]
+    signs = np.empty(2 * w, dtype=np.int8)  # (2W,) start and end of each piece, in turn
+    signs[0::2] = (to_start > tol).astype(np.int8) - (to_start < -tol)
+    signs[1::2] = (to_end > tol).astype(np.int8) - (to_end < -tol)
+    nonzero = np.flatnonzero(signs)
+    sig = signs[nonzero]
+    change = np.flatnonzero(sig != np.roll(sig, 1))
+    last = np.roll(nonzero, 1)[change]  # (X,) entry of the last nonzero sign before each
+    is_max = np.roll(sig, 1)[change] > 0
+    interior = is_max & (np.mod(nonzero[change] - last, 2 * w) == 1) & (last % 2 == 0)
+    at = (last + 2) // 2 % w  # the break after entry `last`
+    at_break = lengths[:w] * np.cos(to_start)  # (W,) d at each break
+    kink_max = is_max & ~interior
+    kink_min = ~is_max
     extrema = (
-        breaks[kink_min].tolist(),
-        at_break[kink_min].tolist(),
-        phases[interior_max].tolist() + breaks[kink_max].tolist(),
-        lengths[interior_max].tolist() + at_break[kink_max].tolist(),
+        breaks[at[kink_min]].tolist(),
+        at_break[at[kink_min]].tolist(),
+        phases[last[interior] // 2].tolist() + breaks[at[kink_max]].tolist(),
+        lengths[last[interior] // 2].tolist() + at_break[at[kink_max]].tolist(),
     )
     return breaks, lengths, phases, np.stack([i_plus, i_minus], axis=1), extrema
 
 
 def _pieces_python(
-    v: FloatArray, tol: float
+    v: FloatArray, tol: float, period: float = math.pi
 ) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, Extrema]:
     """The same as :func:`_pieces_numpy`, step for step, in plain Python (small polygons)."""
     pi = math.pi
@@ -218,39 +290,65 @@ def _pieces_python(
     normals_sorted = [normals[i] for i in order]
     b = sorted(_wrap1(-x, pi) for x in normals)
     breaks = [x for i, x in enumerate(b) if x - (b[i - 1] if i else b[-1] - pi) > tol] or b[:1]
-    p = len(breaks)
     ends = [*breaks[1:], breaks[0] + pi]
+    w = _window(breaks, period, tol)
     lengths, phases, i_plus, i_minus = [], [], [], []
-    min_at, min_d, max_at, max_d, kmax_at, kmax_d = [], [], [], [], [], []
-    slope_end = []
-    slope_start = []
+    starts: list[int] = []  # slope signs at the start and end of each piece of the window
+    stops: list[int] = []
     at_break = []
-    for lo, hi in zip(breaks, ends, strict=True):
+    for k, (lo, hi) in enumerate(zip(breaks, ends, strict=True)):
         mid = 0.5 * (lo + hi)
         a = order[bisect.bisect_left(normals_sorted, _wrap1(-mid, TWO_PI)) % n]
         c = order[bisect.bisect_left(normals_sorted, _wrap1(pi - mid, TWO_PI)) % n]
         cx, cy = xs[a] - xs[c], ys[a] - ys[c]
         length = math.hypot(cx, cy)
         phase = mid - ((mid + math.atan2(cy, cx) + pi) % TWO_PI - pi)
-        to_start, to_end = phase - lo, phase - hi
         i_plus.append(a)
         i_minus.append(c)
         lengths.append(length)
         phases.append(phase)
-        slope_start.append((to_start > tol) - (to_start < -tol))
-        slope_end.append((to_end > tol) - (to_end < -tol))
-        at_break.append(length * math.cos(to_start))
-        if slope_start[-1] > 0 and slope_end[-1] < 0:
-            max_at.append(phase)
-            max_d.append(length)
-    for k in range(p):
-        before = slope_end[k - 1]
-        if before < 0 and slope_start[k] > 0:
-            min_at.append(breaks[k])
-            min_d.append(at_break[k])
-        elif before == 0 and slope_start[k] == 0:
-            kmax_at.append(breaks[k])
-            kmax_d.append(at_break[k])
+        if k < w:
+            to_start, to_end = phase - lo, phase - hi
+            starts.append((to_start > tol) - (to_start < -tol))
+            stops.append((to_end > tol) - (to_end < -tol))
+            at_break.append(length * math.cos(to_start))
+    min_at, min_d, max_at, max_d, kmax_at, kmax_d = [], [], [], [], [], []
+    if 0 not in starts and 0 not in stops:
+        # Most parts: no zeros, so each change is between neighbouring entries: at a break
+        # (the entry before is the end of the previous piece) or inside a piece.
+        for k in range(w):
+            if stops[k - 1] != starts[k]:
+                if stops[k - 1] < 0:
+                    min_at.append(breaks[k])
+                    min_d.append(at_break[k])
+                else:
+                    kmax_at.append(breaks[k])
+                    kmax_d.append(at_break[k])
+            if starts[k] != stops[k]:
+                if starts[k] > 0:
+                    max_at.append(phases[k])
+                    max_d.append(lengths[k])
+                else:
+                    at = (k + 1) % w
+                    min_at.append(breaks[at])
+                    min_d.append(at_break[at])
+    else:
+        signs = [x for pair in zip(starts, stops, strict=True) for x in pair]
+        nonzero = [i for i, x in enumerate(signs) if x]
+        for t, j in enumerate(nonzero):
+            last = nonzero[t - 1]
+            if signs[last] == signs[j]:
+                continue
+            at = (last + 2) // 2 % w
+            if signs[last] < 0:
+                min_at.append(breaks[at])
+                min_d.append(at_break[at])
+            elif (j - last) % (2 * w) == 1 and last % 2 == 0:
+                max_at.append(phases[last // 2])
+                max_d.append(lengths[last // 2])
+            else:
+                kmax_at.append(breaks[at])
+                kmax_d.append(at_break[at])
     pairs = np.array([i_plus, i_minus], dtype=np.intp).T.copy()
     return (
         np.array(breaks),
@@ -259,6 +357,13 @@ def _pieces_python(
         pairs,
         (min_at, min_d, max_at + kmax_at, max_d + kmax_d),
     )
+
+
+def _window(breaks: list[float], period: float, tol: float) -> int:
+    """How many pieces start within one period of the first break (all of them for pi)."""
+    if period >= math.pi:
+        return len(breaks)
+    return max(1, bisect.bisect_left(breaks, breaks[0] + period - tol))
 
 
 def _wrap1(x: float, period: float) -> float:
@@ -274,46 +379,61 @@ def _wrap(x: FloatArray, period: float) -> FloatArray:
     return out
 
 
-def _drop_shallow(
-    min_at: list[float], min_d: list[float], max_at: list[float], max_d: list[float], depth: float
-) -> tuple[FloatArray, FloatArray]:
-    """Extrema over ``[0, pi)`` without the adjacent minimum-maximum pairs shallower than depth.
+Extremum = tuple[float, float, bool]
+"""Angle (from the start of the period), value of d, and whether it is a maximum."""
 
-    Minima and maxima alternate around the circle. Pairs whose values differ by at most
-    ``depth`` are cancelled, shallowest first (a persistence simplification), keeping at
-    least one minimum and one maximum; cancelling an adjacent pair keeps the alternation.
 
-    Returns
-    -------
-    minima, maxima : ndarray
-        Sorted angles in ``[0, pi)``.
-    """
-    pi = math.pi
-    ext = sorted(
+def _merged(extrema: Extrema, origin: float, period: float) -> list[Extremum]:
+    """Minima and maxima as one list sorted by angle from ``origin``, reduced to the period."""
+    min_at, min_d, max_at, max_d = extrema
+    if len(max_at) != len(min_at) or len(min_at) == 0:  # pragma: no cover - a bug, not input
+        raise BayesGraspError(
+            f"internal error: {len(min_at)} minima and {len(max_at)} maxima of the diameter"
+        )
+    return sorted(
         zip(
-            [_wrap1(x, pi) for x in min_at + max_at],
+            [_wrap1(x - origin, period) for x in min_at + max_at],
             min_d + max_d,
             [False] * len(min_at) + [True] * len(max_at),
             strict=True,
         )
     )
-    while len(ext) > 2:
-        m = len(ext)
-        rise = [abs(ext[(i + 1) % m][1] - ext[i][1]) for i in range(m)]
-        if min(rise) > depth:
-            break
-        # Cancel every pair shallower than depth that is shallower than the pairs it
-        # overlaps (ties go to the first); the rest wait for the next round.
-        pick = [
-            i
-            for i in range(m)
-            if rise[i] <= depth and rise[i] < rise[i - 1] and rise[i] <= rise[(i + 1) % m]
-        ] or [i for i in range(m) if rise[i] <= depth][:1]
-        pick = pick[: (m - 2) // 2]  # keep one minimum and one maximum
-        if not pick:
-            break
-        drop = {*pick, *((i + 1) % m for i in pick)}
-        ext = [x for i, x in enumerate(ext) if i not in drop]
-    minima = np.array([at for at, _, is_max in ext if not is_max], dtype=np.float64)
-    maxima = np.array([at for at, _, is_max in ext if is_max], dtype=np.float64)
-    return minima, maxima
+
+
+def _drop_shallow(ext: list[Extremum], depth: float) -> list[Extremum]:
+    """Cyclic, alternating extrema without the adjacent pairs shallower than ``depth``.
+
+    Pairs of neighbours whose values differ by at most ``depth`` are cancelled, shallowest
+    first (a persistence simplification; ties go to the first in angle), keeping at least
+    one minimum and one maximum; cancelling an adjacent pair keeps the alternation. A heap
+    of the neighbours' differences over a cyclic linked list: O(m log m), also when every
+    pair is shallow (a regular 99,999-gon).
+
+    Examples
+    --------
+    >>> _drop_shallow([(0.0, 1.0, False), (0.1, 1.0 + 1e-12, True), (0.2, 1.0, False),
+    ...                (1.0, 2.0, True)], 1e-9)
+    [(0.2, 1.0, False), (1.0, 2.0, True)]
+    """
+    m = len(ext)
+    rise = [abs(ext[i][1] - ext[i - 1][1]) for i in range(m)]  # rise[i]: from i - 1 to i
+    if m <= 2 or min(rise) > depth:
+        return ext
+    nxt = [*range(1, m), 0]
+    prv = [m - 1, *range(m - 1)]
+    alive = [True] * m
+    heap = [(rise[j], (j - 1) % m, j) for j in range(m) if rise[j] <= depth]
+    heapq.heapify(heap)
+    left = m
+    while heap and left > 2:
+        x, i, j = heapq.heappop(heap)
+        if not (alive[i] and nxt[i] == j and alive[j]):
+            continue  # stale: one end was cancelled, or a new neighbour came
+        a, b = prv[i], nxt[j]
+        alive[i] = alive[j] = False
+        nxt[a], prv[b] = b, a
+        left -= 2
+        x = abs(ext[b][1] - ext[a][1])
+        if x <= depth and a != b:
+            heapq.heappush(heap, (x, a, b))
+    return [x for x, keep in zip(ext, alive, strict=True) if keep]

@@ -12,6 +12,7 @@ rotation of the part *as given* relative to the gripper frame.
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from collections.abc import Sequence
@@ -59,7 +60,8 @@ def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
         if not isinstance(points, np.ndarray) and raw.dtype.kind in "iuf":
             # Lists mixing booleans and numbers become numbers in numpy: look at the items.
             items = np.asarray(points, dtype=object)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError, RecursionError) as exc:
+        # Ragged or deeply nested lists, objects whose __array__ or __len__ fails ...
         raise PartError(
             f"`{what}` must be numbers of shape (N, 2); could not read them: {exc}"
         ) from None
@@ -67,13 +69,43 @@ def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
         _check_real(raw, what)
     elif items is not None and items.ndim == 2:
         _check_real(items, what)
-    arr = np.array(raw, dtype=np.float64)
-    if arr.ndim != 2 or arr.shape[1] != 2:
-        raise PartError(f"`{what}` must have shape (N, 2); got shape {arr.shape}")
+    if raw.ndim != 2 or raw.shape[1] != 2:
+        raise PartError(f"`{what}` must have shape (N, 2); got shape {raw.shape}")
+    try:
+        arr = np.array(raw, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError) as exc:
+        # Python ints beyond the float range (10**400), or numbers whose __float__ fails.
+        raise PartError(_unconvertible(raw, what, exc)) from None
     if not np.all(np.isfinite(arr)):
         bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
         raise PartError(f"`{what}` must be finite; point {bad} is {arr[bad].tolist()}")
     return arr
+
+
+def _unconvertible(raw: NDArray[Any], what: str, exc: Exception) -> str:
+    """Why an array of real numbers (dtype object) could not become float64."""
+    for i, row in enumerate(raw.tolist()):
+        for x in row:
+            try:
+                float(x)
+            except OverflowError:
+                bits = x.bit_length() if isinstance(x, int) else 0
+                about = f" (about 1e{int(bits * math.log10(2))})" if bits else ""
+                return (
+                    f"`{what}` must be finite numbers within the range of a float; point {i} "
+                    f"has a coordinate too large{about}"
+                )
+            except (TypeError, ValueError):
+                break
+    return f"`{what}` must be numbers of shape (N, 2); could not convert them: {exc}"
+
+
+def _short_repr(x: object) -> str:
+    """The first 40 characters of ``repr(x)``, which may itself fail (an int of 5000 digits)."""
+    try:
+        return f"{x!r:.40}"
+    except Exception:  # any object's __repr__ may fail; the message must not
+        return "too large to show"
 
 
 _KIND_NAMES = {"b": "booleans", "c": "complex numbers", "U": "text", "S": "bytes"}
@@ -90,11 +122,16 @@ def _check_real(raw: NDArray[Any], what: str) -> None:
             if isinstance(x, bool | np.bool_) or not isinstance(x, numbers.Real):
                 raise PartError(
                     f"`{what}` must be numbers of shape (N, 2); got a {type(x).__name__} "
-                    f"({x!r:.40})"
+                    f"({_short_repr(x)})"
                 )
         return
     name = _KIND_NAMES.get(raw.dtype.kind, f"values of type {raw.dtype}")
     raise PartError(f"`{what}` must be numbers of shape (N, 2); got {name}")
+
+
+def _check_tolerance(tol: object) -> None:
+    if not isinstance(tol, Tolerance):
+        raise PartError(f"`tol` must be a Tolerance; got {type(tol).__name__}")
 
 
 # Areas are products of two coordinates: beyond these magnitudes they overflow or underflow.
@@ -302,8 +339,11 @@ class ConvexPolygon:
     area: float = field(init=False)
     centroid: FloatArray = field(init=False)
     size: float = field(init=False)
+    # symmetry_order once known; -k when only known to be below k; 0 before any test.
+    _symmetry: int = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        _check_tolerance(self.tol)
         v = as_points(self.vertices)
         n = len(v)
         what = "`vertices` must be a counter-clockwise convex polygon"
@@ -333,6 +373,7 @@ class ConvexPolygon:
         object.__setattr__(self, "area", area)
         object.__setattr__(self, "centroid", centroid)
         object.__setattr__(self, "size", size)
+        object.__setattr__(self, "_symmetry", 0)
 
     @classmethod
     def _trusted(
@@ -378,6 +419,7 @@ class ConvexPolygon:
         >>> sq.vertices.tolist()
         [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
         """
+        _check_tolerance(tol)
         pts = as_points(points)
         extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
         _check_magnitude(pts, extent)
@@ -441,21 +483,68 @@ class ConvexPolygon:
         """Order r of the part's rotational symmetry about its centroid (1 if none).
 
         A rotation by ``2 pi / r`` must map every vertex within ``tol.symmetry * size`` of
-        another vertex. A square is 4, an equilateral triangle 3, a rectangle 2.
+        another vertex. A square is 4, an equilateral triangle 3, a rectangle 2. A part
+        symmetric within that tolerance is treated as exactly symmetric everywhere
+        downstream: its diameter function's extrema, hence its squeeze function, are those
+        of :meth:`symmetrized` (see :func:`~bayesgrasp.geometry.diameter.diameter_function`).
 
         Examples
         --------
         >>> ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]).symmetry_order
         2
         """
-        v = self.vertices - self.centroid
-        n = len(v)
+        return self.symmetry_order_from(2)
+
+    def symmetry_order_from(self, lowest: int) -> int:
+        """:attr:`symmetry_order` if it is at least ``lowest``, else 1.
+
+        Only the orders from ``lowest`` up are tested (the answer is cached), so asking
+        whether a part has an order of 3 or more skips the test of a half turn: the
+        diameter function needs no more.
+
+        Examples
+        --------
+        >>> rect = ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])
+        >>> rect.symmetry_order_from(3), rect.symmetry_order
+        (1, 2)
+        """
+        known = self._symmetry
+        if known > 0:
+            return known if known >= lowest else 1
+        if known < 0 and lowest >= -known:
+            return 1  # every order from -known up failed
+        below = -known if known < 0 else math.inf
+        found = self._find_symmetry_order(
+            [r for r in _orders(len(self.vertices)) if lowest <= r < below]
+        )
+        object.__setattr__(self, "_symmetry", found if found > 1 else -lowest)
+        return found
+
+    def _find_symmetry_order(self, orders: list[int]) -> int:
+        n = len(self.vertices)
         eps = self.tol.symmetry_for(self.size)
+        if n <= _SMALL:
+            return _symmetry_order_python(self.vertices, self.centroid, orders, eps)
+        if not orders:
+            return 1
+        # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r, at the same
+        # distance from the centroid. Test those distances on a few vertices for every
+        # order at once (n may have many divisors), then on all vertices for the orders
+        # left: enough to reject most parts before the rotation test.
+        centre = self.centroid
+        probe = np.linspace(0, n - 1, 16).astype(np.intp)  # (16,) a few vertices, spread out
+        steps = np.array([n // r for r in orders], dtype=np.intp)
+        ends = (probe[None, :] + steps[:, None]) % n  # (R, 16) where each probe lands
+        rp = np.hypot(*(self.vertices[probe] - centre).T)
+        re = np.hypot(*(self.vertices[ends] - centre).transpose(2, 0, 1))
+        left = [
+            r for r, ok in zip(orders, np.max(np.abs(re - rp), axis=1) <= eps, strict=True) if ok
+        ]
+        if not left:
+            return 1
+        v = self.vertices - centre
         radii = np.hypot(v[:, 0], v[:, 1])  # (N,) a rotation about the centroid keeps them
-        small = [r for r in range(2, math.isqrt(n) + 1) if n % r == 0]
-        for r in sorted({n, *small, *(n // r for r in small)} - {1}, reverse=True):
-            # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r. Test the
-            # distances from the centroid first (cheap, and enough to reject most parts).
+        for r in left:
             step = n // r
             if np.max(np.abs(radii[step:] - radii[:-step])) > eps:
                 continue
@@ -466,6 +555,90 @@ class ConvexPolygon:
             if np.all(np.hypot(miss[:, 0], miss[:, 1]) <= eps):
                 return r
         return 1
+
+    def symmetrized(self) -> FloatArray:
+        """The vertices made exactly r-fold symmetric, ``r = symmetry_order``.
+
+        Each vertex is replaced by the mean of its orbit under the rotations by ``2 pi k / r``
+        about the centroid (vertex ``i + k n / r`` turned back by ``2 pi k / r``), and the
+        mean is turned forward again: the nearest exactly symmetric polygon with the same
+        vertex correspondence, no vertex moved by more than ``tol.symmetry * size``. It is
+        what the diameter function of a near-symmetric part is built from (its extrema), so
+        that the squeeze function has the symmetry's period to rounding. For ``r = 1`` the
+        vertices are returned unchanged.
+
+        Returns
+        -------
+        ndarray of shape (N, 2)
+
+        Examples
+        --------
+        >>> sq = ConvexPolygon.from_points([(0, 0), (1, 0), (1, 1), (0, 1.000001)])
+        >>> v = sq.symmetrized() - sq.centroid
+        >>> turned = v @ np.array([[0.0, 1.0], [-1.0, 0.0]])  # a quarter turn
+        >>> sq.symmetry_order, bool(np.abs(turned - np.roll(v, -1, axis=0)).max() < 1e-15)
+        (4, True)
+        >>> bool(np.abs(sq.symmetrized() - sq.vertices).max() < 1e-6)
+        True
+        """
+        r = self.symmetry_order
+        v = self.vertices
+        if r == 1:
+            return np.array(v, dtype=np.float64)
+        n, c = len(v), self.centroid
+        step = n // r
+        a = 2.0 * math.pi * np.arange(r) / r  # (r,)
+        cos, sin = np.cos(a)[:, None], np.sin(a)[:, None]
+        blocks = (v - c).reshape(r, step, 2)  # (r, n / r, 2): block k is block 0 turned k times
+        back_x = cos * blocks[..., 0] + sin * blocks[..., 1]  # (r, n / r) turned back
+        back_y = -sin * blocks[..., 0] + cos * blocks[..., 1]
+        mx, my = back_x.mean(axis=0), back_y.mean(axis=0)  # (n / r,) orbit means
+        out = np.empty((r, step, 2))
+        out[..., 0] = cos * mx - sin * my + c[0]
+        out[..., 1] = sin * mx + cos * my + c[1]
+        return out.reshape(n, 2)
+
+
+@functools.cache
+def _orders(n: int) -> list[int]:
+    """The divisors of ``n`` above 1, largest first: the possible orders of symmetry."""
+    small = [r for r in range(2, math.isqrt(n) + 1) if n % r == 0]
+    return sorted({n, *small, *(n // r for r in small)} - {1}, reverse=True)
+
+
+def _symmetry_order_python(
+    vertices: FloatArray, centroid: FloatArray, orders: list[int], eps: float
+) -> int:
+    """:meth:`ConvexPolygon.symmetry_order` for a few vertices, in plain Python (faster).
+
+    The same tests in the same order; the distance of vertex ``step`` from the centroid,
+    compared with vertex 0's, rejects most orders of most parts before any other work.
+    """
+    cx, cy = float(centroid[0]), float(centroid[1])
+    xs, ys = vertices[:, 0].tolist(), vertices[:, 1].tolist()
+    n = len(xs)
+    r0 = math.hypot(xs[0] - cx, ys[0] - cy)
+    radii: list[float] = []
+    for r in orders:
+        step = n // r
+        if abs(math.hypot(xs[step] - cx, ys[step] - cy) - r0) > eps:
+            continue
+        if not radii:
+            radii = [math.hypot(x - cx, y - cy) for x, y in zip(xs, ys, strict=True)]
+        if any(abs(radii[i + step] - radii[i]) > eps for i in range(n - step)):
+            continue
+        a = 2.0 * math.pi / r
+        c, s = math.cos(a), math.sin(a)
+        if all(
+            math.hypot(
+                c * (xs[i] - cx) - s * (ys[i] - cy) - (xs[(i + step) % n] - cx),
+                s * (xs[i] - cx) + c * (ys[i] - cy) - (ys[(i + step) % n] - cy),
+            )
+            <= eps
+            for i in range(n)
+        ):
+            return r
+    return 1
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -630,7 +803,11 @@ class Part:
 
 def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
     """A centre of mass as a fresh (2,) array, refused unless strictly inside the hull."""
-    com = as_points(np.reshape(np.asarray(point, dtype=object), (1, -1)), "center_of_mass")[0]
+    try:
+        flat = np.reshape(np.asarray(point, dtype=object), (1, -1))
+    except (TypeError, ValueError, RecursionError) as exc:
+        raise PartError(f"`center_of_mass` must be 2 numbers; could not read it: {exc}") from None
+    com = as_points(flat, "center_of_mass")[0]
     if not hull_contains(hull, com):
         raise PartError(f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull")
     return np.array(com, dtype=np.float64)

@@ -95,7 +95,11 @@ class RadiusFunction:
         Orientation at which that vertex is straight ahead of the centre of mass (the
         sinusoid's peak; inside the piece only when it is a local maximum of ``r``).
     minima : ndarray
-        Stable orientations of pushing in ``[0, 2 pi)``, increasing (edge alignments).
+        Stable orientations of pushing in ``[0, 2 pi)``, increasing (edge alignments). For a
+        part r-fold symmetric about its centre of mass within ``tol.symmetry``
+        (``symmetry_order`` and a centre of mass within that tolerance of the centroid), the
+        extrema are those of the symmetrized hull, exactly ``2 pi / r``-periodic (see
+        :func:`~bayesgrasp.geometry.diameter.diameter_function`).
     stable_edges : ndarray
         Hull edge flat against the jaw at each minimum.
     maxima : ndarray
@@ -169,25 +173,14 @@ def radius_function(part: Part | ConvexPolygon) -> RadiusFunction:
     poly, c = _hull_and_com(part)
     v = poly.vertices
     n = len(v)
-    ltol = poly.tol.length_for(poly.size)
-    e = np.roll(v, -1, axis=0) - v  # (n, 2) edge i runs from v_i to v_{i+1}
-    elen = np.hypot(e[:, 0], e[:, 1])
-    eu = e / elen[:, None]  # unit edge directions
-    normals = np.arctan2(e[:, 1], e[:, 0]) - math.pi / 2  # outward normals, CCW hull
-    rel = v - c  # (n, 2)
-    # Slopes of r at the ends of piece k (vertex k touching): at the alignment of edge k
-    # (its left end) dr/dtheta = <c - v_k, e_k>, at that of edge k - 1 (its right end)
-    # <c - v_k, e_{k-1}>; zero within the length tolerance (a foot exactly at a vertex).
-    a = -np.einsum("ij,ij->i", rel, eu)  # (n,)
-    b = -np.einsum("ij,ij->i", rel, np.roll(eu, 1, axis=0))  # (n,)
-    a = np.where(np.abs(a) <= ltol, 0.0, a)
-    b = np.where(np.abs(b) <= ltol, 0.0, b)
-
-    align = np.mod(math.pi - normals, TWO_PI)  # (n,) alignment angle of each edge
+    tol = poly.tol
+    ltol = tol.length_for(poly.size)
+    align = _alignments(v)
     order = np.argsort(align)
     breaks = align[order]
     # As theta grows past the alignment of edge i, vertex i touches (until edge i - 1).
     vertex = order.astype(np.intp)
+    rel = v - c  # (n, 2)
     radii = np.hypot(rel[:, 0], rel[:, 1])[vertex]
     beta = np.arctan2(rel[:, 1], rel[:, 0])[vertex]
     ends = np.append(breaks[1:], breaks[0] + TWO_PI)
@@ -195,16 +188,24 @@ def radius_function(part: Part | ConvexPolygon) -> RadiusFunction:
     # Write each phase within pi of its piece's middle.
     phases = mids + (np.mod(math.pi - beta - mids + math.pi, TWO_PI) - math.pi)
 
-    is_min = (a > 0) & (np.roll(b, -1) < 0)  # edge i: before it vertex i + 1, after it i
-    is_max = (a > 0) & (b < 0)  # vertex k: its direction from c inside its normal cone
-    minima_edges = np.flatnonzero(is_min)
-    minima = np.mod(math.pi - normals[minima_edges], TWO_PI)
-    max_vertices = np.flatnonzero(is_max)
-    maxima = np.sort(
-        np.mod(math.pi - np.arctan2(rel[max_vertices, 1], rel[max_vertices, 0]), TWO_PI)
-    )
-    mo = np.argsort(minima)
-    minima, minima_edges = minima[mo], minima_edges[mo].astype(np.intp)
+    r = poly.symmetry_order
+    if r > 1 and math.dist(c, poly.centroid) <= tol.symmetry_for(poly.size):
+        # Symmetric about the centre of mass within the tolerance: treated as exactly
+        # symmetric, like the diameter function (its extrema over one period 2 pi / r of
+        # the symmetrized hull, repeated; vertex i + k n / r is vertex i turned k times).
+        step, period = n // r, TWO_PI / r
+        at, is_max, angle = _push_extrema(poly.symmetrized(), poly.centroid, ltol, step)
+        turns = np.arange(r)
+        minima = (angle[~is_max][:, None] + period * turns).ravel()
+        # Turning the part by 2 pi k / r brings edge i - k n / r where edge i was.
+        edges = (at[~is_max][:, None] - step * turns) % n
+        maxima = (angle[is_max][:, None] + period * turns).ravel()
+        minima, maxima = _wrap(minima), np.sort(_wrap(maxima))
+    else:
+        at, is_max, angle = _push_extrema(v, c, ltol, n)
+        minima, edges, maxima = angle[~is_max], at[~is_max], np.sort(angle[is_max])
+    mo = np.argsort(minima, kind="stable")
+    minima, minima_edges = minima[mo], np.asarray(edges.ravel()[mo], dtype=np.intp)
     if len(minima) != len(maxima) or len(minima) == 0 or n < 3:  # pragma: no cover - a bug
         raise BayesGraspError(
             f"internal error: {len(minima)} minima and {len(maxima)} maxima of the radius"
@@ -215,6 +216,72 @@ def radius_function(part: Part | ConvexPolygon) -> RadiusFunction:
     com = c.copy()
     com.setflags(write=False)
     return RadiusFunction(poly, com, *arrays)
+
+
+def _wrap(x: FloatArray) -> FloatArray:
+    """``x`` reduced to ``[0, 2 pi)`` (``np.mod`` can round a tiny negative to ``2 pi``)."""
+    out = np.mod(x, TWO_PI)
+    out[out >= TWO_PI] = 0.0
+    return out
+
+
+def _alignments(v: FloatArray) -> FloatArray:
+    """Orientation in ``[0, 2 pi)`` at which each edge lies flat against the pushing jaw."""
+    e = np.roll(v, -1, axis=0) - v  # (n, 2) edge i runs from v_i to v_{i+1}
+    normals = np.arctan2(e[:, 1], e[:, 0]) - math.pi / 2  # outward normals, CCW hull
+    return np.asarray(np.mod(math.pi - normals, TWO_PI), dtype=np.float64)
+
+
+def _push_extrema(
+    v: FloatArray, c: FloatArray, ltol: float, w: int
+) -> tuple[IntArray, NDArray[np.bool_], FloatArray]:
+    """Extrema of the radius function over the first ``w`` pieces, read as one period.
+
+    As for the diameter (see diameter.py): the slopes of ``r`` at the start and end of the
+    pieces, in angle order, form one cyclic sequence of signs (zero within the length
+    tolerance: a foot of the perpendicular from ``c`` at a vertex); without the zeros, each
+    change from - to + is a minimum at an edge alignment and each change from + to - a
+    maximum, so they alternate whatever the zeros. A maximum with no zero between, inside a
+    piece, is at its vertex's direction from ``c``; every other extremum is at the first
+    edge alignment after the last nonzero sign. ``w`` is ``n``, or ``n / r`` for a polygon
+    with that symmetry about ``c``: the first ``w`` pieces from the first alignment are then
+    one period, read as one cyclic sequence.
+
+    Returns
+    -------
+    at : ndarray of int
+        For a minimum, the edge flat against the jaw; for a maximum, -1.
+    is_max : ndarray of bool
+    angle : ndarray
+        Where each extremum lies (from ``[0, 2 pi)``; an interior maximum of the last piece
+        may be a little past ``2 pi``).
+    """
+    e = np.roll(v, -1, axis=0) - v  # (n, 2) edge i runs from v_i to v_{i+1}
+    eu = e / np.hypot(e[:, 0], e[:, 1])[:, None]  # unit edge directions
+    rel = v - c  # (n, 2)
+    # Slopes of r at the ends of piece k (vertex k touching): at the alignment of edge k
+    # (its left end) dr/dtheta = <c - v_k, e_k>, at that of edge k - 1 (its right end)
+    # <c - v_k, e_{k-1}>; zero within the length tolerance (a foot exactly at a vertex).
+    a = -np.einsum("ij,ij->i", rel, eu)  # (n,)
+    b = -np.einsum("ij,ij->i", rel, np.roll(eu, 1, axis=0))  # (n,)
+    align = _alignments(v)
+    order = np.argsort(align)  # piece k starts at the alignment of edge order[k]
+    breaks = align[order]
+    signs = np.empty(2 * w, dtype=np.int8)
+    signs[0::2] = (a[order[:w]] > ltol).astype(np.int8) - (a[order[:w]] < -ltol)
+    signs[1::2] = (b[order[:w]] > ltol).astype(np.int8) - (b[order[:w]] < -ltol)
+    nonzero = np.flatnonzero(signs)
+    sig = signs[nonzero]
+    change = np.flatnonzero(sig != np.roll(sig, 1))
+    last = np.roll(nonzero, 1)[change]
+    is_max = np.roll(sig, 1)[change] > 0
+    interior = is_max & (np.mod(nonzero[change] - last, 2 * w) == 1) & (last % 2 == 0)
+    k = (last + 2) // 2 % w  # the alignment after entry `last`
+    angle = breaks[k].copy()
+    top = order[last[interior] // 2]  # the vertex straight ahead of c at an interior maximum
+    angle[interior] = np.mod(math.pi - np.arctan2(rel[top, 1], rel[top, 0]), TWO_PI)
+    at = np.where(is_max, -1, order[k]).astype(np.intp)
+    return at, is_max, angle
 
 
 def _basins(minima: FloatArray, maxima: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -250,7 +317,7 @@ def push_function(part: Part | ConvexPolygon | RadiusFunction) -> TransferFuncti
     """
     r = part if isinstance(part, RadiusFunction) else radius_function(part)
     tol = r.polygon.tol
-    return transfer_from_extrema("push", r.minima, r.maxima, tol.angle, tol.symmetry)
+    return transfer_from_extrema("push", r.minima, r.maxima, tol.angle, tol.angle)
 
 
 def push_grasp_function(
@@ -310,5 +377,5 @@ def push_grasp_function(
         raise BayesGraspError("internal error: push-grasp basins do not tile the circle")
     for arr in (stable, lo, hi):
         arr.setflags(write=False)
-    period = detect_period(stable, np.sort(np.mod(hi, TWO_PI)), poly.tol.symmetry)
+    period = detect_period(stable, np.sort(np.mod(hi, TWO_PI)), poly.tol.angle)
     return TransferFunction("push-grasp", stable, lo, hi, period, poly.tol.angle)

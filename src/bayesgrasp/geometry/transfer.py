@@ -11,13 +11,20 @@ The squeeze function descends the diameter function: each minimum of ``d`` over 
 is a stable orientation and its basin runs between the neighbouring maxima. It commutes with
 the part's symmetry: ``s(theta + T) = s(theta) + T`` for the period ``T`` (pi, or
 ``2 pi / (r (1 + r mod 2))`` for an r-fold symmetric part, Goldberg 1993).
+
+Periods are measured to the angle tolerance, so ``F(theta + T) = F(theta) + T`` holds to
+that tolerance. A part symmetric within ``Tolerance.symmetry`` (its ``symmetry_order``) is
+symmetric everywhere downstream: its diameter and radius functions have exactly periodic
+extrema (diameter.py), so the squeeze period is the formula's and the push and push-grasp
+periods are ``2 pi / r`` (when the centre of mass is the centroid). A part that is not
+symmetric within that tolerance has the period pi, however nearly periodic its extrema.
 """
 
 from __future__ import annotations
 
 import bisect
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -46,7 +53,8 @@ class TransferFunction:
         ``"squeeze"`` or ``"push-grasp"`` (or ``"push"``).
     stable, basin_lo, basin_hi : ndarray of shape (K,)
     period : float
-        Smallest ``T`` with ``F(theta + T) = F(theta) + T`` (divides ``2 pi``).
+        Smallest ``T`` with ``F(theta + T) = F(theta) + T`` to ``angle_tol`` (divides
+        ``2 pi``).
     angle_tol : float
         Angles closer than this are equal.
 
@@ -219,9 +227,12 @@ def squeeze_function(
     TransferFunction
         Stable orientations are the minima of ``d`` over ``[0, 2 pi)``; basins run between
         consecutive maxima. The period is the smallest shift ``2 pi / m`` that maps them
-        onto themselves (to ``tol.symmetry`` radians): ``pi``, or ``2 pi / (r (1 + r mod 2))``
-        for an r-fold symmetric part, also when rounded coordinates make the extrema
-        periodic only to about 1e-5 rad (the vertex test of ``symmetry_order`` decides).
+        onto themselves to the angle tolerance, so ``s(theta + T) = s(theta) + T`` holds to
+        that tolerance: ``pi``, or ``2 pi / (r (1 + r mod 2))`` for a part r-fold symmetric
+        within ``tol.symmetry`` (``symmetry_order``): the diameter function of such a part
+        has exactly periodic extrema (those of its symmetrized vertices), also when rounded
+        coordinates make the part's own extrema periodic only to about 1e-5 rad. (A finer
+        period would need extrema that are periodic by coincidence, beyond the symmetry.)
 
     Examples
     --------
@@ -236,23 +247,4 @@ def squeeze_function(
     stable, bounds = ([*x, *(_wrap(a + math.pi) for a in x)] for x in half)
     stable.sort()
     bounds.sort()
-    f = _from_sorted("squeeze", stable, bounds, poly.tol.angle, poly.tol.symmetry)
-    k, m_strict = len(stable), round(TWO_PI / f.period)
-    if k > m_strict:
-        # Rounded coordinates can leave an r-fold symmetric part's extrema periodic only to
-        # about 1e-5 rad, beyond the strict test. A finer period is accepted when shifting
-        # by it keeps every extremum within a quarter of the closest gap of its partner
-        # (their order is kept) and the vertex test finds the matching symmetry order.
-        both = sorted(stable + bounds)
-        loose = 0.25 * min(b - a for a, b in zip(both, [*both[1:], both[0] + TWO_PI], strict=True))
-        top = k
-        while top > m_strict:
-            m = _period_count(stable, bounds, top, m_strict, loose)
-            if m == m_strict:
-                break
-            r = poly.symmetry_order
-            if r * (1 + r % 2) == m:
-                f = replace(f, period=TWO_PI / m)
-                break
-            top = m - 1
-    return f
+    return _from_sorted("squeeze", stable, bounds, poly.tol.angle, poly.tol.angle)
