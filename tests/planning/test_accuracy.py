@@ -244,9 +244,8 @@ def test_guaranteed_plan_honours_accuracy(rng: np.random.Generator) -> None:
         part = random_part(rng)
         for deg in (1.0, 3.0):
             pb = Problem.build(part, accuracy=math.radians(deg))
-            try:
-                g = plan_guaranteed(pb)
-            except NoPlanError:
+            g = plan_guaranteed(pb)
+            if g.status == "no-plan":
                 continue
             assert g.option.tolerance is not None
             assert g.option.tolerance >= pb.accuracy - 1e-12
@@ -260,8 +259,18 @@ def test_guaranteed_plan_honours_accuracy(rng: np.random.Generator) -> None:
 
 def test_no_guaranteed_plan_under_large_accuracy() -> None:
     pb = Problem.build(load("key"), accuracy=math.radians(30.0))
+    g = plan_guaranteed(pb)
+    assert g.status == "no-plan" and g.options == ()
+    assert g.reason is not None and "gripper accuracy 30 deg" in g.reason
+    assert "short of the period 180.000000 deg" in g.reason
+    # The widths stop growing: the last two are equal, all short of the period.
+    assert len(g.widths) >= 2 and g.widths[-1] <= g.widths[-2] + 1e-9
+    assert max(g.widths) < g.period
+    # Asking for the plan says why there is none.
     with pytest.raises(NoPlanError, match="gripper accuracy 30 deg"):
-        plan_guaranteed(pb)
+        _ = g.option
+    with pytest.raises(NoPlanError, match="gripper accuracy 30 deg"):
+        _ = g.n_actions
     # The exact planner still answers: the single squeeze (no turn to err).
     assert [o.n_actions for o in plan_exact(pb).options] == [1]
 

@@ -18,6 +18,7 @@ from bayesgrasp.cli import main
 from bayesgrasp.errors import PartError, PlanningError
 from bayesgrasp.geometry.polygon import Part
 from bayesgrasp.geometry.transfer import transfer_from_extrema
+from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
 from bayesgrasp.model.prior import HistogramPrior, Prior, UniformPrior, von_mises
 from bayesgrasp.model.problem import CostModel, Goal, Problem
 from bayesgrasp.planning import PlanReport, execute_plan, plan_bfs, plan_exact
@@ -137,11 +138,13 @@ def fake_push_grasp(problem: Problem, offset: int) -> Problem:
     pg = transfer_from_extrema("push-grasp", s.stable[i], s.basin_lo[i], s.angle_tol, 1e-9)
     return Problem(
         problem.part,
+        s,
+        problem.diameter,
         problem.prior,
+        (SQUEEZE, PUSH_GRASP),
         {"squeeze": s, "push-grasp": pg},
         problem.cost,
         problem.goal,
-        ("squeeze", "push-grasp"),
     )
 
 

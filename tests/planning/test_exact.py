@@ -44,8 +44,11 @@ from bayesgrasp import (
     squeeze_function,
     von_mises,
 )
+from bayesgrasp.geometry.diameter import diameter_function
 from bayesgrasp.geometry.transfer import TransferFunction, transfer_from_extrema
+from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
 from bayesgrasp.model.prior import Prior
+from bayesgrasp.planning.arcs import arc_front
 from bayesgrasp.planning.result import PlanOption, PlanReport, choose_indices
 from bayesgrasp.shapes import load, names
 from reference import regular_polygon, rotate
@@ -660,11 +663,13 @@ def test_two_action_types_against_brute_force(rng: np.random.Generator, push_cos
         cost = CostModel({"push-grasp": push_cost}, first={"squeeze": 0.5})
         pb = Problem(
             part,
+            squeeze,
+            diameter_function(part.hull),
             UniformPrior(),
+            (SQUEEZE, PUSH_GRASP),
             {"squeeze": squeeze, "push-grasp": push},
             cost,
             Goal(),
-            ("squeeze", "push-grasp"),
         )
         rep = plan_exact(pb, max_actions=longest)
         sets = collapsible_sets(pb.transfers, longest)
@@ -777,13 +782,12 @@ def test_many_states_plans_replay(rng: np.random.Generator) -> None:
         assert_allclose(frac, o.success_probability, atol=3.0 / len(theta))
 
 
-def test_arc_enumeration_in_chunks_changes_nothing(
-    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    import bayesgrasp.planning.exact as exact
-
+def test_arc_enumeration_in_chunks_changes_nothing(rng: np.random.Generator) -> None:
     pb = Problem.build(noisy_circle(rng, 200, 1e-2))
-    whole = plan_exact(pb)
-    monkeypatch.setattr(exact, "_CHUNK", 50)
-    chunked = plan_exact(Problem.build(pb.part))
-    assert chunked.options == whole.options
+    f = pb.states
+    for max_span in (0.0, 0.3, math.pi, TWO_PI + 1e-9):
+        whole = arc_front(f, max_span)
+        for chunk in (1, 50, 1000):
+            part = arc_front(f, max_span, chunk=chunk)
+            for name in ("lo", "width", "s_first", "span"):
+                assert np.array_equal(getattr(part, name), getattr(whole, name)), name

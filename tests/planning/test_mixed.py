@@ -211,7 +211,7 @@ def test_cli_actions_and_push_grasp_cost(capsys: pytest.CaptureFixture[str]) -> 
 
 @pytest.mark.parametrize(
     ("actions", "message"),
-    [("squeeze,pull", "unknown action type 'pull'"), (",", "at least one action type")],
+    [("squeeze,pull", "unknown action 'pull'"), (",", "at least one action type")],
 )
 def test_cli_bad_actions(capsys: pytest.CaptureFixture[str], actions: str, message: str) -> None:
     code, out, err = run(capsys, "plan", "triangle", "--actions", actions)

@@ -16,8 +16,9 @@ Choices the seed leaves open, and what this module does:
   hyperstate already generated (at any depth) is not generated again: its subtree would
   repeat one already searched. "Identical" means the same distribution of the part
   relative to the *physical* gripper: a squeeze gripper turned by pi is the same gripper, so
-  two distributions that differ by a shift of pi are merged when every action kind is a
-  squeeze (a push-grasp has a pushing side, so then only equal vectors merge). Without
+  two distributions that differ by a shift of pi are merged when every action kind has
+  gripper period pi (:attr:`~bayesgrasp.model.actions.Action.gripper_period`: squeezes; a
+  push-grasp has a pushing side, so then only equal vectors merge). Without
   merging, most random hexagons would pass 1000 nodes at depth 3, against the seed's 1%;
   :func:`search_bfs` also reports the count a search *without* merging would reach
   (``tree_nodes``), computed exactly by finding the first goal node of the unmerged tree in
@@ -43,9 +44,10 @@ Choices the seed leaves open, and what this module does:
   is just the highest probability at every depth.
 - *Angles and tolerance.* Each action is the midpoint of its class interval; a squeeze
   angle is turned by pi into ``(-pi/2, pi/2]`` when needed (the same gripper; the final
-  orientation follows). The reported tolerance is the *class margin*: half the width of
-  the narrowest chosen class. Within it every state, not only the goal's, goes where the
-  plan says, so it is a lower bound on the exact planner's tolerance.
+  orientation follows; :func:`~bayesgrasp.planning.result.short_turns`). The reported
+  tolerance is the *class margin*: half the width of the narrowest chosen class. Within it
+  every state, not only the goal's, goes where the plan says, so it is a lower bound on the
+  exact planner's tolerance.
 """
 
 from __future__ import annotations
@@ -60,18 +62,17 @@ from typing import cast
 import numpy as np
 from numpy.typing import NDArray
 
+from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.prior import UniformPrior
 from ..model.problem import Problem, nearest_state
-from .result import PlanOption, PlanReport, PlanStep, choose_indices
+from .result import PlanOption, PlanResult, choose_indices, plan_actions, short_turns
 
 __all__ = ["BfsResult", "SearchStats", "plan_bfs", "search_bfs"]
 
 logger = logging.getLogger(__name__)
 
-TWO_PI = 2.0 * math.pi
-_EPS = 1e-12  # probability tolerance of "reached the target" (as the exact planner)
 _QUANT = float(2**40)  # distributions are compared after rounding to multiples of 2**-40
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -118,7 +119,7 @@ class SearchStats:
 class BfsResult:
     """The plan report of the search and its statistics."""
 
-    report: PlanReport
+    report: PlanResult
     stats: SearchStats
 
 
@@ -136,9 +137,12 @@ class _Search:
     def __init__(self, problem: Problem, roots: list[_Root]) -> None:
         self.problem = problem
         self.kinds = problem.action_kinds
+        self.actions = plan_actions(problem, self.kinds)
+        # Probability tolerance of "reached the target" (as the exact planner).
+        self.eps = problem.part.hull.tol.probability
         states = problem.states
         self.k = states.n_states
-        self.classes = [problem.classes(t) for t in self.kinds]
+        self.classes = [problem.classes(a) for a in self.actions]
         self.roots = roots
         # Goal: fold states that the goal counts as one (orbits under 2 pi / g).
         g = problem.goal_group
@@ -148,11 +152,12 @@ class _Search:
         self.onehot = (
             None if g == 1 else np.eye(self.n_orbits)[self.orbit]  # (K, O)
         )
-        # Merge distributions that differ by a turn of the gripper by pi (squeezes only).
+        # Merge distributions that differ by a turn of the gripper by pi: when every
+        # action's gripper turned by pi is the same gripper (squeezes).
         half = self.k // 2
         self.shift = 0
         if (
-            all(t == "squeeze" for t in self.kinds)
+            all(math.isclose(a.gripper_period, math.pi) for a in self.actions)
             and self.k % 2 == 0
             and np.allclose(
                 states.stable[half:] - states.stable[:half], math.pi, atol=1e3 * states.angle_tol
@@ -289,12 +294,6 @@ def _orbits(stable: FloatArray, group: int, states: TransferFunction) -> IntArra
     return np.asarray(ids, dtype=np.intp)
 
 
-def _wrap(a: float) -> float:
-    """Angle in (-pi, pi]."""
-    r = math.remainder(a, TWO_PI)
-    return math.pi if r == -math.pi else r
-
-
 def _make_roots(
     problem: Problem, max_actions: int | None, first_angles: Sequence[float] | None
 ) -> list[_Root]:
@@ -322,7 +321,7 @@ def _make_roots(
         )
         atom_state = (
             np.arange(f.n_states, dtype=np.intp)
-            if kind == "squeeze"
+            if f is problem.states  # the squeeze: its stable orientations are the states
             else nearest_state(problem.states, f.stable)
         )
         roots.append(_Root(kind, angle, masses, atom_state))
@@ -424,7 +423,7 @@ def search_bfs(
         if not is_new(s.keys(s.dist[v])[0], 1, s.attempt[v]):
             continue
         level.append(v)
-        if found is None and s.prob[v] >= target - _EPS:
+        if found is None and s.prob[v] >= target - s.eps:
             found = v
     bfs_nodes = len(level)
     limit_hit = False
@@ -442,7 +441,7 @@ def search_bfs(
                     v = s.add_child(u, ti, a, ch[a], float(probs[a]))
                     nxt.append(v)
                     bfs_nodes += 1
-                    if probs[a] >= target - _EPS and (found is None or s.prob[v] > s.prob[found]):
+                    if probs[a] >= target - s.eps and (found is None or s.prob[v] > s.prob[found]):
                         found = v
                     if found is not None and not several_kinds:
                         break
@@ -484,7 +483,7 @@ def search_bfs(
                     v = s.add_child(u, ti, a, ch[a], float(probs[a]))
                     fallback_nodes += 1
                     heapq.heappush(heap, (-s.prob[v], s.depth[v], v))
-                    if s.prob[v] >= target - _EPS:
+                    if s.prob[v] >= target - s.eps:
                         found = v
                         break
                     if fallback_nodes >= fallback_limit:
@@ -500,7 +499,7 @@ def search_bfs(
         final_depth = max(s.depth)
     else:
         best_p = max(s.prob)
-        final_depth = min(d for d, p in zip(s.depth, s.prob, strict=True) if p >= best_p - _EPS)
+        final_depth = min(d for d, p in zip(s.depth, s.prob, strict=True) if p >= best_p - s.eps)
     # For a fixed sequence of action kinds the expected cost falls as the probability
     # rises: only the most probable node of each sequence can be a best plan.
     leaders: dict[tuple[str, ...], int] = {}
@@ -511,9 +510,9 @@ def search_bfs(
         _best_option(s, list(leaders.values()), k, k == final_depth)
         for k in range(1, final_depth + 1)
     )
-    bayes, most = choose_indices(options)
+    bayes, most = choose_indices(options, s.eps)
     n_nodes = bfs_nodes + fallback_nodes
-    report = PlanReport(problem, options, bayes, most, "bfs", n_nodes)
+    report = PlanResult(problem, options, bayes, most, "bfs", n_nodes)
     tree = None
     if not merge and completed and found is not None:
         tree = n_nodes
@@ -532,7 +531,7 @@ def search_bfs(
     return BfsResult(report, stats)
 
 
-def plan_bfs(problem: Problem, max_actions: int | None = None) -> PlanReport:
+def plan_bfs(problem: Problem, max_actions: int | None = None) -> PlanResult:
     """Best plans of every length by the seed's breadth-first search (a baseline).
 
     Same report as :func:`~bayesgrasp.planning.exact.plan_exact`, with ``method="bfs"``
@@ -548,7 +547,7 @@ def plan_bfs(problem: Problem, max_actions: int | None = None) -> PlanReport:
 
     Returns
     -------
-    PlanReport
+    PlanResult
 
     Examples
     --------
@@ -578,17 +577,26 @@ def _best_option(s: _Search, candidates: list[int], k: int, final: bool) -> Plan
     return _option(s, pick, k)
 
 
+def _keeps_states(s: _Search, ti: int) -> bool:
+    """Whether action kind ``ti`` is the squeeze itself: its transfer function is the states'.
+
+    Made with the gripper unturned it leaves every state where it is.
+    """
+    return s.problem.transfers[s.kinds[ti]] is s.problem.states
+
+
 def _pad_kind(s: _Search) -> int:
-    """Kind index used to pad a plan: a squeeze if allowed, else the first kind."""
-    return s.kinds.index("squeeze") if "squeeze" in s.kinds else 0
+    """Kind index used to pad a plan: the squeeze if allowed, else the first kind."""
+    return next((ti for ti in range(len(s.kinds)) if _keeps_states(s, ti)), 0)
 
 
 def _pad_class(s: _Search, ti: int, dist: FloatArray) -> int:
     """A class that keeps the distribution's success probability (or raises it most)."""
     cl = s.classes[ti]
-    if s.kinds[ti] == "squeeze":
-        # The class holding alpha = 0 (mod pi): every state stays put (or turns by pi).
-        inside = np.mod(-cl.lo, math.pi) < cl.hi - cl.lo
+    if _keeps_states(s, ti):
+        # The class holding alpha = 0 (mod the gripper period): every state stays put (or
+        # turns by pi).
+        inside = np.mod(-cl.lo, s.actions[ti].gripper_period) < cl.hi - cl.lo
         if np.any(inside):
             return int(np.flatnonzero(inside)[0])
     return int(np.argmax(s.goal_prob(s.children(dist, ti))))
@@ -606,40 +614,21 @@ def _option(s: _Search, v: int, k: int) -> PlanOption:
         dist = s.children(dist, ti_pad)[a]
         mapping = s.classes[ti_pad].transfer[a][mapping]
         path.append((ti_pad, a))
-    raw = [(root.kind, root.angle)]
+    kinds = [root.kind]
+    angles = [root.angle]
     margins = []
     for ti, a in path:
         cl = s.classes[ti]
-        raw.append((s.kinds[ti], float(cl.mid[a])))
+        kinds.append(s.kinds[ti])
+        angles.append(float(cl.mid[a]))
         margins.append(0.5 * float(cl.hi[a] - cl.lo[a]))
-    steps, turned = _short_turns(raw)
+    steps, turned = short_turns(plan_actions(s.problem, kinds), angles)
     p = float(s.goal_prob(dist))
     goal = s.goal_state(dist)
     final = math.fmod(float(s.problem.states.stable[goal]) + turned + TWO_PI, TWO_PI)
-    kinds = tuple(st.kind for st in steps)
-    c = s.problem.cost.expected_cost(kinds, p)
+    c = s.problem.cost.expected_cost(tuple(kinds), p)
     arc = _success_arc(s.problem, root, mapping, goal)
     return PlanOption(tuple(steps), final, p, c, min(margins) if margins else None, arc)
-
-
-def _short_turns(raw: list[tuple[str, float]]) -> tuple[list[PlanStep], float]:
-    """Steps with every squeeze angle in ``(-pi/2, pi/2]``, and the turn of the final frame.
-
-    A squeeze gripper turned by pi is the same gripper: the part then lies pi further round
-    in its frame, before and after the squeeze (``s(theta + pi) = s(theta) + pi``), which the
-    next angle absorbs (or, after the last action, the final orientation). A push-grasp has a
-    pushing side: its angle absorbs what it receives and keeps it.
-    """
-    steps = []
-    carry = 0.0  # how much further round the part lies in the current frame
-    for kind, angle in raw:
-        a = _wrap(angle + carry)
-        carry = 0.0
-        if kind == "squeeze":
-            short = _wrap(2.0 * a) / 2.0
-            carry, a = a - short, short
-        steps.append(PlanStep(kind, a))
-    return steps, carry
 
 
 def _success_arc(
@@ -679,7 +668,7 @@ def _tree_nodes(s: _Search, depth: int, target: float) -> int:
             return None
         ch = np.concatenate([s.children(dist, ti) for ti in range(len(s.kinds))])
         if d + 1 == depth:
-            hits = np.flatnonzero(s.goal_prob(ch) >= target - _EPS)
+            hits = np.flatnonzero(s.goal_prob(ch) >= target - s.eps)
             if len(hits):
                 return int(hits[0])
         else:
@@ -695,7 +684,7 @@ def _tree_nodes(s: _Search, depth: int, target: float) -> int:
     for r in range(n_roots):
         root_dist = s.dist[r]  # roots are nodes 0..R-1
         if depth == 1:
-            if s.prob[r] >= target - _EPS:
+            if s.prob[r] >= target - s.eps:
                 pos = r
                 break
             continue

@@ -23,20 +23,20 @@ until they reach ``T``); Chen and Ierardi bounded its length by ``2 n - 1`` for 
 With several action types and costs, plans with the same number of actions may differ in
 cost; the plan returned is the cheapest of the shortest (the width of an arc collapsible
 with given counts of each type does not depend on their order after the first action, the
-argument of :mod:`bayesgrasp.planning.exact`).
+argument of :mod:`bayesgrasp.planning.arcs`).
 
-This is the exact planner's machinery run to a different stop: the widths ``W_k`` come from
-its arc fronts (the widest arc under a span limit is a binary search on the front of each
-action type), and the plan's angles from its witness chain, the arcs that maximise the least
-margin (see :mod:`bayesgrasp.planning.exact`); each image is centred in the next witness, so
-each turn after the first may err by the plan's tolerance, the largest of any plan with
+This is the exact planner's machinery (:mod:`bayesgrasp.planning.arcs`) run to a different
+stop: the widths ``W_k`` come from the arc fronts (the widest arc under a span limit is a
+binary search on the front of each action type), and the plan's angles from the witness
+chain, the arcs that maximise the least margin; each image is centred in the next witness,
+so each turn after the first may err by the plan's tolerance, the largest of any plan with
 these action types in this order that collapses an arc this wide. Among equally cheap
 shortest plans the one of largest tolerance is returned.
 
 With a gripper accuracy (``Problem.accuracy``) every image must fit the next arc with that
 margin to spare on each side, as in the exact planner; the widths may then stop growing
-short of the period, and no guaranteed plan exists (:class:`~bayesgrasp.errors.NoPlanError`,
-raised as soon as the widths stop growing).
+short of the period, and no guaranteed plan exists: the result has status ``"no-plan"``
+and says why, as soon as the widths stop growing.
 
 Cost: O(K^2) once per action type for its front (K stable orientations), O(log K) per
 (count of each type, first type), and O(F log F) per action for the witnesses (F arcs on a
@@ -47,84 +47,58 @@ by executing them.
 
 from __future__ import annotations
 
-import bisect
 import math
 from dataclasses import dataclass
 
-from ..errors import NoPlanError, PlanningError
-from ..geometry.transfer import TransferFunction
+from ..errors import PlanningError
 from ..model.problem import Problem
-from .exact import Arc, _arc_front, _chain_option, _Planner
-from .result import PlanOption
+from .arcs import Arc, ArcPlanner, chain_option, widest_arc
+from .result import PlanOption, PlanResult, max_plan_length
 
 __all__ = ["GuaranteedPlan", "plan_guaranteed", "widest_arc"]
 
-TWO_PI = 2.0 * math.pi
 
+@dataclass(frozen=True, slots=True, eq=False, kw_only=True)
+class GuaranteedPlan(PlanResult):
+    """The guaranteed planner's result: the shortest plan that orients every orientation.
 
-@dataclass(frozen=True, slots=True)
-class GuaranteedPlan:
-    """The shortest plan that orients every initial orientation up to ``period``.
+    A :class:`~bayesgrasp.planning.result.PlanResult` whose ``options`` hold the one plan
+    (``bayes`` and ``most_certain`` are both 0), or none when ``status`` is ``"no-plan"``
+    (``reason`` says why), with what the guaranteed planner adds.
 
     Attributes
     ----------
-    option : PlanOption
-        Its steps, final orientation, tolerance, and (for the problem's single or symmetry
-        goal and prior) success probability and expected cost.
     period : float
         The plan sends every orientation to ``final_orientation + j * period``.
     widths : tuple of float
-        ``W_1 .. W_k``: the widest collapsible arc with 1 .. k actions.
+        ``W_1 .. W_k``: the widest collapsible arc with 1 .. k actions (with no plan, up to
+        where the search stopped).
     """
 
-    option: PlanOption
     period: float
     widths: tuple[float, ...]
 
     @property
+    def option(self) -> PlanOption:
+        """The plan (``options[0]``).
+
+        Its steps, final orientation, tolerance, and (for the problem's single or symmetry
+        goal and prior) success probability and expected cost.
+
+        Raises
+        ------
+        NoPlanError
+            If ``status`` is ``"no-plan"`` (the message is the ``reason``).
+        """
+        return self.bayes_plan
+
+    @property
     def n_actions(self) -> int:
-        """Number of actions."""
+        """Number of actions of the plan (raises :class:`NoPlanError` if there is none)."""
         return self.option.n_actions
 
 
-def widest_arc(f: TransferFunction, limit: float, tol: float) -> Arc:
-    """Widest boundary-to-boundary arc of ``f`` whose image spans less than ``limit``.
-
-    The last arc of the front of ``f`` under that span limit (the exact planner's
-    ``_arc_front``); among the arcs as wide within ``tol`` the one of least span is returned
-    (it leaves the most room to the next action). O(K^2) for K stable orientations.
-
-    Parameters
-    ----------
-    f : TransferFunction
-    limit : float
-        The image must fit in an open arc of this length (``span < limit - 2 tol``); a
-        limit at most ``2 tol`` admits a single basin (its image is one point).
-    tol : float
-        Angle tolerance.
-
-    Returns
-    -------
-    Arc
-        ``kind``, ``lo``, ``hi`` (the open arc), ``s_first``, ``s_last`` (its image), with
-        ``width`` and ``span``.
-
-    Examples
-    --------
-    >>> from bayesgrasp.geometry.polygon import ConvexPolygon
-    >>> from bayesgrasp.geometry.transfer import squeeze_function
-    >>> s = squeeze_function(ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
-    >>> one = widest_arc(s, 0.0, 1e-9)  # a single basin
-    >>> two = widest_arc(s, one.width, 1e-9)
-    >>> [round(math.degrees(a.width), 6) for a in (one, two)]
-    [126.869898, 180.0]
-    """
-    front = _arc_front(f, limit - 2.0 * tol)
-    widths = front.width_list  # increasing with the span
-    return front.arc(bisect.bisect_left(widths, widths[-1] - tol))
-
-
-def plan_guaranteed(problem: Problem) -> GuaranteedPlan:
+def plan_guaranteed(problem: Problem, max_actions: int | None = None) -> GuaranteedPlan:
     """The shortest plan (then the cheapest) that orients the part up to the period.
 
     Uses the problem's action types, cost model (to break ties between plans of the same
@@ -135,40 +109,65 @@ def plan_guaranteed(problem: Problem) -> GuaranteedPlan:
     Parameters
     ----------
     problem : Problem
+    max_actions : int, optional
+        Look no further than plans of this many actions (default ``4 n + 8`` for an n-gon,
+        :func:`~bayesgrasp.planning.result.max_plan_length`; Goldberg 1993 bounds plans by
+        O(n)).
 
     Returns
     -------
     GuaranteedPlan
+        Status ``"ok"`` with the plan, or ``"no-plan"`` with the reason: the widest
+        collapsible arc stops growing short of the period (no plan honours the problem's
+        gripper accuracy; without one, Goldberg 1993 proves a plan exists), or no plan
+        within ``max_actions``.
 
     Raises
     ------
-    NoPlanError
-        If the widest collapsible arc stops growing short of the period: no plan honours the
-        problem's gripper accuracy (without one, Goldberg 1993 proves a plan exists).
     PlanningError
-        If no plan is found within ``4 n + 8`` actions (a degenerate part; Goldberg 1993
-        bounds plans by O(n)).
+        If ``max_actions`` is less than 1.
 
     Examples
     --------
     >>> from bayesgrasp.geometry.polygon import Part
     >>> rect = Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)])
     >>> g = plan_guaranteed(Problem.build(rect))
-    >>> g.n_actions, round(math.degrees(g.period), 6), g.option.success_probability
-    (2, 180.0, 0.5)
+    >>> g.status, g.n_actions, round(math.degrees(g.period), 6), g.option.success_probability
+    ('ok', 2, 180.0, 0.5)
+
+    With turns that err by up to 30 degrees the widths stop short of the period:
+
+    >>> g = plan_guaranteed(Problem.build(rect, accuracy=math.radians(30)))
+    >>> g.status, g.reason.split(":")[0]
+    ('no-plan', "no guaranteed plan for part 'part' with gripper accuracy 30 deg")
     """
-    tol = problem.states.angle_tol
+    if max_actions is not None and max_actions < 1:
+        raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
     poly = problem.part.hull
-    periods = [problem.transfers[t].period for t in problem.action_kinds]
-    period = min(max(periods), TWO_PI / problem.goal_group)
+    planner = ArcPlanner.for_problem(problem)
+    tol, period = planner.tol, planner.period
     reach = period - max(tol, poly.tol.symmetry)
-    planner = _Planner(problem, tol, max(periods) + tol)
+    limit = max_plan_length(problem) if max_actions is None else max_actions
     widths: list[float] = []
     level = [(0,) * len(problem.action_kinds)]
-    for _ in range(4 * poly.n_sides + 8):
+
+    def result(option: PlanOption | None, reason: str | None = None) -> GuaranteedPlan:
+        return GuaranteedPlan(
+            problem,
+            () if option is None else (option,),
+            0,
+            0,
+            "guaranteed",
+            status="no-plan" if option is None else "ok",
+            reason=reason,
+            period=period,
+            widths=tuple(widths),
+        )
+
+    for _ in range(limit):
         candidates, level = planner.extend(level)
         widths.append(max(planner.best[key][0] for key in level))
-        found = []
+        found: list[tuple[float, float, list[Arc], float | None, float]] = []
         for key, first, width in candidates:
             if width >= reach:
                 kinds = planner.order(key, first)
@@ -180,19 +179,20 @@ def plan_guaranteed(problem: Problem) -> GuaranteedPlan:
             placed = min(width, period)
             p, _ = problem.prior.max_arc_mass(placed, problem.goal_group)
             cost = problem.cost.expected_cost(tuple(a.kind for a in chain), p)
-            option = _chain_option(problem, chain, margin, placed, p, cost, placed)
-            return GuaranteedPlan(option, period, tuple(widths))
+            return result(chain_option(problem, chain, margin, placed, p, cost, placed))
         # The widest arc of k + 1 actions is a non-decreasing function of that of k (see
-        # exact.py): once it stops growing it never grows again.
+        # arcs.py): once it stops growing it never grows again.
         if len(widths) > 1 and widths[-1] <= widths[-2] + tol:
-            raise NoPlanError(
+            return result(
+                None,
                 f"no guaranteed plan for part {problem.part.name!r} with gripper accuracy "
                 f"{math.degrees(problem.accuracy):.6g} deg: the widest arc any plan collapses "
                 f"stops at {math.degrees(max(widths)):.6f} deg, short of the period "
-                f"{math.degrees(period):.6f} deg"
+                f"{math.degrees(period):.6f} deg",
             )
-    raise PlanningError(
-        f"no guaranteed plan within {4 * poly.n_sides + 8} actions for part "
+    return result(
+        None,
+        f"no guaranteed plan within {limit} actions for part "
         f"{problem.part.name!r} (widest collapsible arc {math.degrees(widths[-1]):.6f} deg, "
-        f"period {math.degrees(period):.6f} deg)"
+        f"period {math.degrees(period):.6f} deg)",
     )

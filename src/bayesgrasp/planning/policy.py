@@ -567,7 +567,7 @@ class _Builder:
     leaves_at: list[tuple[int, float, float]] = field(default_factory=list)
 
     def turn(self, kind: _Kind, alpha: float, carry: float) -> tuple[float, float]:
-        """The turn to command and the carry it leaves (see ``bfs._short_turns``).
+        """The turn to command and the carry it leaves (see :func:`.result.short_turns`).
 
         A gripper with a pi-symmetric action turned by pi is the same gripper; the part then
         lies pi further round in its frame, which later turns and the declared orientation

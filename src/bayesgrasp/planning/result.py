@@ -1,30 +1,118 @@
-"""Plans and plan reports: what every planner returns.
+"""Plans and plan results: what every planner returns.
 
 A plan is a sequence of steps. Step 1 is made with the gripper at ``steps[0].alpha`` in the
 world frame; before step ``i > 1`` the gripper turns by ``steps[i].alpha`` (counter-clockwise)
 relative to the previous step, so the part at ``theta`` in the old gripper frame is at
 ``theta - alpha`` in the new one (design.md). A verification step follows the last action.
+
+Every planner returns a :class:`PlanResult`: the plans it found (:class:`PlanOption`, which
+satisfies the :class:`Plan` protocol), which of them is the Bayes plan and which the most
+certain, and a ``status``: ``"ok"``, or ``"no-plan"`` with the ``reason`` (no plan reached
+the goal asked for is a result, not an exception; style.md).
+
+This module also holds what the planners share about plans: the gripper turns reported in
+their shortest form (:func:`short_turns`), the choice of the Bayes and most certain plans
+(:func:`choose_indices`) and the bound on plan lengths (:func:`max_plan_length`).
 """
 
 from __future__ import annotations
 
-import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Literal, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..angles import TWO_PI, wrap, wrap_period
+from ..errors import NoPlanError, PlanningError
+from ..model.actions import Action
 from ..model.problem import Problem
+from ..tolerance import DEFAULT_TOLERANCE
 
-__all__ = ["PlanOption", "PlanReport", "PlanStep", "execute_plan"]
+__all__ = [
+    "COST_RTOL",
+    "Plan",
+    "PlanOption",
+    "PlanReport",
+    "PlanResult",
+    "PlanStep",
+    "Status",
+    "choose_indices",
+    "execute_plan",
+    "max_plan_length",
+    "plan_actions",
+    "short_turns",
+]
+
+Status = Literal["ok", "no-plan"]
+"""A result's status: ``"ok"`` (it holds plans) or ``"no-plan"`` (none reached the goal)."""
+
+COST_RTOL = 1e-12
+"""Two expected costs closer than this (relative) tie: the plan with fewer actions wins."""
 
 
 @dataclass(frozen=True, slots=True)
 class PlanStep:
-    """One action: rotate the gripper by ``alpha`` (radians), then act (``kind``)."""
+    """One action: rotate the gripper by ``alpha`` (radians), then act (``kind``).
+
+    ``kind`` is the action's name (:attr:`bayesgrasp.model.actions.Action.name`).
+    """
 
     kind: str
     alpha: float
+
+
+@runtime_checkable
+class Plan(Protocol):
+    """What every plan tells: its actions, where the part ends, how likely and how costly.
+
+    :class:`PlanOption` (a linear plan: the same actions whatever happens) satisfies it.
+
+    Room for a tree: a *policy* whose nodes branch on readings (the seed's section 6.2,
+    jaw-width sensing; :mod:`bayesgrasp.planning.policy`) shares ``success_probability``
+    and ``expected_cost`` (over its branches) but has no single sequence of steps nor one
+    final orientation. When results carry policies this protocol splits in two: a base of
+    what any plan has (``n_actions`` as the longest path, ``success_probability``,
+    ``expected_cost``) and the linear plan's ``steps``, ``final_orientation`` and
+    ``tolerance``; code typed against ``Plan`` today keeps working with linear plans.
+
+    Examples
+    --------
+    >>> opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+    >>> isinstance(opt, Plan)
+    True
+    """
+
+    @property
+    def steps(self) -> tuple[PlanStep, ...]:
+        """The actions in order (angles as in the module notes)."""
+        ...
+
+    @property
+    def n_actions(self) -> int:
+        """Number of actions."""
+        ...
+
+    @property
+    def final_orientation(self) -> float:
+        """The goal orientation of the part in the frame of the last action (radians)."""
+        ...
+
+    @property
+    def success_probability(self) -> float:
+        """Probability that the part ends at the goal."""
+        ...
+
+    @property
+    def expected_cost(self) -> float:
+        """Expected cost of repeating the plan until verification succeeds."""
+        ...
+
+    @property
+    def tolerance(self) -> float | None:
+        """Error every relative turn may have at once and keep the plan's success."""
+        ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -35,8 +123,9 @@ class PlanOption:
     ----------
     steps : tuple of PlanStep
         ``steps[0].alpha`` is the world gripper angle of the first action; ``steps[i].alpha``
-        (i >= 1) the turn of the gripper relative to the previous action (the exact planner
-        gives squeeze turns in ``(-pi/2, pi/2]``: a gripper turned by pi is the same gripper).
+        (i >= 1) the turn of the gripper relative to the previous action, in
+        ``(-g/2, g/2]`` for an action of gripper period ``g`` (:func:`short_turns`: a squeeze
+        gripper turned by pi is the same gripper).
     final_orientation : float
         The goal orientation of the part in the frame of the last action (radians, in
         ``[0, 2 pi)``).
@@ -83,22 +172,36 @@ class PlanOption:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
-class PlanReport:
-    """Plans of every length up to the most certain one, for one problem.
+class PlanResult:
+    """What a planner found for one problem: plans of every length up to the most certain.
 
     Attributes
     ----------
     problem : Problem
     options : tuple of PlanOption
-        ``options[k - 1]`` is the best plan with ``k`` actions.
+        The exact and breadth-first planners: ``options[k - 1]`` is the best plan with ``k``
+        actions (possibly one more, see :func:`~bayesgrasp.planning.exact.plan_exact`). The
+        guaranteed planner: its one plan. Empty when ``status`` is ``"no-plan"``.
     bayes : int
         Index of the plan of least expected cost (ties go to fewer actions).
     most_certain : int
         Index of the shortest plan with the highest attainable success probability.
     method : str
-        ``"exact"`` or ``"bfs"``.
+        ``"exact"``, ``"bfs"`` or ``"guaranteed"``.
     nodes : int or None
         Hyperstates generated (breadth-first baseline only).
+    status : {"ok", "no-plan"}
+        ``"no-plan"``: no plan reached the goal asked for (``options`` is empty).
+    reason : str or None
+        Why there is no plan (``None`` when ``status`` is ``"ok"``).
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.planning import plan
+    >>> res = plan(Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])))
+    >>> res.status, res.reason, res.method, res.bayes_plan.n_actions
+    ('ok', None, 'exact', 1)
     """
 
     problem: Problem
@@ -107,25 +210,143 @@ class PlanReport:
     most_certain: int
     method: str
     nodes: int | None = None
+    status: Status = "ok"
+    reason: str | None = None
+
+    @property
+    def ok(self) -> bool:
+        """Whether the result holds plans (``status == "ok"``)."""
+        return self.status == "ok"
+
+    def _plan(self, index: int) -> PlanOption:
+        if self.status != "ok":
+            raise NoPlanError(self.reason or "no plan")
+        return self.options[index]
 
     @property
     def bayes_plan(self) -> PlanOption:
-        """The plan of least expected cost."""
-        return self.options[self.bayes]
+        """The plan of least expected cost.
+
+        Raises
+        ------
+        NoPlanError
+            If ``status`` is ``"no-plan"`` (the message is the ``reason``).
+        """
+        return self._plan(self.bayes)
 
     @property
     def most_certain_plan(self) -> PlanOption:
-        """The shortest plan with the highest success probability."""
-        return self.options[self.most_certain]
+        """The shortest plan with the highest success probability.
+
+        Raises
+        ------
+        NoPlanError
+            If ``status`` is ``"no-plan"`` (the message is the ``reason``).
+        """
+        return self._plan(self.most_certain)
 
 
-def choose_indices(options: tuple[PlanOption, ...], tol: float = 1e-12) -> tuple[int, int]:
-    """Indices of the Bayes plan (least cost, ties to fewer actions) and the most certain."""
+PlanReport = PlanResult
+"""The former name of :class:`PlanResult`."""
+
+
+def max_plan_length(problem: Problem) -> int:
+    """The most actions a planner tries before it gives up: ``4 n + 8`` for an n-gon hull.
+
+    Goldberg 1993 bounds plans by O(n) (Chen and Ierardi: ``2 n - 1`` squeezes); the
+    planners never get near this bound, which only stops a search on a degenerate part.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> max_plan_length(Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])))
+    24
+    """
+    return 4 * problem.part.hull.n_sides + 8
+
+
+def choose_indices(
+    options: tuple[PlanOption, ...], tol: float = DEFAULT_TOLERANCE.probability
+) -> tuple[int, int]:
+    """Indices of the Bayes plan (least cost, ties to fewer actions) and the most certain.
+
+    Costs tie within a relative ``1e-12`` plus ``tol``; probabilities within ``tol``
+    (:attr:`bayesgrasp.tolerance.Tolerance.probability`).
+
+    Examples
+    --------
+    >>> opts = [PlanOption((PlanStep("squeeze", 0.0),), 0.0, p, c, None, (0.0, 1.0))
+    ...         for p, c in [(0.3, 6.0), (0.5, 6.0), (0.5, 7.0)]]
+    >>> choose_indices(tuple(opts))
+    (0, 1)
+    """
     costs = np.array([o.expected_cost for o in options])
     probs = np.array([o.success_probability for o in options])
-    bayes = int(np.flatnonzero(costs <= costs.min() * (1 + 1e-12) + tol)[0])
+    bayes = int(np.flatnonzero(costs <= costs.min() * (1 + COST_RTOL) + tol)[0])
     most = int(np.flatnonzero(probs >= probs.max() - tol)[0])
     return bayes, most
+
+
+def plan_actions(problem: Problem, kinds: Iterable[str]) -> tuple[Action, ...]:
+    """The problem's :class:`~bayesgrasp.model.actions.Action` of each action name.
+
+    Raises
+    ------
+    PlanningError
+        If a name is not one of the problem's actions.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    >>> [a.tag for a in plan_actions(pb, ["squeeze", "squeeze"])]
+    ['S', 'S']
+    """
+    by_name = {a.name: a for a in problem.actions}
+    try:
+        return tuple(by_name[k] for k in kinds)
+    except KeyError as exc:
+        known = ", ".join(problem.action_kinds)
+        raise PlanningError(
+            f"action {exc.args[0]!r} is not one of this problem's ({known})"
+        ) from None
+
+
+def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[list[PlanStep], float]:
+    """Steps with each gripper angle in its shortest form, and the turn of the final frame.
+
+    ``angles[m]`` is the turn (or, for ``m = 0``, the world angle) before ``actions[m]``.
+    An action of gripper period ``g`` (:attr:`~bayesgrasp.model.actions.Action.gripper_period`)
+    made with the gripper turned by ``g`` is the same action: a squeeze gripper turned by pi
+    is the same gripper with its jaws swapped. The part then lies ``g`` further round in its
+    frame, and stays so after the action (``s(theta + pi) = s(theta) + pi``). So each angle
+    is reported in ``(-g/2, g/2]`` and the rest of the turn is carried into the next angle
+    (or, after the last action, the final orientation). A push-grasp (``g = 2 pi``) has a
+    pushing side, so its angle only wraps into ``(-pi, pi]``.
+
+    Returns
+    -------
+    steps : list of PlanStep
+    carry : float
+        How much further round (0 or a multiple of pi) the part lies in the last frame than
+        the unshortened angles would leave it: add it to the final orientation.
+
+    Examples
+    --------
+    >>> import math
+    >>> from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
+    >>> steps, carry = short_turns([SQUEEZE, PUSH_GRASP], [math.radians(100), 0.0])
+    >>> [round(math.degrees(s.alpha), 6) for s in steps], round(math.degrees(carry), 6)
+    ([-80.0, 180.0], 0.0)
+    """
+    steps = []
+    carry = 0.0  # how much further round the part lies in the current frame
+    for action, angle in zip(actions, angles, strict=True):
+        a = wrap(angle + carry)
+        short = wrap_period(a, action.gripper_period)
+        carry = a - short  # 0, or +-pi for a period of pi
+        steps.append(PlanStep(action.name, short))
+    return steps, carry
 
 
 def execute_plan(
@@ -146,4 +367,4 @@ def execute_plan(
     theta = np.asarray(initial, dtype=np.float64)
     for step in steps:
         theta = problem.transfers[step.kind](theta - step.alpha)
-    return np.mod(theta, 2.0 * math.pi)
+    return np.mod(theta, TWO_PI)
