@@ -255,7 +255,12 @@ class Problem:
         return tuple(a.name for a in self.actions)
 
     def action(self, name: str | Action) -> Action:
-        """The action of that name (also one the problem does not use)."""
+        """The action of that name: the problem's own first, else the registry's."""
+        if isinstance(name, Action):
+            return name
+        for a in self.actions:
+            if a.name == name:
+                return a
         return get_action(name)
 
     def transfer(self, name: str | Action) -> TransferFunction:
@@ -293,7 +298,7 @@ class Problem:
 
     def transition(self, name: str | Action) -> ActionClasses:
         """The action classes (and their transition matrices) of one action (computed once)."""
-        action = get_action(name)
+        action = self.action(name)
         key = ("classes", action.name)
         if key not in self._cache:
             self._cache[key] = action_classes(
