@@ -270,3 +270,28 @@ def test_symmetry_goal_result_through_the_front_door() -> None:
     for method in METHODS:
         res = plan(pb, method)
         assert res.most_certain_plan.success_probability == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("name", ["triangle", "house", "key", "example"])
+def test_bayes_choice_does_not_depend_on_cost_units(name: str) -> None:
+    """Scaling every cost by the same factor scales every expected cost: same Bayes plan."""
+    from bayesgrasp.model.cost import CostModel
+    from bayesgrasp.shapes import load
+
+    def bayes(scale: float) -> int:
+        cost = CostModel(
+            {"squeeze": 1.0 * scale}, verify=0.7 * scale, first={"squeeze": 1.3 * scale}
+        )
+        return plan_exact(Problem.build(load(name), cost=cost)).bayes
+
+    assert bayes(1e-13) == bayes(1.0) == bayes(1e250)
+
+
+def test_all_infinite_costs_choose_the_fewest_actions() -> None:
+    from bayesgrasp.planning.result import PlanOption, PlanStep, choose_indices
+
+    opts = tuple(
+        PlanOption((PlanStep("squeeze", 0.0),) * k, 0.0, 0.5, math.inf, None, (0.0, 1.0))
+        for k in (1, 2)
+    )
+    assert choose_indices(opts) == (0, 0)

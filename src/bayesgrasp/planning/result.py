@@ -17,6 +17,7 @@ their shortest form (:func:`short_turns`), the choice of the Bayes and most cert
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol, runtime_checkable
@@ -270,7 +271,9 @@ def choose_indices(
 ) -> tuple[int, int]:
     """Indices of the Bayes plan (least cost, ties to fewer actions) and the most certain.
 
-    Costs tie within a relative ``1e-12`` plus ``tol``; probabilities within ``tol``
+    Costs tie within a relative :data:`COST_RTOL` (so the choice does not depend on the cost
+    units: costs of 1e-13 are ranked as costs of 1); when every cost is infinite the plan of
+    fewest actions is chosen. Probabilities tie within ``tol``
     (:attr:`bayesgrasp.tolerance.Tolerance.probability`).
 
     Examples
@@ -282,7 +285,9 @@ def choose_indices(
     """
     costs = np.array([o.expected_cost for o in options])
     probs = np.array([o.success_probability for o in options])
-    bayes = int(np.flatnonzero(costs <= costs.min() * (1 + COST_RTOL) + tol)[0])
+    m = float(costs.min())
+    tie = costs - m <= COST_RTOL * abs(m) if math.isfinite(m) else np.ones(len(costs), bool)
+    bayes = int(np.flatnonzero(tie)[0])
     most = int(np.flatnonzero(probs >= probs.max() - tol)[0])
     return bayes, most
 
