@@ -10,16 +10,9 @@ import typer
 
 from .common import chosen_plan, emit_json, with_progress
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
-from .specs import PartSpec, ProblemSpec
+from .specs import Engine, PartSpec, ProblemSpec
 
 app = command_app()
-
-
-class Engine(enum.StrEnum):
-    """How a plan is executed."""
-
-    kinematic = "kinematic"
-    mujoco = "mujoco"
 
 
 class NoiseKind(enum.StrEnum):

@@ -32,6 +32,13 @@ class Method(enum.StrEnum):
     bfs = "bfs"
 
 
+class Engine(enum.StrEnum):
+    """How a plan is executed (simulate, sweep)."""
+
+    kinematic = "kinematic"
+    mujoco = "mujoco"
+
+
 class GoalKind(enum.StrEnum):
     """What counts as success."""
 

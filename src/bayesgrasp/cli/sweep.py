@@ -11,16 +11,9 @@ import typer
 
 from .common import emit_json, with_progress
 from .options import JsonOpt, command_app, problem_options
-from .specs import ProblemSpec
+from .specs import Engine, ProblemSpec
 
 app = command_app()
-
-
-class SimEngine(enum.StrEnum):
-    """Execution check of each part's Bayes plan."""
-
-    kinematic = "kinematic"
-    mujoco = "mujoco"
 
 
 class ResultFormat(enum.StrEnum):
@@ -46,7 +39,7 @@ def sweep(
         ResultFormat.parquet
     ),
     simulate: Annotated[
-        SimEngine | None, typer.Option(help="Also execute each Bayes plan (kinematic or MuJoCo).")
+        Engine | None, typer.Option(help="Also execute each Bayes plan (kinematic or MuJoCo).")
     ] = None,
     trials: Annotated[
         int | None, typer.Option(min=1, help="Executions a part (default 1,000,000 / 200).")
