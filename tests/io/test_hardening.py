@@ -5,7 +5,7 @@ outline, a point cloud is a hull), huge and non-finite coordinates refused in on
 without numpy warnings, malformed documents refused as PartFileError, the work a file can
 cause bounded (with the limit named), non-regular files refused unopened, parts read from
 memory and standard input. A bounded hypothesis fuzz of every reader closes the file: only
-PartFileError may escape, within a bounded time; the longer variant is marked ``slow``.
+PartFileError may escape, within a bounded time; the longer, randomised variant is marked ``slow`` and runs with BAYESGRASP_LONG_FUZZ=1.
 """
 
 from __future__ import annotations
@@ -976,6 +976,13 @@ DOCUMENTS = {
 }
 
 
+# The long, randomised campaign is opt-in (BAYESGRASP_LONG_FUZZ=1): CI runs the fixed-seed
+# suite above, so a new finding never fails an unrelated change at random.
+long_fuzz = pytest.mark.skipif(
+    os.environ.get("BAYESGRASP_LONG_FUZZ") != "1", reason="set BAYESGRASP_LONG_FUZZ=1 to run"
+)
+
+
 def fuzz(examples: int) -> Callable[[Callable[..., None]], Callable[..., None]]:
     return settings(max_examples=examples, deadline=None, derandomize=True, database=None)
 
@@ -995,6 +1002,7 @@ def test_fuzz_near_valid_documents(fmt: str, data: st.DataObject) -> None:
 
 
 @pytest.mark.slow
+@long_fuzz
 @pytest.mark.parametrize("fmt", FORMATS)
 @settings(max_examples=600, deadline=None, database=None)
 @given(st.data())
@@ -1003,6 +1011,7 @@ def test_fuzz_near_valid_documents_long(fmt: str, data: st.DataObject) -> None:
 
 
 @pytest.mark.slow
+@long_fuzz
 @pytest.mark.parametrize("fmt", FORMATS)
 @settings(max_examples=400, deadline=None, database=None)
 @given(data=st.binary(max_size=4000))
@@ -1036,3 +1045,13 @@ def test_fuzz_strategies_reach_valid_parts() -> None:
         from bayesgrasp.io import read_part_bytes
 
         assert math.isclose(float(np.ptp(read_part_bytes(data, fmt).hull.vertices[:, 0])), 4.0)
+
+
+def test_dxf_arc_with_an_infinite_angle_is_refused() -> None:
+    """Found by the long fuzz: an ARC ending at 1e999 degrees reached scipy as inf."""
+    from bayesgrasp.io import read_part_bytes
+
+    arc = "0 ARC 8 0 10 20 20 0 30 0 40 1 50 1e999 51 180"
+    body = "\n".join(f"0 SECTION 2 ENTITIES {arc} 0 ENDSEC 0 EOF".split()) + "\n"
+    with pytest.raises(PartFileError, match=r"ARC #\w+ on layer 0 has angles inf to 180.0"):
+        read_part_bytes(body.encode(), "dxf", name="f.dxf")

@@ -254,6 +254,11 @@ def _entity_curves(entity: Any) -> tuple[list[Curve], bool] | None:
         center = dxf.center
         if kind == "CIRCLE":
             return [_circle_arc(frame, center, dxf.radius, 0.0, 2 * math.pi, center[2])], True
+        if not (math.isfinite(dxf.start_angle) and math.isfinite(dxf.end_angle)):
+            raise _Refused(
+                f"{_source(entity)} has angles {dxf.start_angle!r} to {dxf.end_angle!r}; "
+                "they must be finite"
+            )
         t0 = math.radians(dxf.start_angle)
         span = math.radians((dxf.end_angle - dxf.start_angle) % 360.0) or 2 * math.pi
         arc = _circle_arc(frame, center, dxf.radius, t0, span, center[2])
@@ -261,6 +266,8 @@ def _entity_curves(entity: Any) -> tuple[list[Curve], bool] | None:
         return [EllipticArc(arc.center, arc.major, arc.minor, t0, span, pin)], False
     if kind == "ELLIPSE":
         ce = entity.construction_tool()
+        if not (math.isfinite(ce.start_param) and math.isfinite(ce.end_param)):
+            raise _Refused(f"{_source(entity)} has parameters that are not finite")
         span = (ce.end_param - ce.start_param) % (2 * math.pi)
         full = span < 1e-12 or abs(span - 2 * math.pi) < 1e-12
         span = 2 * math.pi if full else span
