@@ -5,7 +5,8 @@ outline, a point cloud is a hull), huge and non-finite coordinates refused in on
 without numpy warnings, malformed documents refused as PartFileError, the work a file can
 cause bounded (with the limit named), non-regular files refused unopened, parts read from
 memory and standard input. A bounded hypothesis fuzz of every reader closes the file: only
-PartFileError may escape, within a bounded time; the longer, randomised variant is marked ``slow`` and runs with BAYESGRASP_LONG_FUZZ=1.
+PartFileError may escape, within a bounded time; the longer, randomised variant is marked
+``slow`` and runs with BAYESGRASP_LONG_FUZZ=1.
 """
 
 from __future__ import annotations
