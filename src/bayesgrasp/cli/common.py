@@ -81,16 +81,10 @@ def save_figure(fig: Any, path: Path) -> None:
 
 def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
     """The guaranteed plan of a problem, or the reason none exists (a string)."""
-    from ..errors import NoPlanError
-    from ..planning.guaranteed import plan_guaranteed
+    from ..planning import guaranteed
 
-    try:
-        found = plan_guaranteed(problem)
-    except NoPlanError as exc:  # the planner before its no-plan result
-        return str(exc)
-    if getattr(found, "status", "ok") != "ok":
-        return str(getattr(found, "reason", None) or "no guaranteed plan")
-    return found
+    found = guaranteed.plan_guaranteed(problem)
+    return found if found.status == "ok" else str(found.reason or "no guaranteed plan")
 
 
 def chosen_plan(which: str, spec: ProblemSpec, part: Part) -> tuple[Problem, PlanOption, str]:

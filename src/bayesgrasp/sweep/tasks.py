@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Literal, cast
 
-from ..errors import BayesGraspError, NoPlanError
+from ..errors import BayesGraspError
 from ..model.prior import Prior, parse_prior
 
 __all__ = [
@@ -426,15 +426,11 @@ def _plan(part: Any, options: SweepOptions, prior: Prior) -> tuple[Any, dict[str
     if options.guaranteed:
         from ..planning.guaranteed import plan_guaranteed
 
-        try:
-            found = plan_guaranteed(pb)
-        except NoPlanError as exc:  # the planner before its no-plan result
-            missing = str(exc)
+        found = plan_guaranteed(pb)
+        if found.status == "ok":
+            sure = found
         else:
-            if getattr(found, "status", "ok") == "ok":
-                sure = found
-            else:
-                missing = str(getattr(found, "reason", None) or "no guaranteed plan")
+            missing = str(found.reason or "no guaranteed plan")
     doc = plan_document(rep, guaranteed=sure, guaranteed_missing=missing)
     return rep, doc, "ok" if missing is None else "no-plan"
 
