@@ -1,0 +1,686 @@
+"""The Bayes plan under noisy actions and a payoff (the seed, section 6.4).
+
+Under a noise model (:mod:`bayesgrasp.model.noise`: turn error, contact asynchrony) every
+action is a row-stochastic (K, K) matrix ``M_t(alpha)`` that depends smoothly (normal error)
+or piecewise linearly (uniform error) on the turn, so a plan's outcome is no longer fixed by
+finitely many action classes. A plan of actions ``t_1..t_k`` at angles ``a, alpha_2..alpha_k``
+ends in the distribution
+
+    q_k = q_1(a) M_{t_2}(alpha_2) ... M_{t_k}(alpha_k)
+
+(``q_1`` the prior convolved with the first action, :meth:`NoisyTransitions.initial`), and
+earns ``E[payoff] = q_k . u``: ``u`` the payoff vector (:mod:`bayesgrasp.model.payoff`), or
+for today's goal the indicator of the best final state (of its symmetry orbit for a symmetry
+goal). The plan's cost is ``E[cycle cost] / E[payoff]``
+(:meth:`~bayesgrasp.model.cost.CostModel.expected_cost` with ``E[payoff]`` as ``p``; for a
+0/1 payoff the seed's ``C / p``). The Bayes plan minimises it.
+
+How the plan is found, for each length ``k``:
+
+1. *Seeds*: the noise-free exact planner's plans (:func:`~.exact.plan_exact`), and those it
+   gives with a gripper accuracy of 1, 2 and 3 times the error's scale (robust plans).
+2. *Hyperstate search* (the seed's breadth-first search, section 5, generalised to
+   stochastic transfers): a hyperstate is the distribution ``q`` after some actions; its
+   children are ``q M_t(alpha)`` for every action kind ``t`` and the middle ``alpha`` of
+   every noise-free action class (:meth:`~bayesgrasp.model.problem.Problem.classes`). The
+   children no longer collapse onto few distinct distributions, so each level keeps the
+   ``beam`` most valuable ones (value: the payoff they would earn if the plan ended there).
+3. *Continuous refinement* of the best candidates of each length, one turn at a time:
+   ``f(alpha_m) = q_{m-1} M(alpha_m) r_m`` with ``r_m = M(alpha_{m+1}) ... M(alpha_k) u``
+   is maximised over the turn's whole range ``(-g/2, g/2]``. Uniform error: ``f`` is
+   piecewise linear with kinks at ``S_i - B - o +- A`` (state ``S_i``, basin boundary ``B``,
+   contact offset ``o``), so its maximum over the kinks is exact (the middle of a flat top
+   is kept). Normal error: ``f`` on a grid of step ``h = sigma / 6`` then a golden-section
+   search around the best grid point; since ``|f''| <= 2 phi(1) / sigma^2``
+   (:attr:`~bayesgrasp.model.noise.TurnNoise.curvature_bound`) the grid's best is within
+   ``eps = |f''|max h^2 / 8 = 1.7e-3`` of the turn's global maximum. Sweeps repeat until
+   no turn gains more than the probability tolerance.
+4. *Exact evaluation*: every candidate's distribution, payoff and cost are matrix products
+   (:func:`evaluate_plan`), nothing is sampled.
+
+The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
+
+- every reported probability, payoff and cost is exact for the noise model (to rounding;
+  under a non-uniform prior the first action's average over its own error is a
+  512-node Gauss-Legendre rule);
+- the plan of each length is the best of its candidate set, and each refined plan is
+  coordinate-wise optimal: changing any one turn ``alpha_2..alpha_k`` gains at most ``eps``
+  in ``E[payoff]`` (0 for the uniform error, whose one-turn maxima are exact). The first
+  angle is not refined under a non-uniform prior beyond a local grid (it places the arc on
+  the prior; the exact planner's placements are seeds);
+- the lengths searched are enough: the search stops at the first length ``k`` where the
+  cheapest attempt of ``k + 1`` actions, at the highest attainable payoff (the largest entry
+  of ``u``; for today's goal without contact noise, the noise-free bound: averaging over
+  errors cannot beat the best deterministic plan, so ``p <= max prior mass of an arc of the
+  period``), already costs more than the best plan found;
+- not guaranteed: the global maximum over all turns at once (the payoff is a multimodal
+  function of the turns). The tests compare the planner with a brute-force grid over the
+  turns of every plan of up to 3 actions, within the grid's resolution bound
+  ``peak_density * h * (k - 1) / 2`` (``|d f / d alpha_m| <= sup density``).
+
+With no noise at all the planner returns the exact planner's plans, re-evaluated.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..angles import TWO_PI, wrap_period
+from ..errors import PlanningError
+from ..model.noise import NoiseModel, NoisyTransitions
+from ..model.payoff import Payoff, as_vector
+from ..model.prior import UniformPrior
+from ..model.problem import Problem, nearest_state
+from .exact import plan_exact
+from .result import (
+    PlanOption,
+    PlanResult,
+    PlanStep,
+    choose_indices,
+    max_plan_length,
+    plan_actions,
+    short_turns,
+)
+
+__all__ = ["NoisyEvaluation", "NoisyOption", "NoisyPlanResult", "evaluate_plan", "plan_noisy"]
+
+FloatArray = NDArray[np.float64]
+
+GRID_PER_SIGMA = 6
+"""Grid points per standard deviation of a normal turn error in the refinement."""
+FLAT_SIGMAS = 8.0
+"""Farther than this many sigma from every critical turn, ``f`` is flat (to 1e-15)."""
+ACCURACY_SEEDS = (2.0,)
+"""Seeds: the exact planner's plans with a gripper accuracy of these many error scales."""
+MAX_SWEEPS = 4
+"""Most sweeps over the turns in the refinement of one plan."""
+_GAIN_TOL = 1e-12
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class NoisyEvaluation:
+    """A plan evaluated exactly under a noise model.
+
+    Attributes
+    ----------
+    distribution : ndarray of shape (K,)
+        Probability of each final state (frame of the last action).
+    target : ndarray of shape (K,)
+        The payoff of each final state (today's goal: 1 on the chosen state or orbit).
+    final_state : int
+        The state the plan aims at: the one of largest ``distribution * target``.
+    expected_payoff : float
+    success_probability : float
+        Probability of a final state of positive payoff.
+    expected_cost : float
+        Expected cost per unit payoff (inf if the payoff is 0).
+    """
+
+    distribution: FloatArray
+    target: FloatArray
+    final_state: int
+    expected_payoff: float
+    success_probability: float
+    expected_cost: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class NoisyOption:
+    """The best plan of one length under the noise.
+
+    Attributes
+    ----------
+    option : PlanOption
+        Its steps and final orientation; ``success_probability`` and ``expected_cost``
+        (per unit payoff) under the noise; ``tolerance`` ``None`` (the noise is in the
+        probability already); ``success_arc`` the noise-free one of its steps.
+    evaluation : NoisyEvaluation
+    noise_free_probability : float
+        The same steps' success probability with exact actions (same target).
+    source : str
+        Where the plan came from: ``"exact"``, ``"accuracy"`` (a robust exact plan),
+        ``"search"`` (hyperstate search), with ``"+refined"`` if refinement moved it.
+    """
+
+    option: PlanOption
+    evaluation: NoisyEvaluation
+    noise_free_probability: float
+    source: str
+
+    @property
+    def expected_payoff(self) -> float:
+        """Expected payoff of one attempt."""
+        return self.evaluation.expected_payoff
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class NoisyPlanResult:
+    """What :func:`plan_noisy` found: the best plan of each length under the noise.
+
+    Attributes
+    ----------
+    problem : Problem
+    noise : NoiseModel
+    payoff : ndarray of shape (K,) or None
+        The payoff of each state (``None``: the problem's goal).
+    options : tuple of NoisyOption
+        ``options[k - 1]``: the best plan of ``k`` actions found.
+    bayes, most_certain : int
+        Least cost per unit payoff; highest expected payoff.
+    candidates : int
+        Plans evaluated exactly.
+    refinement_bound : float
+        ``eps``: no single turn of a refined plan can gain more expected payoff.
+    payoff_bound : float
+        The highest expected payoff any plan can reach, used to stop the length search.
+    """
+
+    problem: Problem
+    noise: NoiseModel
+    payoff: FloatArray | None
+    options: tuple[NoisyOption, ...]
+    bayes: int
+    most_certain: int
+    candidates: int
+    refinement_bound: float
+    payoff_bound: float
+
+    @property
+    def bayes_plan(self) -> NoisyOption:
+        """The plan of least expected cost per unit payoff."""
+        return self.options[self.bayes]
+
+    def plan_result(self) -> PlanResult:
+        """As a :class:`PlanResult` (method ``"noisy"``) for tables, files and simulation."""
+        return PlanResult(
+            self.problem,
+            tuple(o.option for o in self.options),
+            self.bayes,
+            self.most_certain,
+            "noisy",
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """The noise-specific part of a plan document."""
+        return {
+            "noise": self.noise.to_json(),
+            "payoff": None if self.payoff is None else self.payoff.tolist(),
+            "candidates": self.candidates,
+            "refinement_bound": self.refinement_bound,
+            "payoff_bound": self.payoff_bound,
+            "noisy_options": [
+                {
+                    "expected_payoff": o.expected_payoff,
+                    "cost_per_unit_payoff": _json_float(o.evaluation.expected_cost),
+                    "success_probability": o.evaluation.success_probability,
+                    "noise_free_probability": o.noise_free_probability,
+                    "final_distribution": o.evaluation.distribution.tolist(),
+                    "source": o.source,
+                }
+                for o in self.options
+            ],
+        }
+
+
+def _json_float(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+class _Evaluator:
+    """Exact evaluation of plans of one problem under one noise model and payoff."""
+
+    def __init__(self, problem: Problem, noise: NoiseModel, payoff: FloatArray | None) -> None:
+        self.problem = problem
+        self.noise = noise
+        self.nt = NoisyTransitions(problem, noise)
+        self.payoff = payoff
+        stable = problem.states.stable
+        # (K, K): row j is the success vector of a plan ending at state j (the goal).
+        self.masks = (
+            np.eye(len(stable))
+            if problem.goal_group == 1
+            else np.array([problem.success_states(float(s)) for s in stable], dtype=np.float64)
+        )
+        self.evaluated = 0
+        # The state pi further round of each state (None if the states are not pi-periodic).
+        half = nearest_state(problem.states, stable + math.pi)
+        ok = np.allclose(
+            np.abs(np.mod(stable[half] - stable - math.pi + math.pi, TWO_PI) - math.pi), 0.0,
+            atol=1e3 * problem.states.angle_tol,
+        )
+        self.half = half if ok else None
+
+    def targets(self, q: FloatArray) -> tuple[FloatArray, int]:
+        """The payoff vector a final distribution is scored with, and the aimed state."""
+        if self.payoff is not None:
+            return self.payoff, int(np.argmax(q * self.payoff))
+        j = int(np.argmax(self.masks @ q))
+        members = np.flatnonzero(self.masks[j] > 0)
+        return self.masks[j], int(members[np.argmax(q[members])])
+
+    def value(self, q: FloatArray) -> FloatArray:
+        """Expected payoff of distributions (rows), each with its best target."""
+        if self.payoff is not None:
+            return np.asarray(q @ self.payoff, dtype=np.float64)
+        return np.asarray((q @ self.masks.T).max(axis=-1), dtype=np.float64)
+
+    def forward(self, kinds: Sequence[str], angles: Sequence[float]) -> list[FloatArray]:
+        """Distributions after each action: ``[q_1, ..., q_k]``."""
+        qs = [self.nt.initial(kinds[0], angles[0])]
+        for t, a in zip(kinds[1:], angles[1:], strict=True):
+            qs.append(self.step(qs[-1], t, np.array([a]))[0])
+        return qs
+
+    def step(self, q: FloatArray, kind: str, alphas: FloatArray) -> FloatArray:
+        """``q M(alpha)`` for each turn: shape (N, K); only states with mass are computed."""
+        rows = np.flatnonzero(q > 0)
+        m = self.nt.matrices(kind, alphas, rows)  # (N, R, K)
+        return np.asarray(np.einsum("r,nrk->nk", q[rows], m), dtype=np.float64)
+
+    def evaluate(self, kinds: Sequence[str], angles: Sequence[float]) -> NoisyEvaluation:
+        self.evaluated += 1
+        q = self.forward(kinds, angles)[-1]
+        u, j = self.targets(q)
+        eu = float(q @ u)
+        p = float(q[u > 0].sum())
+        cost = self.problem.cost.expected_cost(tuple(kinds), eu)
+        return NoisyEvaluation(q, u, j, eu, p, cost)
+
+
+def evaluate_plan(
+    problem: Problem,
+    noise: NoiseModel,
+    steps: Sequence[PlanStep],
+    payoff: Payoff | FloatArray | None = None,
+) -> NoisyEvaluation:
+    """Evaluate a plan exactly under a noise model (and a payoff).
+
+    Parameters
+    ----------
+    problem : Problem
+    noise : NoiseModel
+    steps : sequence of PlanStep
+        As a plan reports them (the final distribution is in the frame of the last one).
+    payoff : Payoff or array of shape (K,), optional
+        Default: the problem's goal (1 on the best final state or its orbit).
+
+    Returns
+    -------
+    NoisyEvaluation
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.noise import TurnNoise
+    >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
+    >>> pb = Problem.build(rect)
+    >>> plan = plan_exact(pb).bayes_plan
+    >>> ev = evaluate_plan(pb, NoiseModel(TurnNoise("uniform", math.radians(5))), plan.steps)
+    >>> round(ev.success_probability, 6) == round(plan.success_probability, 6)
+    True
+    """
+    if not steps:
+        raise PlanningError("a plan needs at least one step")
+    plan_actions(problem, [s.kind for s in steps])
+    u = None if payoff is None else as_vector(payoff, problem.states)
+    ev = _Evaluator(problem, noise, u)
+    return ev.evaluate([s.kind for s in steps], [s.alpha for s in steps])
+
+
+@dataclass(slots=True)
+class _Cand:
+    kinds: tuple[str, ...]
+    angles: list[float]
+    source: str
+    ev: NoisyEvaluation | None = None
+
+
+def _periods(problem: Problem, kinds: Sequence[str]) -> list[float]:
+    return [a.gripper_period for a in plan_actions(problem, kinds)]
+
+
+def _short(problem: Problem, kinds: Sequence[str], angles: Sequence[float]) -> list[float]:
+    """Angles in their reported ranges, with any carry absorbed (see :func:`short_turns`)."""
+    steps, carry = short_turns(plan_actions(problem, kinds), angles)
+    if carry != 0.0:  # the last frame is turned by pi: not the same plan for a payoff
+        return [float(a) for a in angles]
+    return [s.alpha for s in steps]
+
+
+class _Planner:
+    def __init__(self, problem: Problem, noise: NoiseModel, payoff: FloatArray | None) -> None:
+        self.problem = problem
+        self.noise = noise
+        self.ev = _Evaluator(problem, noise, payoff)
+        self.turn = noise.turn
+        self.p_tol = problem.part.hull.tol.probability
+
+    # -- refinement -----------------------------------------------------------------------
+    def _right(self, kinds: Sequence[str], angles: Sequence[float], m: int, u: FloatArray):
+        """``r_m = M(alpha_{m+1}) ... M(alpha_k) u`` (applied right to left)."""
+        r = u.copy()
+        for t, a in zip(kinds[m + 1 :][::-1], angles[m + 1 :][::-1], strict=True):
+            r = self.ev.nt.matrix(t, a) @ r
+        return r
+
+    def _line(self, kind: str, left: FloatArray, right: FloatArray, alphas: FloatArray):
+        """``f(alpha) = left M(alpha) right`` at many turns."""
+        return self.ev.nt.line(kind, left, right, alphas)
+
+    def _best_turn(
+        self, kind: str, period: float, left: FloatArray, right: FloatArray, current: float
+    ) -> tuple[float, float]:
+        """The turn of largest ``f`` over ``(-g/2, g/2]`` and its value."""
+        turn = self.turn
+        f0 = float(self._line(kind, left, right, np.array([current]))[0])
+        if turn.kind == "uniform":
+            crit = self.ev.nt.critical(kind, left, right)
+            pts = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
+            kinks = np.unique(np.mod(pts + period / 2, period)) - period / 2
+            vals = self._line(kind, left, right, kinks)
+            top = vals.max()
+            at = np.flatnonzero(vals >= top - self.p_tol)
+            # The longest run of consecutive kinks at the top is a flat segment: its middle.
+            runs = np.split(at, np.flatnonzero(np.diff(at) != 1) + 1)
+            run = max(runs, key=lambda r: kinks[r[-1]] - kinks[r[0]])
+            best = 0.5 * (kinks[run[0]] + kinks[run[-1]])
+            fb = float(self._line(kind, left, right, np.array([best]))[0])
+            if fb < top - self.p_tol:  # pragma: no cover - a flat run is flat
+                best, fb = float(kinks[run[0]]), float(top)
+        else:
+            h = turn.scale / GRID_PER_SIGMA
+            n = max(8, math.ceil(period / h))
+            grid = -period / 2 + period * (np.arange(n) + 0.5) / n
+            grid = _near_critical(
+                grid, self.ev.nt.critical(kind, left, right), period, FLAT_SIGMAS * turn.scale
+            )
+            vals = self._line(kind, left, right, grid)
+            i = int(np.argmax(vals))
+            best, fb = float(grid[i]), float(vals[i])
+            # Two finer grids around the best point (resolution h / 256).
+            width = period / n
+            for _ in range(2):
+                fine = best + width * np.linspace(-1.0, 1.0, 33)
+                fv = self._line(kind, left, right, fine)
+                j = int(np.argmax(fv))
+                if fv[j] > fb:
+                    best, fb = float(fine[j]), float(fv[j])
+                width /= 16.0
+        if fb > f0 + _GAIN_TOL:
+            return wrap_period(best, period), fb
+        return current, f0
+
+    def refine(self, cand: _Cand) -> _Cand:
+        """Coordinate ascent over the turns (see the module notes)."""
+        kinds, angles = cand.kinds, list(cand.angles)
+        if len(kinds) < 2 or self.turn.exact and self.noise.contact == 0:
+            return cand
+        periods = _periods(self.problem, kinds)
+        moved = False
+        ev = cand.ev or self.ev.evaluate(kinds, angles)
+        # A turn is optimised again only after another turn (or the target) has changed:
+        # with the rest fixed its line, and so its best value, is the same.
+        stale = set(range(1, len(kinds)))
+        qs = self.ev.forward(kinds, angles)
+        for _ in range(MAX_SWEEPS):
+            u = ev.target
+            for m in range(1, len(kinds)):
+                if m not in stale:
+                    continue
+                stale.discard(m)
+                right = self._right(kinds, angles, m, u)
+                new, _ = self._best_turn(kinds[m], periods[m], qs[m - 1], right, angles[m])
+                if new != angles[m]:
+                    angles[m] = new
+                    for j in range(m, len(kinds)):
+                        qs[j] = self.ev.step(qs[j - 1], kinds[j], np.array([angles[j]]))[0]
+                    stale |= set(range(1, len(kinds))) - {m}
+                    moved = True
+            # The target is chosen again: the payoff can only rise.
+            ev = self.ev.evaluate(kinds, angles)
+            if not np.array_equal(ev.target, u):
+                stale = set(range(1, len(kinds)))
+            if not stale:
+                break
+        if not moved:
+            return dataclasses.replace(cand, ev=ev)
+        return _Cand(kinds, angles, cand.source + "+refined", ev)
+
+
+def _near_critical(grid: FloatArray, crit: FloatArray, period: float, reach: float) -> FloatArray:
+    """The grid points within ``reach`` of a critical turn, and one point in each flat gap.
+
+    Farther than ``reach`` from every critical turn the line ``f`` is constant to rounding
+    (its CDF terms are 0 or 1), so one point of each gap stands for all of it.
+    """
+    if len(crit) == 0:
+        return grid[:1]
+    c = np.sort(np.mod(crit + period / 2, period) - period / 2)
+    ext = np.concatenate([c[-1:] - period, c, c[:1] + period])
+    k = np.searchsorted(ext, grid)
+    dist = np.minimum(ext[k] - grid, grid - ext[k - 1])
+    gaps = np.diff(ext[1:])  # gaps between consecutive critical turns, the last wraps
+    wide = gaps > 2.0 * reach
+    mids = np.mod(c[wide] + gaps[wide] / 2 + period / 2, period) - period / 2
+    return np.concatenate([grid[dist < reach], mids])
+
+
+def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list[_Cand]:
+    """The exact planner's plans, noise-free and with accuracies of 1-3 error scales."""
+    out = []
+    runs: list[tuple[float, str]] = [(problem.accuracy, "exact")]
+    if not noise.turn.exact:
+        runs += [(problem.accuracy + m * noise.turn.scale, "accuracy") for m in ACCURACY_SEEDS]
+    for acc, label in runs:
+        pb = problem if acc == problem.accuracy else dataclasses.replace(problem, accuracy=acc, _cache={})
+        res = plan_exact(pb, max_actions)
+        out += [_Cand(o.kinds, [s.alpha for s in o.steps], label) for o in res.options]
+    return out
+
+
+def _payoff_bound(problem: Problem, ev: _Evaluator, payoff: FloatArray | None) -> float:
+    """The highest expected payoff any plan can reach (see the module notes)."""
+    noise = ev.noise
+    targets = ev.masks if payoff is None else payoff[None, :]  # (T, K)
+    if noise.contact > 0:
+        squeezes = all(math.isclose(a.gripper_period, math.pi) for a in problem.actions)
+        if squeezes and isinstance(problem.prior, UniformPrior) and ev.half is not None:
+            # Every action commutes with the turn by pi (the contact events are symmetric)
+            # and the uniform prior is invariant under it, so is the final distribution q:
+            # q . v = q . (v + v o pi) / 2 <= max of (v + v o pi) / 2.
+            return float(np.max(0.5 * (targets + targets[:, ev.half])))
+        return float(targets.max())
+    if payoff is not None:
+        return float(payoff.max())
+    # Averaging over the errors cannot beat the best plan with exact turns.
+    period = max(problem.transfer(t).period for t in problem.action_kinds)
+    group = problem.goal_group
+    p, _ = problem.prior.max_arc_mass(min(period, TWO_PI / group), group)
+    return min(1.0, float(p))
+
+
+def plan_noisy(
+    problem: Problem,
+    noise: NoiseModel,
+    payoff: Payoff | FloatArray | None = None,
+    max_actions: int | None = None,
+    *,
+    beam: int = 6,
+    refine: int = 2,
+) -> NoisyPlanResult:
+    """The Bayes plan (least expected cost per unit payoff) under a noise model.
+
+    See the module notes for the method and its guarantee.
+
+    Parameters
+    ----------
+    problem : Problem
+    noise : NoiseModel
+    payoff : Payoff or array of shape (K,), optional
+        Payoff of each final state (default: the problem's goal).
+    max_actions : int, optional
+        Longest plan (default: until longer plans cannot cost less).
+    beam : int
+        Hyperstates kept per level of the search.
+    refine : int
+        Candidates of each length refined continuously.
+
+    Returns
+    -------
+    NoisyPlanResult
+
+    Raises
+    ------
+    PlanningError
+        ``max_actions``, ``beam`` or ``refine`` below 1, or a bad payoff.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.noise import TurnNoise
+    >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
+    >>> res = plan_noisy(Problem.build(rect), NoiseModel(TurnNoise("normal", math.radians(5))))
+    >>> [round(o.option.success_probability, 4) for o in res.options]
+    [0.3163, 0.4914]
+    """
+    if max_actions is not None and max_actions < 1:
+        raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    if beam < 1 or refine < 1:
+        raise PlanningError(f"`beam` and `refine` must be at least 1; got {beam} and {refine}")
+    u = None if payoff is None else as_vector(payoff, problem.states)
+    pl = _Planner(problem, noise, u)
+    ev = pl.ev
+    exact = ev if noise.exact else _Evaluator(problem, NoiseModel(), u)
+    cost = problem.cost
+    kinds_all = problem.action_kinds
+    limit = min(max_plan_length(problem), max_actions or max_plan_length(problem))
+    seeds = _seeds(problem, noise, max_actions)
+    bound = _payoff_bound(problem, ev, u)
+    first_kind = min(kinds_all, key=lambda t: cost.action_cost(t, first=True))
+    next_kind = min(kinds_all, key=lambda t: cost.action_cost(t))
+    # Hyperstate search: level 1 is the first action at each seed's first angle.
+    firsts = dict.fromkeys((c.kinds[0], c.angles[0]) for c in seeds)
+    if isinstance(problem.prior, UniformPrior):
+        firsts = dict.fromkeys((t, 0.0) for t in kinds_all)
+    level = [_Cand((t, ), [a], "search") for t, a in firsts]
+    level_q = [ev.nt.initial(t, a) for t, a in firsts]
+    mids = {
+        t: np.array(
+            [wrap_period(float(x), a.gripper_period) for x in problem.classes(t).mid]
+        )
+        for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True)
+    }
+    options: list[NoisyOption] = []
+    best_cost = math.inf
+    k = 0
+    while k < limit:
+        k += 1
+        if k > 1:  # expand the beam
+            children: list[tuple[float, _Cand, FloatArray]] = []
+            for cand, q in zip(level, level_q, strict=True):
+                for t in kinds_all:
+                    qs = ev.step(q, t, mids[t])
+                    vals = ev.value(qs)
+                    for i in np.argsort(-vals)[: 2 * beam]:
+                        c = _Cand((*cand.kinds, t), [*cand.angles, float(mids[t][i])], "search")
+                        children.append((float(vals[i]), c, qs[i]))
+            children.sort(key=lambda x: -x[0])
+            seen: set[bytes] = set()
+            level, level_q = [], []
+            for _, c, q in children:
+                key = np.round(q, 9).tobytes()
+                if key in seen:
+                    continue
+                seen.add(key)
+                level.append(c)
+                level_q.append(q)
+                if len(level) >= beam:
+                    break
+        cands = [c for c in seeds if len(c.kinds) == k] + level
+        for c in cands:
+            c.angles = _short(problem, c.kinds, c.angles)
+            c.ev = ev.evaluate(c.kinds, c.angles)
+        cands.sort(key=lambda c: (c.ev.expected_cost, -c.ev.expected_payoff))  # type: ignore[union-attr]
+        refined, done = [], set()
+        for c in cands:
+            key = (c.kinds, tuple(np.round(c.angles, 9)))
+            if key in done:
+                continue
+            done.add(key)
+            refined.append(pl.refine(c))
+            if len(refined) >= refine:
+                break
+        pool = refined + cands
+        best = min(pool, key=lambda c: (c.ev.expected_cost, -c.ev.expected_payoff))  # type: ignore[union-attr]
+        options.append(_noisy_option(problem, exact, best))
+        best_cost = min(best_cost, best.ev.expected_cost)  # type: ignore[union-attr]
+        cheapest_next = cost.expected_cost((first_kind,) + (next_kind,) * k, bound)
+        if cheapest_next >= best_cost * (1.0 - 1e-12):
+            break
+    plans = tuple(o.option for o in options)
+    bayes, most = choose_indices(plans, pl.p_tol)
+    # The most certain: highest expected payoff (choose_indices reads success_probability).
+    pays = np.array([o.expected_payoff for o in options])
+    most = int(np.flatnonzero(pays >= pays.max() - pl.p_tol)[0])
+    turn = noise.turn
+    if turn.exact or turn.kind == "uniform":
+        eps = 0.0
+    else:
+        h = turn.scale / GRID_PER_SIGMA
+        eps = turn.curvature_bound * h * h / 8.0
+    return NoisyPlanResult(problem, noise, u, tuple(options), bayes, most, ev.evaluated, eps, bound)
+
+
+def _noisy_option(problem: Problem, exact: _Evaluator, c: _Cand) -> NoisyOption:
+    """The reported plan of a candidate (``exact``: an evaluator without noise)."""
+    e = c.ev
+    if e is None:  # pragma: no cover - every candidate is evaluated before it is chosen
+        raise PlanningError("internal error: a plan was chosen before it was evaluated")
+    steps = tuple(PlanStep(t, a) for t, a in zip(c.kinds, c.angles, strict=True))
+    q0 = exact.forward(c.kinds, c.angles)[-1]
+    p0 = float(q0 @ e.target)
+    final = float(problem.states.stable[e.final_state])
+    arc = _success_arc(problem, steps, e.target)
+    opt = PlanOption(steps, final, e.success_probability, e.expected_cost, None, arc)
+    return NoisyOption(opt, e, p0, c.source)
+
+
+def _success_arc(
+    problem: Problem, steps: tuple[PlanStep, ...], target: FloatArray
+) -> tuple[float, float]:
+    """The widest run of first-action basins that the noise-free steps send to the target."""
+    from .result import execute_plan
+
+    f = problem.transfer(steps[0].kind)
+    a = steps[0].alpha
+    ends = execute_plan(problem, steps[1:], f.stable)
+    from ..model.states import nearest_state
+
+    good = target[nearest_state(problem.states, ends)] > 0
+    n = len(good)
+    if not good.any():
+        return (a, a)
+    if good.all():
+        return (float(f.basin_lo[0]) + a, float(f.basin_lo[0]) + a + TWO_PI)
+    start = int(np.flatnonzero(~good)[0])
+    order = (np.arange(n) + start) % n
+    best_len, best_run, run = 0.0, None, []
+    for i in [*order, start]:
+        if good[i]:
+            run.append(i)
+            continue
+        if run:
+            width = float(np.sum(f.basin_hi[run] - f.basin_lo[run]))
+            if width > best_len:
+                best_len, best_run = width, list(run)
+        run = []
+    assert best_run is not None  # noqa: S101
+    lo = float(f.basin_lo[best_run[0]]) + a
+    return (lo, lo + best_len)
