@@ -190,7 +190,8 @@ class TurnNoise:
         if self.exact:
             return np.asarray(out, dtype=np.float64)
         w = self.support
-        top = math.ceil((w + math.pi) / TWO_PI)
+        # r + 2 pi m is at least pi from 0 for m != 0: only m = 0 meets a support below pi.
+        top = 0 if w < math.pi else math.ceil((w + math.pi) / TWO_PI)
         for m in range(-top, top + 1):
             z = r + TWO_PI * m if m else r
             near = np.abs(z) < w
@@ -387,8 +388,7 @@ class NoisyTransitions:
             x = start[None, :, None] - al[:, None, None] - c.offset  # (N, R, 1)
             d_hi = turn.lifted(x - c.hi)  # (N, R, B)
             # Basin b is (hi[b - 1], hi[b]); basin 0 starts at hi[-1] - 2 pi: D shifts by 1.
-            d_lo = np.roll(d_hi, 1, axis=-1)
-            d_lo[..., 0] += 1.0
+            d_lo = np.concatenate([d_hi[..., -1:] + 1.0, d_hi[..., :-1]], axis=-1)
             out += c.weight * ((d_lo - d_hi) @ c.onehot)
         return out
 

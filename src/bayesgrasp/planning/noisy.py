@@ -99,6 +99,8 @@ FLAT_SIGMAS = 8.0
 """Farther than this many sigma from every critical turn, ``f`` is flat (to 1e-15)."""
 ACCURACY_SEEDS = (2.0,)
 """Seeds: the exact planner's plans with a gripper accuracy of these many error scales."""
+TIE_RTOL = 1e-9
+"""Costs closer than this (relative) tie: the earlier candidate (an exact seed) is kept."""
 MAX_SWEEPS = 4
 """Most sweeps over the turns in the refinement of one plan."""
 _GAIN_TOL = 1e-12
@@ -249,6 +251,7 @@ class _Evaluator:
             else np.array([problem.success_states(float(s)) for s in stable], dtype=np.float64)
         )
         self.evaluated = 0
+        self.p_tol = problem.part.hull.tol.probability
         # The state pi further round of each state (None if the states are not pi-periodic).
         half = nearest_state(problem.states, stable + math.pi)
         ok = np.allclose(
@@ -257,11 +260,17 @@ class _Evaluator:
         )
         self.half = half if ok else None
 
-    def targets(self, q: FloatArray) -> tuple[FloatArray, int]:
-        """The payoff vector a final distribution is scored with, and the aimed state."""
+    def targets(self, q: FloatArray, prefer: int | None = None) -> tuple[FloatArray, int]:
+        """The payoff vector a final distribution is scored with, and the aimed state.
+
+        ``prefer``: the state to aim at when it ties with the best (the exact planner's).
+        """
         if self.payoff is not None:
             return self.payoff, int(np.argmax(q * self.payoff))
-        j = int(np.argmax(self.masks @ q))
+        vals = self.masks @ q
+        j = int(np.argmax(vals))
+        if prefer is not None and vals[prefer] >= vals[j] - self.p_tol:
+            j = prefer
         members = np.flatnonzero(self.masks[j] > 0)
         return self.masks[j], int(members[np.argmax(q[members])])
 
@@ -284,10 +293,13 @@ class _Evaluator:
         m = self.nt.matrices(kind, alphas, rows)  # (N, R, K)
         return np.asarray(np.einsum("r,nrk->nk", q[rows], m), dtype=np.float64)
 
-    def evaluate(self, kinds: Sequence[str], angles: Sequence[float]) -> NoisyEvaluation:
+    def evaluate(
+        self, kinds: Sequence[str], angles: Sequence[float], prefer: int | None = None
+    ) -> NoisyEvaluation:
+        """Exact distribution, payoff and cost of a plan (``prefer``: see :meth:`targets`)."""
         self.evaluated += 1
         q = self.forward(kinds, angles)[-1]
-        u, j = self.targets(q)
+        u, j = self.targets(q, prefer)
         eu = float(q @ u)
         p = float(q[u > 0].sum())
         cost = self.problem.cost.expected_cost(tuple(kinds), eu)
@@ -340,6 +352,7 @@ class _Cand:
     angles: list[float]
     source: str
     ev: NoisyEvaluation | None = None
+    prefer: int | None = None  # the final state of an exact seed (kept on ties)
 
 
 def _periods(problem: Problem, kinds: Sequence[str]) -> list[float]:
@@ -396,16 +409,13 @@ class _Planner:
                 best, fb = float(kinks[run[0]]), float(top)
         else:
             h = turn.scale / GRID_PER_SIGMA
-            n = max(8, math.ceil(period / h))
-            grid = -period / 2 + period * (np.arange(n) + 0.5) / n
-            grid = _near_critical(
-                grid, self.ev.nt.critical(kind, left, right), period, FLAT_SIGMAS * turn.scale
-            )
+            crit = self.ev.nt.critical(kind, left, right)
+            grid = _turn_grid(crit, period, h, FLAT_SIGMAS * turn.scale)
             vals = self._line(kind, left, right, grid)
             i = int(np.argmax(vals))
             best, fb = float(grid[i]), float(vals[i])
             # Two finer grids around the best point (resolution h / 256).
-            width = period / n
+            width = h
             for _ in range(2):
                 fine = best + width * np.linspace(-1.0, 1.0, 33)
                 fv = self._line(kind, left, right, fine)
@@ -424,7 +434,7 @@ class _Planner:
             return cand
         periods = _periods(self.problem, kinds)
         moved = False
-        ev = cand.ev or self.ev.evaluate(kinds, angles)
+        ev = cand.ev or self.ev.evaluate(kinds, angles, cand.prefer)
         # A turn is optimised again only after another turn (or the target) has changed:
         # with the rest fixed its line, and so its best value, is the same.
         stale = set(range(1, len(kinds)))
@@ -444,32 +454,58 @@ class _Planner:
                     stale |= set(range(1, len(kinds))) - {m}
                     moved = True
             # The target is chosen again: the payoff can only rise.
-            ev = self.ev.evaluate(kinds, angles)
+            ev = self.ev.evaluate(kinds, angles, cand.prefer)
             if not np.array_equal(ev.target, u):
                 stale = set(range(1, len(kinds)))
             if not stale:
                 break
         if not moved:
             return dataclasses.replace(cand, ev=ev)
-        return _Cand(kinds, angles, cand.source + "+refined", ev)
+        return _Cand(kinds, angles, cand.source + "+refined", ev, cand.prefer)
 
 
-def _near_critical(grid: FloatArray, crit: FloatArray, period: float, reach: float) -> FloatArray:
-    """The grid points within ``reach`` of a critical turn, and one point in each flat gap.
+def _cost(c: _Cand) -> float:
+    if c.ev is None:  # pragma: no cover - every candidate is evaluated before it is ranked
+        raise PlanningError("internal error: a plan was ranked before it was evaluated")
+    return c.ev.expected_cost
+
+
+def _ranked(cands: list[_Cand]) -> list[_Cand]:
+    """Candidates by cost per unit payoff, then payoff (stable: seeds stay first on ties)."""
+    return sorted(cands, key=lambda c: (_cost(c), -c.ev.expected_payoff))  # type: ignore[union-attr]
+
+
+def _best(cands: list[_Cand], p_tol: float) -> _Cand:
+    """The least cost; among costs tied within ``TIE_RTOL``, the highest payoff, then the first.
+
+    So a seed of the exact planner (listed first) wins a tie with a later candidate.
+    """
+    m = min(_cost(c) for c in cands)
+    tied = [c for c in cands if _cost(c) <= m * (1.0 + TIE_RTOL)] if math.isfinite(m) else cands
+    top = max(c.ev.expected_payoff for c in tied)  # type: ignore[union-attr]
+    return next(c for c in tied if c.ev.expected_payoff >= top - p_tol)  # type: ignore[union-attr]
+
+
+def _turn_grid(crit: FloatArray, period: float, h: float, reach: float) -> FloatArray:
+    """Turns to try: a grid of step ``h`` within ``reach`` of the critical turns, one per gap.
 
     Farther than ``reach`` from every critical turn the line ``f`` is constant to rounding
-    (its CDF terms are 0 or 1), so one point of each gap stands for all of it.
+    (its CDF terms are 0 or 1), so one point of each gap stands for all of it. Where the
+    windows cover the period the grid is the whole period's, of step at most ``h``.
     """
+    n = max(8, math.ceil(period / h))
     if len(crit) == 0:
-        return grid[:1]
-    c = np.sort(np.mod(crit + period / 2, period) - period / 2)
-    ext = np.concatenate([c[-1:] - period, c, c[:1] + period])
-    k = np.searchsorted(ext, grid)
-    dist = np.minimum(ext[k] - grid, grid - ext[k - 1])
-    gaps = np.diff(ext[1:])  # gaps between consecutive critical turns, the last wraps
+        return np.zeros(1)
+    c = np.unique(np.mod(crit + period / 2, period) - period / 2)
+    per = 2 * math.ceil(reach / h) + 1
+    if len(c) * per >= n:
+        return -period / 2 + period * (np.arange(n) + 0.5) / n
+    offsets = h * (np.arange(per) - per // 2)
+    pts = (c[:, None] + offsets[None, :]).ravel()
+    gaps = np.diff(np.append(c, c[0] + period))
     wide = gaps > 2.0 * reach
-    mids = np.mod(c[wide] + gaps[wide] / 2 + period / 2, period) - period / 2
-    return np.concatenate([grid[dist < reach], mids])
+    mids = c[wide] + gaps[wide] / 2
+    return np.mod(np.concatenate([pts, mids]) + period / 2, period) - period / 2
 
 
 def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list[_Cand]:
@@ -481,7 +517,15 @@ def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list
     for acc, label in runs:
         pb = problem if acc == problem.accuracy else dataclasses.replace(problem, accuracy=acc, _cache={})
         res = plan_exact(pb, max_actions)
-        out += [_Cand(o.kinds, [s.alpha for s in o.steps], label) for o in res.options]
+        out += [
+            _Cand(
+                o.kinds,
+                [s.alpha for s in o.steps],
+                label,
+                prefer=int(nearest_state(problem.states, np.array([o.final_orientation]))[0]),
+            )
+            for o in res.options
+        ]
     return out
 
 
@@ -514,6 +558,7 @@ def plan_noisy(
     *,
     beam: int = 6,
     refine: int = 2,
+    all_lengths: bool = False,
 ) -> NoisyPlanResult:
     """The Bayes plan (least expected cost per unit payoff) under a noise model.
 
@@ -531,6 +576,9 @@ def plan_noisy(
         Hyperstates kept per level of the search.
     refine : int
         Candidates of each length refined continuously.
+    all_lengths : bool
+        Search every length up to ``max_actions`` (which is then required) even where
+        longer plans cannot cost less.
 
     Returns
     -------
@@ -552,6 +600,8 @@ def plan_noisy(
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    if all_lengths and max_actions is None:
+        raise PlanningError("`all_lengths` needs `max_actions`")
     if beam < 1 or refine < 1:
         raise PlanningError(f"`beam` and `refine` must be at least 1; got {beam} and {refine}")
     u = None if payoff is None else as_vector(payoff, problem.states)
@@ -577,12 +627,15 @@ def plan_noisy(
         )
         for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True)
     }
+    # Without noise the exact planner's plans are the best of each length (it is exact):
+    # the search is needed only for a payoff, which it does not know.
+    search = not noise.exact or u is not None
     options: list[NoisyOption] = []
     best_cost = math.inf
     k = 0
     while k < limit:
         k += 1
-        if k > 1:  # expand the beam
+        if k > 1 and search:  # expand the beam
             children: list[tuple[float, _Cand, FloatArray]] = []
             for cand, q in zip(level, level_q, strict=True):
                 for t in kinds_all:
@@ -603,11 +656,14 @@ def plan_noisy(
                 level_q.append(q)
                 if len(level) >= beam:
                     break
-        cands = [c for c in seeds if len(c.kinds) == k] + level
+        cands = [c for c in seeds if len(c.kinds) == k]
+        if search:
+            cands += level
         for c in cands:
-            c.angles = _short(problem, c.kinds, c.angles)
-            c.ev = ev.evaluate(c.kinds, c.angles)
-        cands.sort(key=lambda c: (c.ev.expected_cost, -c.ev.expected_payoff))  # type: ignore[union-attr]
+            if c.source == "search":  # seeds are in their short form already
+                c.angles = _short(problem, c.kinds, c.angles)
+            c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
+        cands = _ranked(cands)
         refined, done = [], set()
         for c in cands:
             key = (c.kinds, tuple(np.round(c.angles, 9)))
@@ -617,12 +673,11 @@ def plan_noisy(
             refined.append(pl.refine(c))
             if len(refined) >= refine:
                 break
-        pool = refined + cands
-        best = min(pool, key=lambda c: (c.ev.expected_cost, -c.ev.expected_payoff))  # type: ignore[union-attr]
+        best = _best(cands + refined, pl.p_tol)
         options.append(_noisy_option(problem, exact, best))
         best_cost = min(best_cost, best.ev.expected_cost)  # type: ignore[union-attr]
         cheapest_next = cost.expected_cost((first_kind,) + (next_kind,) * k, bound)
-        if cheapest_next >= best_cost * (1.0 - 1e-12):
+        if not all_lengths and cheapest_next >= best_cost * (1.0 - 1e-12):
             break
     plans = tuple(o.option for o in options)
     bayes, most = choose_indices(plans, pl.p_tol)
