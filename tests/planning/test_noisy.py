@@ -133,9 +133,9 @@ def test_best_plans_match_a_brute_force_grid(part: Part, noise: NoiseModel) -> N
 
 
 def _binomial_ok(observed: NDArray[np.intp], predicted: NDArray[np.float64], n: int) -> None:
-    sd = np.sqrt(np.maximum(predicted * (1 - predicted), 1e-12) / n)
-    z = np.abs(observed / n - predicted) / sd
-    assert np.all(z < 5.0), (observed / n, predicted)
+    # Five standard deviations, and three trials for the rare states (Poisson counts).
+    sd = np.sqrt(np.clip(predicted * (1 - predicted), 0.0, None) / n)
+    assert np.all(np.abs(observed / n - predicted) < 5 * sd + 3 / n), (observed / n, predicted)
 
 
 @pytest.mark.parametrize("name", ["key", "rectangle", "tuning-fork"])

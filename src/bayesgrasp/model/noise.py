@@ -184,11 +184,13 @@ class TurnNoise:
         which vanishes outside the error's support: the CDF is evaluated only there.
         """
         y = np.asarray(y, dtype=np.float64)
+        shape = y.shape
+        y = y.reshape(-1) if y.ndim == 0 else y
         n = np.floor((y + math.pi) / TWO_PI)
         r = y - TWO_PI * n
         out = n - (r < 0.0)
         if self.exact:
-            return np.asarray(out, dtype=np.float64)
+            return np.asarray(out, dtype=np.float64).reshape(shape)
         w = self.support
         # r + 2 pi m is at least pi from 0 for m != 0: only m = 0 meets a support below pi.
         top = 0 if w < math.pi else math.ceil((w + math.pi) / TWO_PI)
@@ -198,7 +200,7 @@ class TurnNoise:
             if np.any(near):
                 zn = z[near]
                 out[near] += self.cdf(zn) - (zn >= 0.0)
-        return np.asarray(out, dtype=np.float64)
+        return np.asarray(out, dtype=np.float64).reshape(shape)
 
     def interval_prob(self, a: ArrayLike, b: ArrayLike) -> FloatArray:
         """``P(e in (a, b])`` on the circle (``e`` wrapped mod 2 pi), ``0 <= b - a <= 2 pi``.
