@@ -63,9 +63,7 @@ def test_no_error_gives_the_class_matrices(name: str, scale: float) -> None:
         got = nt.matrices(action, cl.mid[wide])
         want = np.array([cl.matrix(a) for a in np.flatnonzero(wide)])
         np.testing.assert_allclose(got, want, atol=1e-12)
-    np.testing.assert_allclose(
-        nt.initial("squeeze", 0.3), pb.state_distribution(0.3), atol=1e-15
-    )
+    np.testing.assert_allclose(nt.initial("squeeze", 0.3), pb.state_distribution(0.3), atol=1e-15)
 
 
 def _monte_carlo(pb: Problem, noise: NoiseModel, alpha: float, n: int, seed: int) -> np.ndarray:

@@ -87,7 +87,9 @@ def test_read_json_and_csv(tmp_path: Path) -> None:
         json.dumps({"payoff": {f"{a:.2f}": 1.0, f"{b:.2f}": 0.5}, "default": 0.1})
     )
     (tmp_path / "l.json").write_text(
-        json.dumps({"payoff": [{"orientation_deg": a, "value": 1}, {"orientation_deg": b, "value": 0.5}]})
+        json.dumps(
+            {"payoff": [{"orientation_deg": a, "value": 1}, {"orientation_deg": b, "value": 0.5}]}
+        )
     )
     (tmp_path / "u.csv").write_text(f"orientation_deg,value\n{a:.3f},1\n{b:.3f},0.5\n")
     (tmp_path / "n.csv").write_text(f"{a},1\n\n{b},0.5\n")

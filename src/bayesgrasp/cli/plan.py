@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import check_figure_path, emit_json, guaranteed_plan, save_figure
+from .noisy import ContactNoiseOpt, PayoffOpt, TurnNoiseOpt
 from .options import JsonOpt, command_app, part_options, problem_options
 from .specs import PartSpec, ProblemSpec
 
@@ -72,6 +73,9 @@ def plan(
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
     max_actions: MaxActionsOpt = 3,
+    turn_noise: TurnNoiseOpt = None,
+    contact_noise: ContactNoiseOpt = None,
+    payoff: PayoffOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -80,7 +84,13 @@ def plan(
     """
     from .. import report
     from ..io.plans import plan_document
+    from . import noisy
 
+    if noisy.asked(turn_noise, contact_noise, payoff):
+        if sense is not None or guaranteed or plot_file is not None:
+            raise typer.BadParameter("--sense, --guaranteed and --plot do not take noise yet")
+        noisy.plan_noisy_command(part.load(), spec, turn_noise, contact_noise, payoff, as_json)
+        return
     if sense is not None:
         _policy(part, spec, sense, also or [], part_prior, max_actions, as_json)
         return

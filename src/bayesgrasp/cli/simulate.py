@@ -9,6 +9,7 @@ from typing import Annotated, Any
 import typer
 
 from .common import chosen_plan, emit_json, with_progress
+from .noisy import TurnNoiseOpt
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
 from .specs import Engine, PartSpec, ProblemSpec
 
@@ -67,6 +68,7 @@ def simulate(
     seed: SeedOpt = 0,
     units: UnitsOpt = None,
     as_json: JsonOpt = False,
+    turn_noise: TurnNoiseOpt = None,
 ) -> None:
     """Execute a plan many times and compare the final orientations with the prediction."""
     from .. import report
@@ -81,6 +83,13 @@ def simulate(
     pb, option, label = chosen_plan(which, spec, p)
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
     err = GripperNoise(noise_kind.value, math.radians(noise))
+    if turn_noise is not None:  # the spelling of plan --turn-noise
+        from .noisy import turn_noise as parse
+
+        if noise > 0:
+            raise typer.BadParameter("give --noise or --turn-noise, not both", param_hint="--noise")
+        t = parse(turn_noise)
+        err = GripperNoise(t.kind, t.scale)
 
     def run(progress: Any) -> Any:
         if engine is Engine.kinematic:

@@ -147,7 +147,7 @@ class TurnNoise:
 
     @property
     def peak_density(self) -> float:
-        """Sup of the error's density: ``1 / (sigma sqrt(2 pi))`` or ``1 / (2 A)`` (inf if exact)."""
+        """Sup of the error's density, ``1 / (sigma sqrt(2 pi))`` or ``1 / (2 A)``; inf if exact."""
         if self.exact:
             return math.inf
         if self.kind == "normal":
@@ -373,9 +373,7 @@ class NoisyTransitions:
             self._components[kind] = tuple(comps)
         return self._components[kind]
 
-    def matrices(
-        self, kind: str, alphas: ArrayLike, rows: ArrayLike | None = None
-    ) -> FloatArray:
+    def matrices(self, kind: str, alphas: ArrayLike, rows: ArrayLike | None = None) -> FloatArray:
         """Transition matrices for the turns ``alphas``: shape (N, R, K).
 
         ``rows`` picks the states to start from (default all K: R = K); entry
@@ -394,9 +392,7 @@ class NoisyTransitions:
             out += c.weight * ((d_lo - d_hi) @ c.onehot)
         return out
 
-    def line(
-        self, kind: str, left: FloatArray, right: FloatArray, alphas: ArrayLike
-    ) -> FloatArray:
+    def line(self, kind: str, left: FloatArray, right: FloatArray, alphas: ArrayLike) -> FloatArray:
         """``left M(alpha) right`` for many turns, shape (N,), without forming ``M``.
 
         For each way the action may go, with ``rho_b`` the value of ending in basin ``b``
@@ -432,7 +428,7 @@ class NoisyTransitions:
 
     def matrix(self, kind: str, alpha: float) -> FloatArray:
         """The (K, K) transition matrix of one turn."""
-        return self.matrices(kind, [alpha])[0]
+        return np.asarray(self.matrices(kind, [alpha])[0], dtype=np.float64)
 
     def initial(self, kind: str, angle: float) -> FloatArray:
         """Distribution over the states after the first action at world angle ``angle``.

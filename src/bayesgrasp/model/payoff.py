@@ -104,9 +104,7 @@ class Payoff:
         o = np.asarray(self.orientations, dtype=np.float64).ravel()
         v = np.asarray(self.values, dtype=np.float64).ravel()
         if len(o) != len(v):
-            raise PayoffError(
-                f"payoff needs one value per orientation; got {len(o)} and {len(v)}"
-            )
+            raise PayoffError(f"payoff needs one value per orientation; got {len(o)} and {len(v)}")
         if not np.all(np.isfinite(o)):
             raise PayoffError("payoff orientations must be finite")
         for i, x in enumerate(v.tolist()):
@@ -224,7 +222,7 @@ def _entries_csv(text: str, name: str) -> tuple[list[float], list[float], float]
 
 
 def read_payoff(path: str | Path) -> Payoff:
-    """Read a payoff file (JSON, or CSV ``orientation_deg,value``; by the extension).
+    r"""Read a payoff file (JSON, or CSV ``orientation_deg,value``; by the extension).
 
     Raises
     ------
@@ -233,10 +231,10 @@ def read_payoff(path: str | Path) -> Payoff:
 
     Examples
     --------
-    >>> import tempfile, os
+    >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as d:
-    ...     p = os.path.join(d, "u.csv")
-    ...     _ = open(p, "w").write("orientation_deg,value\\n90,1\\n")
+    ...     p = Path(d) / "u.csv"
+    ...     _ = p.write_text("orientation_deg,value\n90,1\n")
     ...     read_payoff(p).values.tolist()
     [1.0]
     """

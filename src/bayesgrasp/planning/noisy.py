@@ -255,7 +255,8 @@ class _Evaluator:
         # The state pi further round of each state (None if the states are not pi-periodic).
         half = nearest_state(problem.states, stable + math.pi)
         ok = np.allclose(
-            np.abs(np.mod(stable[half] - stable - math.pi + math.pi, TWO_PI) - math.pi), 0.0,
+            np.abs(np.mod(stable[half] - stable - math.pi + math.pi, TWO_PI) - math.pi),
+            0.0,
             atol=1e3 * problem.states.angle_tol,
         )
         self.half = half if ok else None
@@ -376,14 +377,18 @@ class _Planner:
         self.p_tol = problem.part.hull.tol.probability
 
     # -- refinement -----------------------------------------------------------------------
-    def _right(self, kinds: Sequence[str], angles: Sequence[float], m: int, u: FloatArray):
+    def _right(
+        self, kinds: Sequence[str], angles: Sequence[float], m: int, u: FloatArray
+    ) -> FloatArray:
         """``r_m = M(alpha_{m+1}) ... M(alpha_k) u`` (applied right to left)."""
         r = u.copy()
         for t, a in zip(kinds[m + 1 :][::-1], angles[m + 1 :][::-1], strict=True):
             r = self.ev.nt.matrix(t, a) @ r
         return r
 
-    def _line(self, kind: str, left: FloatArray, right: FloatArray, alphas: FloatArray):
+    def _line(
+        self, kind: str, left: FloatArray, right: FloatArray, alphas: FloatArray
+    ) -> FloatArray:
         """``f(alpha) = left M(alpha) right`` at many turns."""
         return self.ev.nt.line(kind, left, right, alphas)
 
@@ -393,7 +398,20 @@ class _Planner:
         """The turn of largest ``f`` over ``(-g/2, g/2]`` and its value."""
         turn = self.turn
         f0 = float(self._line(kind, left, right, np.array([current]))[0])
-        if turn.kind == "uniform":
+        if turn.exact:
+            # Exact turns (contact noise only): f is constant between critical turns, so
+            # the middles of those intervals are all there is; the widest of the best wins.
+            crit = self.ev.nt.critical(kind, left, right)
+            c = np.unique(np.mod(crit + period / 2, period) - period / 2)
+            if len(c) == 0:
+                return current, f0
+            widths = np.diff(np.append(c, c[0] + period))
+            mids = np.mod(c + widths / 2 + period / 2, period) - period / 2
+            vals = self._line(kind, left, right, mids)
+            top = np.flatnonzero(vals >= vals.max() - self.p_tol)
+            i = int(top[np.argmax(widths[top])])
+            best, fb = float(mids[i]), float(vals[i])
+        elif turn.kind == "uniform":
             crit = self.ev.nt.critical(kind, left, right)
             pts = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
             kinks = np.unique(np.mod(pts + period / 2, period)) - period / 2
@@ -430,7 +448,7 @@ class _Planner:
     def refine(self, cand: _Cand) -> _Cand:
         """Coordinate ascent over the turns (see the module notes)."""
         kinds, angles = cand.kinds, list(cand.angles)
-        if len(kinds) < 2 or self.turn.exact and self.noise.contact == 0:
+        if len(kinds) < 2 or (self.turn.exact and self.noise.contact == 0):
             return cand
         periods = _periods(self.problem, kinds)
         moved = False
@@ -515,7 +533,11 @@ def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list
     if not noise.turn.exact:
         runs += [(problem.accuracy + m * noise.turn.scale, "accuracy") for m in ACCURACY_SEEDS]
     for acc, label in runs:
-        pb = problem if acc == problem.accuracy else dataclasses.replace(problem, accuracy=acc, _cache={})
+        pb = (
+            problem
+            if acc == problem.accuracy
+            else dataclasses.replace(problem, accuracy=acc, _cache={})
+        )
         res = plan_exact(pb, max_actions)
         out += [
             _Cand(
@@ -596,7 +618,7 @@ def plan_noisy(
     >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
     >>> res = plan_noisy(Problem.build(rect), NoiseModel(TurnNoise("normal", math.radians(5))))
     >>> [round(o.option.success_probability, 4) for o in res.options]
-    [0.3163, 0.4914]
+    [0.3176, 0.4964]
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
@@ -619,12 +641,10 @@ def plan_noisy(
     firsts = dict.fromkeys((c.kinds[0], c.angles[0]) for c in seeds)
     if isinstance(problem.prior, UniformPrior):
         firsts = dict.fromkeys((t, 0.0) for t in kinds_all)
-    level = [_Cand((t, ), [a], "search") for t, a in firsts]
+    level = [_Cand((t,), [a], "search") for t, a in firsts]
     level_q = [ev.nt.initial(t, a) for t, a in firsts]
     mids = {
-        t: np.array(
-            [wrap_period(float(x), a.gripper_period) for x in problem.classes(t).mid]
-        )
+        t: np.array([wrap_period(float(x), a.gripper_period) for x in problem.classes(t).mid])
         for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True)
     }
     # Without noise the exact planner's plans are the best of each length (it is exact):
@@ -664,12 +684,13 @@ def plan_noisy(
                 c.angles = _short(problem, c.kinds, c.angles)
             c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
         cands = _ranked(cands)
-        refined, done = [], set()
+        refined: list[_Cand] = []
+        done: set[tuple[tuple[str, ...], tuple[float, ...]]] = set()
         for c in cands:
-            key = (c.kinds, tuple(np.round(c.angles, 9)))
-            if key in done:
+            plan_key = (c.kinds, tuple(np.round(c.angles, 9).tolist()))
+            if plan_key in done:
                 continue
-            done.add(key)
+            done.add(plan_key)
             refined.append(pl.refine(c))
             if len(refined) >= refine:
                 break
@@ -736,6 +757,7 @@ def _success_arc(
             if width > best_len:
                 best_len, best_run = width, list(run)
         run = []
-    assert best_run is not None  # noqa: S101
+    if best_run is None:  # pragma: no cover - some basin is good and some is not
+        return (a, a)
     lo = float(f.basin_lo[best_run[0]]) + a
     return (lo, lo + best_len)
