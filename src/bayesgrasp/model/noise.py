@@ -407,7 +407,7 @@ class NoisyTransitions:
         out = np.zeros(len(al))
         for c in self.components(kind):
             rho = c.onehot @ right  # (B,)
-            jump = np.roll(rho, -1) - rho
+            jump = np.append(rho[1:], rho[0]) - rho
             w = lv[:, None] * jump[None, :]  # (R, B)
             keep = w != 0.0
             pts = (self.stable[rows][:, None] - c.offset - c.hi[None, :])[keep]  # (T,)
@@ -421,7 +421,7 @@ class NoisyTransitions:
         pts = []
         for c in self.components(kind):
             rho = c.onehot @ right
-            jump = np.roll(rho, -1) - rho
+            jump = np.append(rho[1:], rho[0]) - rho
             keep = (left[rows][:, None] * jump[None, :]) != 0.0
             pts.append((self.stable[rows][:, None] - c.offset - c.hi[None, :])[keep])
         return np.concatenate(pts)

@@ -298,8 +298,13 @@ class _Evaluator:
         self, kinds: Sequence[str], angles: Sequence[float], prefer: int | None = None
     ) -> NoisyEvaluation:
         """Exact distribution, payoff and cost of a plan (``prefer``: see :meth:`targets`)."""
+        return self.finish(kinds, self.forward(kinds, angles)[-1], prefer)
+
+    def finish(
+        self, kinds: Sequence[str], q: FloatArray, prefer: int | None = None
+    ) -> NoisyEvaluation:
+        """The evaluation of a plan that ends in the distribution ``q``."""
         self.evaluated += 1
-        q = self.forward(kinds, angles)[-1]
         u, j = self.targets(q, prefer)
         eu = float(q @ u)
         p = float(q[u > 0].sum())
@@ -393,11 +398,16 @@ class _Planner:
         return self.ev.nt.line(kind, left, right, alphas)
 
     def _best_turn(
-        self, kind: str, period: float, left: FloatArray, right: FloatArray, current: float
+        self,
+        kind: str,
+        period: float,
+        left: FloatArray,
+        right: FloatArray,
+        current: float,
+        f0: float,
     ) -> tuple[float, float]:
-        """The turn of largest ``f`` over ``(-g/2, g/2]`` and its value."""
+        """The turn of largest ``f`` over ``(-g/2, g/2]`` and its value (``f0`` at ``current``)."""
         turn = self.turn
-        f0 = float(self._line(kind, left, right, np.array([current]))[0])
         if turn.exact:
             # Exact turns (contact noise only): f is constant between critical turns, so
             # the middles of those intervals are all there is; the widest of the best wins.
@@ -432,15 +442,13 @@ class _Planner:
             vals = self._line(kind, left, right, grid)
             i = int(np.argmax(vals))
             best, fb = float(grid[i]), float(vals[i])
-            # Two finer grids around the best point (resolution h / 256).
+            # A finer grid around the best point (resolution h / 32).
             width = h
-            for _ in range(2):
-                fine = best + width * np.linspace(-1.0, 1.0, 33)
-                fv = self._line(kind, left, right, fine)
-                j = int(np.argmax(fv))
-                if fv[j] > fb:
-                    best, fb = float(fine[j]), float(fv[j])
-                width /= 16.0
+            fine = best + width * np.linspace(-1.0, 1.0, 65)
+            fv = self._line(kind, left, right, fine)
+            j = int(np.argmax(fv))
+            if fv[j] > fb:
+                best, fb = float(fine[j]), float(fv[j])
         if fb > f0 + _GAIN_TOL:
             return wrap_period(best, period), fb
         return current, f0
@@ -464,7 +472,8 @@ class _Planner:
                     continue
                 stale.discard(m)
                 right = self._right(kinds, angles, m, u)
-                new, _ = self._best_turn(kinds[m], periods[m], qs[m - 1], right, angles[m])
+                f0 = float(qs[m] @ right)
+                new, _ = self._best_turn(kinds[m], periods[m], qs[m - 1], right, angles[m], f0)
                 if new != angles[m]:
                     angles[m] = new
                     for j in range(m, len(kinds)):
@@ -472,7 +481,7 @@ class _Planner:
                     stale |= set(range(1, len(kinds))) - {m}
                     moved = True
             # The target is chosen again: the payoff can only rise.
-            ev = self.ev.evaluate(kinds, angles, cand.prefer)
+            ev = self.ev.finish(kinds, qs[-1], cand.prefer)
             if not np.array_equal(ev.target, u):
                 stale = set(range(1, len(kinds)))
             if not stale:

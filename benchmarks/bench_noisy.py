@@ -1,0 +1,152 @@
+"""Noise-aware Bayes plans: speed, and the comparison on the same noise (issue 14).
+
+Targets: a noise-aware Bayes plan for a Table-1 part in < 1 s; the 2000 study polygons under
+turn noise SIGMA = 2 deg in < 60 s. Prints wall and CPU times (the machine may be shared:
+best of ``--repeat`` for the parts, one pass for the study).
+
+``--compare``: for the catalogue and a sample of study polygons, the noise-free Bayes plan,
+the ``--accuracy`` plan (accuracy 2 SIGMA for the normal error, A for the uniform) and the
+noise-aware plan, each evaluated exactly under the noise and by the kinematic Monte Carlo
+with that noise drawn (observed cost = attempt cost / observed success), as a Markdown table.
+
+Run: ``.venv/bin/python benchmarks/bench_noisy.py [--polygons 2000] [--repeat 3]
+[--compare] [--sample 10] [--trials 100000]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from bayesgrasp import shapes
+from bayesgrasp.model.noise import NoiseModel, TurnNoise
+from bayesgrasp.model.problem import Problem
+from bayesgrasp.paper.study import random_polygon
+from bayesgrasp.planning import plan_exact
+from bayesgrasp.planning.noisy import evaluate_plan, plan_noisy
+from bayesgrasp.planning.result import PlanStep
+from bayesgrasp.sim.noisy import simulate_noise
+
+DEG = math.pi / 180
+
+
+def timed(fn: Callable[[], Any], repeat: int = 1) -> tuple[float, float, Any]:
+    """Best wall time and best CPU time over ``repeat`` calls, and the last result."""
+    best_wall = best_cpu = math.inf
+    out = None
+    for _ in range(repeat):
+        w, c = time.perf_counter(), time.process_time()
+        out = fn()
+        best_wall = min(best_wall, time.perf_counter() - w)
+        best_cpu = min(best_cpu, time.process_time() - c)
+    return best_wall, best_cpu, out
+
+
+def parts_speed(repeat: int) -> None:
+    noises = [
+        NoiseModel(TurnNoise("normal", 2 * DEG)),
+        NoiseModel(TurnNoise("uniform", 2 * DEG)),
+        NoiseModel(TurnNoise("normal", 2 * DEG), 0.1),
+    ]
+    print("Table-1 parts, noise-aware Bayes plan (Problem.build + plan_noisy), best of", repeat)
+    print(f"{'part':<13}" + "".join(f"{n.describe():>40}" for n in noises))
+    worst = 0.0
+    for name in shapes.names():
+        part = shapes.load(name)
+        cells = []
+        for noise in noises:
+            w, c, _ = timed(lambda: plan_noisy(Problem.build(part), noise), repeat)  # noqa: B023
+            worst = max(worst, w)
+            cells.append(f"wall {w * 1000:7.1f} ms, cpu {c * 1000:7.1f} ms")
+        print(f"{name:<13}" + "".join(f"{x:>40}" for x in cells))
+    print(f"slowest: {worst:.3f} s (target < 1 s)")
+
+
+def study_speed(n: int, seed: int) -> None:
+    noise = NoiseModel(TurnNoise("normal", 2 * DEG))
+    rng = np.random.default_rng(seed)
+    parts = [random_polygon(rng) for _ in range(n)]
+
+    def run() -> list[Any]:
+        return [plan_noisy(Problem.build(p), noise) for p in parts]
+
+    w, c, res = timed(run)
+    gain = []
+    for p, r in zip(parts, res, strict=True):
+        pb = r.problem
+        fragile = evaluate_plan(pb, noise, plan_exact(pb).bayes_plan.steps).expected_cost
+        gain.append(fragile / r.bayes_plan.evaluation.expected_cost)
+    g = np.array(gain)
+    print(
+        f"study, {n} polygons (seed {seed}), turn noise normal:2: wall {w:.2f} s, cpu {c:.2f} s "
+        f"(target < 60 s); {w / n * 1000:.1f} ms a polygon"
+    )
+    print(
+        f"  noise-free Bayes plan's cost under the noise / noise-aware plan's: mean {g.mean():.4f}, "
+        f"max {g.max():.4f}, >1.01 for {int(np.sum(g > 1.01))} of {n}"
+    )
+
+
+def _observed(
+    pb: Problem, noise: NoiseModel, steps: tuple[PlanStep, ...], target: Any, trials: int, seed: int
+) -> float:
+    counts = simulate_noise(pb, noise, steps, trials, rng=seed)
+    p = counts[target > 0].sum() / trials
+    return pb.cost.expected_cost(tuple(s.kind for s in steps), float(p))
+
+
+def compare(sample: int, trials: int, seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    study = [dataclasses.replace(random_polygon(rng), name=f"study #{i}") for i in range(sample)]
+    settings = [
+        (NoiseModel(TurnNoise("normal", 2 * DEG)), 4 * DEG),
+        (NoiseModel(TurnNoise("uniform", 2 * DEG)), 2 * DEG),
+        (NoiseModel(TurnNoise("normal", 2 * DEG), 0.1), 4 * DEG),
+    ]
+    for noise, acc in settings:
+        print(f"\n{noise.describe()}; accuracy plan: --accuracy {acc / DEG:g}\n")
+        print(
+            "| part | noise-free Bayes plan | `--accuracy` plan | noise-aware plan |\n"
+            "|---|---|---|---|"
+        )
+        sums = np.zeros((3, 2))
+        for j, part in enumerate([shapes.load(n) for n in shapes.names()] + study):
+            pb = Problem.build(part)
+            free = plan_exact(pb).bayes_plan.steps
+            robust = plan_exact(dataclasses.replace(pb, accuracy=acc, _cache={})).bayes_plan.steps
+            aware = plan_noisy(pb, noise).bayes_plan
+            cells = []
+            for i, steps in enumerate([free, robust, aware.option.steps]):
+                ev = evaluate_plan(pb, noise, steps)
+                obs = _observed(pb, noise, steps, ev.target, trials, 1000 * j + i)
+                sums[i] += (ev.expected_cost, obs)
+                cells.append(f"{ev.expected_cost:.3f} / {obs:.3f} ({len(steps)})")
+            print(f"| {part.name} | " + " | ".join(cells) + " |")
+        m = sums / (len(shapes.names()) + sample)
+        print("| mean | " + " | ".join(f"{a:.3f} / {b:.3f}" for a, b in m) + " |")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--polygons", type=int, default=2000)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--compare", action="store_true")
+    ap.add_argument("--sample", type=int, default=10)
+    ap.add_argument("--trials", type=int, default=100_000)
+    args = ap.parse_args()
+    if args.compare:
+        compare(args.sample, args.trials, args.seed)
+        return
+    parts_speed(args.repeat)
+    study_speed(args.polygons, args.seed)
+
+
+if __name__ == "__main__":
+    main()
