@@ -96,7 +96,8 @@ def noisy_text(res: NoisyPlanResult) -> str:
         f"noise: {res.noise.describe()}; P(success) and E[cost] are exact under it"
         + ("" if res.payoff is None else "; E[cost] is per unit payoff")
     )
-    lines.append(f"{'k':>3} {'E[payoff]':>10} {'P no noise':>10}  source")
+    lines.append("no noise: the same steps' E[payoff] with exact actions")
+    lines.append(f"{'k':>3} {'E[payoff]':>10} {'no noise':>10}  source")
     for o in res.options:
         lines.append(
             f"{o.option.n_actions:>3} {o.expected_payoff:10.4f} "
