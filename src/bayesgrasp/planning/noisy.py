@@ -18,7 +18,8 @@ goal). The plan's cost is ``E[cycle cost] / E[payoff]``
 How the plan is found, for each length ``k``:
 
 1. *Seeds*: the noise-free exact planner's plans (:func:`~.exact.plan_exact`), and those it
-   gives with a gripper accuracy of 1, 2 and 3 times the error's scale (robust plans).
+   gives with a gripper accuracy of :data:`ACCURACY_SEEDS` times the error's scale (robust
+   plans).
 2. *Hyperstate search* (the seed's breadth-first search, section 5, generalised to
    stochastic transfers): a hyperstate is the distribution ``q`` after some actions; its
    children are ``q M_t(alpha)`` for every action kind ``t`` and the middle ``alpha`` of
@@ -30,11 +31,15 @@ How the plan is found, for each length ``k``:
    is maximised over the turn's whole range ``(-g/2, g/2]``. Uniform error: ``f`` is
    piecewise linear with kinks at ``S_i - B - o +- A`` (state ``S_i``, basin boundary ``B``,
    contact offset ``o``), so its maximum over the kinks is exact (the middle of a flat top
-   is kept). Normal error: ``f`` on a grid of step ``h = sigma / 6`` then a golden-section
-   search around the best grid point; since ``|f''| <= 2 phi(1) / sigma^2``
+   is kept). Exact turns (contact noise alone): ``f`` is constant between the critical
+   turns ``S_i - B - o``, whose interval middles are tried (exact). Normal error: ``f`` on a
+   grid of step ``h = sigma / 6`` within ``8 sigma`` of the critical turns (farther, ``f`` is
+   flat to 1e-15: one point a gap) then a grid of step ``h / 32`` around the best point;
+   since ``|f''| <= 2 phi(1) / sigma^2``
    (:attr:`~bayesgrasp.model.noise.TurnNoise.curvature_bound`) the grid's best is within
-   ``eps = |f''|max h^2 / 8 = 1.7e-3`` of the turn's global maximum. Sweeps repeat until
-   no turn gains more than the probability tolerance.
+   ``eps = |f''|max h^2 / 8 = 1.7e-3`` of the turn's global maximum. A turn is optimised
+   again only after another turn or the target changed, for at most :data:`MAX_SWEEPS`
+   sweeps.
 4. *Exact evaluation*: every candidate's distribution, payoff and cost are matrix products
    (:func:`evaluate_plan`), nothing is sampled.
 
