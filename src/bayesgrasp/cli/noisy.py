@@ -1,13 +1,14 @@
 """``plan --turn-noise / --contact-noise / --payoff``: the Bayes plan under noise (and a payoff).
 
-The options are declared here and added to ``plan`` (and ``--turn-noise`` to ``simulate``);
-this module parses them, calls :func:`~bayesgrasp.planning.noisy.plan_noisy` and prints.
+The options are declared in :mod:`.options` (``plan`` and ``simulate`` load this module only
+when they are given); this module parses them, calls
+:func:`~bayesgrasp.planning.noisy.plan_noisy` and prints.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -18,36 +19,6 @@ if TYPE_CHECKING:
     from ..model.noise import NoiseModel, TurnNoise
     from ..planning.noisy import NoisyPlanResult
     from .specs import ProblemSpec
-
-TurnNoiseOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--turn-noise",
-        metavar="normal:SIGMA_DEG|uniform:A_DEG",
-        help="Plan for gripper turns executed as alpha + e, e ~ Normal(0, SIGMA^2) or uniform "
-        "on [-A, A] degrees (exact transition matrices; the noise-aware Bayes plan).",
-    ),
-]
-ContactNoiseOpt = Annotated[
-    float | None,
-    typer.Option(
-        "--contact-noise",
-        metavar="Q",
-        min=0.0,
-        max=1.0,
-        help="Plan for jaws that touch one after the other with probability Q (either side "
-        "first): such a squeeze acts as a push-grasp from that side.",
-    ),
-]
-PayoffOpt = Annotated[
-    Path | None,
-    typer.Option(
-        "--payoff",
-        metavar="FILE",
-        help="Payoff in [0, 1] of final stable orientations (.json or .csv, orientation_deg,"
-        "value): minimise the expected cost per unit payoff.",
-    ),
-]
 
 
 def asked(turn: str | None, contact: float | None, payoff: Path | None) -> bool:

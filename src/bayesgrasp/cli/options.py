@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import inspect
 from collections.abc import Callable
+from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
 import typer
@@ -56,6 +57,37 @@ ACCURACY_HELP = (
     "Gripper accuracy: each turn between actions may err by up to DEG degrees; only plans "
     "whose tolerance is at least DEG are returned (exact planner)."
 )
+
+# The noise and payoff options of plan (and --turn-noise of simulate), see cli/noisy.py.
+TurnNoiseOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--turn-noise",
+        metavar="normal:SIGMA_DEG|uniform:A_DEG",
+        help="Gripper turns executed as alpha + e, e ~ Normal(0, SIGMA^2) or uniform on "
+        "[-A, A] degrees: plan gives the noise-aware Bayes plan, simulate draws e.",
+    ),
+]
+ContactNoiseOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--contact-noise",
+        metavar="Q",
+        min=0.0,
+        max=1.0,
+        help="Plan for jaws that touch one after the other with probability Q (either side "
+        "first): such a squeeze acts as a push-grasp from that side.",
+    ),
+]
+PayoffOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--payoff",
+        metavar="FILE",
+        help="Payoff in [0, 1] of final stable orientations (.json or .csv, orientation_deg,"
+        "value): minimise the expected cost per unit payoff.",
+    ),
+]
 
 
 def command_app() -> typer.Typer:

@@ -8,8 +8,15 @@ from typing import Annotated
 import typer
 
 from .common import check_figure_path, emit_json, guaranteed_plan, save_figure
-from .noisy import ContactNoiseOpt, PayoffOpt, TurnNoiseOpt
-from .options import JsonOpt, command_app, part_options, problem_options
+from .options import (
+    ContactNoiseOpt,
+    JsonOpt,
+    PayoffOpt,
+    TurnNoiseOpt,
+    command_app,
+    part_options,
+    problem_options,
+)
 from .specs import PartSpec, ProblemSpec
 
 app = command_app()

@@ -9,8 +9,14 @@ from typing import Annotated, Any
 import typer
 
 from .common import chosen_plan, emit_json, with_progress
-from .noisy import TurnNoiseOpt
-from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .options import (
+    JsonOpt,
+    PlanChoiceOpt,
+    TurnNoiseOpt,
+    command_app,
+    part_options,
+    problem_options,
+)
 from .specs import Engine, PartSpec, ProblemSpec
 
 app = command_app()
