@@ -156,6 +156,19 @@ def test_claims_agree_with_the_kinematic_simulation(name: str, kind: str) -> Non
         assert lo <= o.option.expected_cost <= hi, (cost_obs, o.option.expected_cost)
 
 
+def test_a_peaked_prior_agrees_with_the_kinematic_simulation() -> None:
+    # The simulation errs the first angle too: the prior convolved with the error.
+    from bayesgrasp.model.prior import von_mises
+
+    pb = Problem.build(shapes.load("key"), prior=von_mises(0.7, 4.0))
+    noise = NoiseModel(TurnNoise("normal", 6 * DEG))
+    res = plan_noisy(pb, noise, max_actions=2, all_lengths=True)
+    n = 100_000
+    for i, o in enumerate(res.options):
+        sim = simulate_kinematic(pb, o.option, n, GripperNoise("normal", 6 * DEG), rng=20 + i)
+        _binomial_ok(sim.observed, o.evaluation.distribution, n)
+
+
 @pytest.mark.parametrize("name", ["key", "house"])
 def test_contact_noise_agrees_with_its_simulation(name: str) -> None:
     pb = Problem.build(shapes.load(name))

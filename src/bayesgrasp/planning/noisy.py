@@ -47,12 +47,12 @@ The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
 
 - every reported probability, payoff and cost is exact for the noise model (to rounding;
   under a non-uniform prior the first action's average over its own error is a
-  512-node Gauss-Legendre rule);
+  composite 512-node Gauss-Legendre rule);
 - the plan of each length is the best of its candidate set, and each refined plan is
   coordinate-wise optimal: changing any one turn ``alpha_2..alpha_k`` gains at most ``eps``
   in ``E[payoff]`` (0 for the uniform error, whose one-turn maxima are exact). The first
-  angle is not refined under a non-uniform prior beyond a local grid (it places the arc on
-  the prior; the exact planner's placements are seeds);
+  angle is not refined: under a non-uniform prior it is one of the exact planner's
+  placements of the arc on the prior (with the error, those are seeds, not optima);
 - the lengths searched are enough: the search stops at the first length ``k`` where the
   cheapest attempt of ``k + 1`` actions, at the highest attainable payoff (the largest entry
   of ``u``; for today's goal without contact noise, the noise-free bound: averaging over
