@@ -1,14 +1,18 @@
-"""What the commands share besides options: printing, progress, figure files, plans.
+"""What the commands share besides options: printing, progress, output files, plans.
 
 :func:`chosen_plan` is the one way to get the plan a command acts on, by name (bayes,
-most-certain, guaranteed) or from a plan file.
+most-certain, guaranteed) or from a plan file. :func:`check_outputs` is the one way a
+command decides that it may write a file: never over one of its inputs (the part file, a
+prior file, a plan file; also through a symlink, a hard link or another letter case), and
+over any other existing file only with ``--force``.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
@@ -57,6 +61,71 @@ def no_plan(reason: str) -> NoReturn:
     """No plan reached the requested goal: say why on stderr, exit code 1."""
     typer.echo(f"bayesgrasp: no plan: {reason}", err=True)
     raise typer.Exit(1)
+
+
+def input_files(part: str | None, prior: str | None = None, *more: str | Path | None) -> list[Path]:
+    """The files a command reads: the part file, the prior's file, plan files and the like.
+
+    ``part`` is PART as given (a catalogue name or ``-`` is no file); ``prior`` the
+    ``--prior`` text (``histogram:FILE`` and ``sample:FILE`` name a file).
+    """
+    names: list[str | Path] = [m for m in more if m is not None]
+    if part is not None:
+        names.append(part)
+    if prior is not None:
+        kind, _, arg = prior.partition(":")
+        if kind.strip().lower() in ("histogram", "sample") and arg:
+            names.append(arg)
+    return [Path(n) for n in names if str(n) != "-" and Path(n).exists()]
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether writing ``a`` would write ``b``.
+
+    One path after symlinks, the same inode (a hard link), or the same path but for letter
+    case (one file on a case-insensitive file system; refused on every system, so that a
+    command line means the same everywhere).
+    """
+    ra, rb = a.resolve(), b.resolve()
+    if ra == rb or str(ra).casefold() == str(rb).casefold():
+        return True
+    try:
+        return os.path.samefile(ra, rb)
+    except OSError:  # one of them does not exist
+        return False
+
+
+def check_outputs(
+    outputs: Sequence[Path], inputs: Iterable[Path], force: bool = False, hint: str = "--out"
+) -> None:
+    """Refuse, before any work, to write over an input or (without ``--force``) any file.
+
+    An output that is an input (:func:`_same_file`) is refused even with ``--force``: the
+    user's part or prior would be lost. An existing output is refused unless ``force``; a
+    folder where a file would go is always refused.
+
+    Raises
+    ------
+    typer.BadParameter
+        Exit code 2, one line naming the file.
+    """
+    given = list(inputs)
+    for out in outputs:
+        for src in given:
+            if _same_file(out, src):
+                raise typer.BadParameter(
+                    f"{str(out)!r} is an input of this command ({str(src)!r}); "
+                    "refusing to write over it, choose another name",
+                    param_hint=hint,
+                )
+        if out.is_dir():
+            raise typer.BadParameter(f"{str(out)!r} is a folder, not a file", param_hint=hint)
+    there = [out for out in outputs if out.exists() or out.is_symlink()]
+    if there and not force:
+        more = f" (and {len(there) - 1} more the command writes)" if len(there) > 1 else ""
+        raise typer.BadParameter(
+            f"{str(there[0])!r} exists{more}; use --force to replace", param_hint=hint
+        )
 
 
 def check_figure_path(path: Path, hint: str = "--plot") -> None:

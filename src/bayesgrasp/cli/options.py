@@ -27,6 +27,12 @@ PartArg = Annotated[
     typer.Argument(help="Catalogue name or part file (.json, .csv, .wkt, .geojson, .svg, .dxf)."),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON for machines.")]
+ForceOpt = Annotated[
+    bool,
+    typer.Option(
+        "--force", help="Replace output files that exist (an input file is never replaced)."
+    ),
+]
 PlanChoiceOpt = Annotated[
     str,
     typer.Option("--plan", metavar="PLAN", help="bayes | most-certain | guaranteed | FILE.json"),

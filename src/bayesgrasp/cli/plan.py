@@ -7,8 +7,15 @@ from typing import Annotated
 
 import typer
 
-from .common import check_figure_path, emit_json, guaranteed_plan, save_figure
-from .options import JsonOpt, command_app, part_options, problem_options
+from .common import (
+    check_figure_path,
+    check_outputs,
+    emit_json,
+    guaranteed_plan,
+    input_files,
+    save_figure,
+)
+from .options import ForceOpt, JsonOpt, command_app, part_options, problem_options
 from .specs import PartSpec, ProblemSpec
 
 app = command_app()
@@ -72,6 +79,7 @@ def plan(
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
     max_actions: MaxActionsOpt = 3,
+    force: ForceOpt = False,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -88,6 +96,7 @@ def plan(
         raise typer.BadParameter("--also and --part-prior need --sense")
     if plot_file is not None:
         check_figure_path(plot_file)
+        check_outputs([plot_file], input_files(part.part, spec.prior), force, "--plot")
     pb = spec.build(part.load())
     result = spec.plan(pb)
     found = guaranteed_plan(pb) if guaranteed else None

@@ -44,7 +44,7 @@ NoiseOpt = Annotated[
     float, typer.Option(min=0, metavar="DEG", help="Gripper angle error: sigma or bound, degrees.")
 ]
 NoiseKindOpt = Annotated[NoiseKind, typer.Option(help="Gripper error distribution.")]
-SeedOpt = Annotated[int, typer.Option(help="Seed of the random generator.")]
+SeedOpt = Annotated[int, typer.Option(min=0, help="Seed of the random generator (>= 0).")]
 UnitsOpt = Annotated[
     str | None,
     typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
