@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
     from ..planning.result import PlanOption
-    from .specs import ProblemSpec
+    from .specs import PartSpec, ProblemSpec
 
 IMAGE_FORMATS = ("png", "svg", "pdf")
 PLAN_NAMES = {"bayes": "Bayes", "most-certain": "most certain", "guaranteed": "guaranteed"}
@@ -138,6 +138,19 @@ def check_figure_path(path: Path, hint: str = "--plot") -> None:
         raise typer.BadParameter(f"no folder {str(path.parent)!r} to write into", param_hint=hint)
 
 
+def check_export(path: Path, inputs: Iterable[Path], force: bool = False) -> None:
+    """Refuse a robot file name that cannot be written, before any work is done."""
+    if path.suffix.lstrip(".").lower() not in ("csv", "json"):
+        raise typer.BadParameter(
+            f"the robot file must end in .csv or .json; got {path.name!r}", param_hint="--export"
+        )
+    if not path.parent.is_dir():
+        raise typer.BadParameter(
+            f"no folder {str(path.parent)!r} to write into", param_hint="--export"
+        )
+    check_outputs([path], inputs, force, "--export")
+
+
 def save_figure(fig: Any, path: Path) -> None:
     """Write a figure; a bad file name is a usage error (exit 2), not a traceback."""
     check_figure_path(path)
@@ -156,11 +169,17 @@ def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
     return found if found.status == "ok" else str(found.reason or "no guaranteed plan")
 
 
-def chosen_plan(which: str, spec: ProblemSpec, part: Part) -> tuple[Problem, PlanOption, str]:
+def chosen_plan(
+    which: str, spec: ProblemSpec, part: Part, force: bool = False
+) -> tuple[Problem, PlanOption, str]:
     """The problem and the plan ``--plan`` names (bayes, most-certain, guaranteed, a file).
 
     Returns the problem (with the action kinds of a plan file added), the plan and its name
     for titles. No guaranteed plan: exit code 1. A bad name or file: exit code 2.
+
+    A plan file made for another part (:func:`bayesgrasp.io.plans.same_part`) is refused
+    unless ``force``; the prior and goal it was made under apply unless ``--prior`` or
+    ``--goal`` was given, so the prediction is the plan's own.
     """
     path = Path(which)
     if which not in PLAN_NAMES and path.suffix.lower() != ".json":
@@ -168,18 +187,53 @@ def chosen_plan(which: str, spec: ProblemSpec, part: Part) -> tuple[Problem, Pla
         raise typer.BadParameter(
             f"expected {names} or a .json plan file; got {which!r}", param_hint="--plan"
         )
+    if which not in PLAN_NAMES:
+        return _plan_file(path, spec, part, force)
     problem = spec.build(part)
     if which == "guaranteed":
         found = guaranteed_plan(problem)
         if isinstance(found, str):
             no_plan(found)
         return problem, found.option, PLAN_NAMES[which]
-    if which in PLAN_NAMES:
-        result = spec.plan(problem)
-        plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
-        return problem, plan, PLAN_NAMES[which]
-    from ..io.plans import read_plan_document
+    result = spec.plan(problem)
+    plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
+    return problem, plan, PLAN_NAMES[which]
 
-    plan = read_plan_document(path)
-    missing = tuple(k for k in plan.kinds if k not in problem.action_kinds)
-    return (spec.build(part, missing) if missing else problem), plan, path.name
+
+def _plan_file(
+    path: Path, spec: ProblemSpec, part: Part, force: bool
+) -> tuple[Problem, PlanOption, str]:
+    """The plan of a plan file, checked against the part, and the problem it was made for."""
+    import dataclasses
+
+    from ..io.plans import part_id, read_plan, same_part
+    from .specs import GoalKind
+
+    src = read_plan(path)
+    if same_part(src.part, part) is False and not force:
+        theirs = src.part or {}
+        raise typer.BadParameter(
+            f"plan file {path.name!r} is for part {theirs.get('name', '?')!r} "
+            f"({theirs.get('id', 'other vertices')}), not {part.name!r} ({part_id(part)}); "
+            "use --force to run it anyway",
+            param_hint="--plan",
+        )
+    if "goal" not in spec.given and src.goal in tuple(GoalKind):
+        spec = dataclasses.replace(spec, goal=GoalKind(src.goal))
+    prior = None if "prior" in spec.given else src.prior
+    plan = src.option
+    missing = tuple(k for k in plan.kinds if k not in spec.actions)
+    return spec.build(part, missing, prior), plan, path.name
+
+
+def run_inputs(part: PartSpec, spec: ProblemSpec) -> dict[str, Any]:
+    """What the command line adds to a document's provenance: the part and its file options."""
+    return {
+        "part_source": part.part,
+        "format": part.fmt.value if part.fmt else None,
+        "element": part.element,
+        "layer": part.layer,
+        "flatten_tolerance": part.flatten_tol,
+        "prior_text": spec.prior,
+        "max_actions": spec.max_actions,
+    }

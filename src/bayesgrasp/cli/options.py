@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import math
 from collections.abc import Callable
 from typing import Annotated, Any, TypeVar
 
@@ -58,6 +59,7 @@ ACTIONS_HELP = (
     "Action types a plan may use, comma-separated: {} (the pushing jaw is on the gripper's "
     "-x side)."
 )
+MAX_HELP = "Longest plan to consider, counting actions of every kind (push-grasps too)."
 ACCURACY_HELP = (
     "Gripper accuracy: each turn between actions may err by up to DEG degrees; only plans "
     "whose tolerance is at least DEG are returned (exact planner)."
@@ -86,33 +88,70 @@ def _part_params() -> list[inspect.Parameter]:
     ]
 
 
+def _cost_value(value: float | None) -> float | None:
+    """A cost option: a number, >= 0, small enough that expected costs stay finite."""
+    from ..model.cost import MAX_COST
+
+    if value is None:
+        return value
+    if math.isnan(value):
+        raise typer.BadParameter("is not a number; give a cost >= 0")
+    if value < 0:
+        raise typer.BadParameter(f"should be >= 0; got {value:g}")
+    if math.isfinite(value) and value > MAX_COST:  # infinity: the cost model says why
+        raise typer.BadParameter(
+            f"should be at most {MAX_COST:g} (larger costs overflow the expected cost); "
+            f"got {value:g}"
+        )
+    return value
+
+
+def _accuracy_value(value: float) -> float:
+    """The gripper accuracy in degrees: a number in [0, 90)."""
+    if math.isnan(value):
+        raise typer.BadParameter("is not a number; give degrees >= 0")
+    if value < 0:
+        raise typer.BadParameter(f"should be >= 0 deg; got {value:g} deg")
+    if value >= 90:
+        raise typer.BadParameter(
+            f"no plan keeps a tolerance of {value:g} deg (stable orientations repeat every "
+            "180 deg at most, so every tolerance is below 90 deg); give less than 90"
+        )
+    return value
+
+
 def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Parameter]:
+    money = {"callback": _cost_value}
     cost = [
-        _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", min=0, help=f"Cost of a {n}.")
+        _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", **money, help=f"Cost of a {n}.")
         for i, n in enumerate(names)
     ]
     first_help = "Cost of the first {} (default: as others)."
     first = [
         _opt(
-            f"first_{i}", float | None, None, f"--first-{n}-cost", min=0, help=first_help.format(n)
+            f"first_{i}",
+            float | None,
+            None,
+            f"--first-{n}-cost",
+            **money,
+            help=first_help.format(n),
         )
         for i, n in enumerate(names)
     ]
     kinds = ACTIONS_HELP.format(", ".join(names))
+    from_file = " (default: {}; with --plan FILE: the file's)"
     params = [
-        inspect.Parameter(
-            "prior", inspect.Parameter.KEYWORD_ONLY, default="uniform", annotation=PriorOpt
-        ),
+        _opt("prior", str | None, None, help=PRIOR_HELP + from_file.format("uniform")),
         cost[0],
-        _opt("verify_cost", float, 1.0, min=0, help="Cost of the verification."),
+        _opt("verify_cost", float, 1.0, **money, help="Cost of the verification."),
         *first,
-        _opt("retry_cost", float, 0.0, min=0, help="Overhead paid on each failed verification."),
+        _opt("retry_cost", float, 0.0, **money, help="Overhead paid on each failed verification."),
         *cost[1:],
-        _opt("goal", GoalKind, GoalKind.single, help=GOAL_HELP),
+        _opt("goal", GoalKind | None, None, help=GOAL_HELP + from_file.format("single")),
         _opt("actions", str, "squeeze", metavar="KINDS", help=kinds),
-        _opt("accuracy", float, 0.0, min=0, metavar="DEG", help=ACCURACY_HELP),
+        _opt("accuracy", float, 0.0, callback=_accuracy_value, metavar="DEG", help=ACCURACY_HELP),
         _opt("method", Method, Method.exact, help="exact planner or the seed's search."),
-        _opt("max_squeezes", int | None, None, min=1, help="Longest plan to consider."),
+        _opt("max_squeezes", int | None, None, min=1, help=MAX_HELP),
     ]
     if push_grasp_alias:  # the old spelling of simulate and plot, kept working
         alias = "Same as --actions squeeze,push-grasp."
@@ -127,17 +166,19 @@ def _problem_spec(names: list[str], values: dict[str, Any]) -> ProblemSpec:
     if values.get("push_grasp"):  # exactly --actions squeeze,push-grasp (order breaks ties)
         actions = [SQUEEZE.name, PUSH_GRASP.name, *actions]
     first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
+    given = frozenset(k for k in ("prior", "goal") if values[k] is not None)
     return ProblemSpec(
-        prior=values["prior"],
+        prior=values["prior"] or "uniform",
         costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
         first={n: c for n, c in first.items() if c is not None},
         verify=values["verify_cost"],
         retry=values["retry_cost"],
-        goal=values["goal"],
+        goal=values["goal"] or GoalKind.single,
         actions=tuple(dict.fromkeys(actions)),
         accuracy_deg=values["accuracy"],
         method=values["method"],
         max_actions=values["max_squeezes"],
+        given=given,
     )
 
 

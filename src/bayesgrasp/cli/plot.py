@@ -67,7 +67,7 @@ def plot(
         raise typer.BadParameter(f"{str(out)!r} is a file, not a folder", param_hint="--out")
     inputs = input_files(part.part, spec.prior, which)
     check_outputs(figure_files(out, formats, animation), inputs, force, "--out")
-    pb, option, label = chosen_plan(which, spec, part.load())
+    pb, option, label = chosen_plan(which, spec, part.load(), force)
     try:
         files = write_figures(
             pb,

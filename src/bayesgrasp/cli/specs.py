@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..model.prior import Prior
     from ..model.problem import Problem
     from ..planning.result import PlanReport
 
@@ -80,9 +81,16 @@ class ProblemSpec:
     accuracy_deg: float = 0.0
     method: Method = Method.exact
     max_actions: int | None = None
+    given: frozenset[str] = frozenset()
+    """The options of ``prior`` and ``goal`` the user gave (a plan file's own apply otherwise)."""
 
-    def build(self, part: Part, more_actions: tuple[str, ...] = ()) -> Problem:
-        """The problem for ``part`` (with ``more_actions`` added to the action kinds)."""
+    def build(
+        self, part: Part, more_actions: tuple[str, ...] = (), prior: Prior | None = None
+    ) -> Problem:
+        """The problem for ``part`` (with ``more_actions`` added to the action kinds).
+
+        ``prior`` replaces the ``--prior`` text (a plan file's prior).
+        """
         from ..model.cost import CostModel
         from ..model.goal import Goal
         from ..model.prior import parse_prior
@@ -91,7 +99,7 @@ class ProblemSpec:
         cost = CostModel(self.costs or {}, self.verify, self.first or {}, self.retry)
         return Problem.build(
             part,
-            prior=parse_prior(self.prior),
+            prior=parse_prior(self.prior) if prior is None else prior,
             cost=cost,
             goal=Goal(self.goal.value),
             actions=tuple(dict.fromkeys((*self.actions, *more_actions))),
