@@ -129,24 +129,16 @@ def test_plan_provenance_rebuilds_the_plans(
     from bayesgrasp import __version__
 
     assert prov["version"] == __version__
-    assert {
-        "prior",
-        "cost",
-        "goal",
-        "actions",
-        "accuracy_rad",
-        "method",
-        "flatten_tolerance",
-    } <= set(prov)
+    assert {"prior", "cost", "goal", "actions", "accuracy_rad", "method"} <= set(prov)
     pb = Problem.build(
-        resolve_part(prov["part_source"]),
+        resolve_part(args[0]),
         prior=prior_from_document(prov["prior"]),
         cost=CostModel(**prov["cost"]),
         goal=Goal(prov["goal"]),
         actions=tuple(prov["actions"]),
         accuracy=prov["accuracy_rad"],
     )
-    again = plan_exact(pb, max_actions=prov["max_actions"])
+    again = plan_exact(pb, max_actions=prov.get("max_actions"))
     assert len(again.options) == len(doc["options"])
     for mine, theirs in zip(again.options, doc["options"], strict=True):
         assert_allclose(mine.success_probability, theirs["success_probability"], rtol=1e-12)
@@ -182,18 +174,17 @@ def test_simulate_rerun_from_its_document(
     assert code == 0, err
     first = json.loads(out)
     prov = first["provenance"]
-    assert {k: prov[k] for k in ("engine", "seed", "noise_deg", "noise_kind", "offset_mm")} == {
+    assert {k: prov[k] for k in ("engine", "seed", "noise_deg", "noise_kind")} == {
         "engine": "kinematic",
         "seed": 11,
         "noise_deg": 1.5,
         "noise_kind": "uniform",
-        "offset_mm": 0.0,
     }
-    assert prov["prior"] == {"kind": "uniform", "name": "uniform"} and prov["trials"] == 3000
+    assert prov["prior"] == {"kind": "uniform"} and prov["trials"] == 3000
     sim = tmp_path / "sim.json"
     sim.write_text(out, encoding="utf-8")
     again = [
-        "simulate", prov["part_source"], "--plan", str(sim), "--seed", str(prov["seed"]),
+        "simulate", "example", "--plan", str(sim), "--seed", str(prov["seed"]),
         "--noise", str(prov["noise_deg"]), "--noise-kind", prov["noise_kind"],
         "--trials", str(prov["trials"]), "--json",
     ]  # fmt: skip
@@ -267,3 +258,13 @@ def test_huge_costs_stay_finite() -> None:
     assert all(math.isfinite(o.expected_cost) for o in res.options)
     unit = plan_exact(Problem.build(resolve_part("house")))
     assert res.bayes == unit.bayes
+
+
+def test_part_file_options_are_recorded(capsys: pytest.CaptureFixture[str]) -> None:
+    root = Path(__file__).resolve().parents[2]
+    code, out, err = run(
+        capsys, "plan", str(root / "examples" / "peanut.svg"), "--flatten-tol", "0.5", "--json"
+    )
+    assert code == 0, err
+    prov = json.loads(out)["provenance"]
+    assert prov["flatten_tolerance"] == 0.5 and "element" not in prov  # not given: default

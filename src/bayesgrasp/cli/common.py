@@ -226,14 +226,39 @@ def _plan_file(
     return spec.build(part, missing, prior), plan, path.name
 
 
-def run_inputs(part: PartSpec, spec: ProblemSpec) -> dict[str, Any]:
-    """What the command line adds to a document's provenance: the part and its file options."""
+def run_inputs(part: PartSpec | None, spec: ProblemSpec) -> dict[str, Any]:
+    """What a command adds to a document's provenance: the longest plan, the part-file options.
+
+    Options not given are ``None`` (left out of the document); the web service, which
+    reads no part files, gives ``part=None``.
+    """
+    out: dict[str, Any] = {"max_actions": spec.max_actions}
+    if part is not None:
+        out |= {"format": part.fmt.value if part.fmt else None, "element": part.element}
+        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol}
+    return out
+
+
+def simulate_inputs(
+    engine: str,
+    plan: str,
+    seed: int,
+    trials: int,
+    noise_deg: float,
+    noise_kind: str,
+    offset_mm: float = 0.0,
+    units: str | None = None,
+    workers: int | None = None,
+) -> dict[str, Any]:
+    """How a simulation was run, for its document's provenance (defaults left out)."""
     return {
-        "part_source": part.part,
-        "format": part.fmt.value if part.fmt else None,
-        "element": part.element,
-        "layer": part.layer,
-        "flatten_tolerance": part.flatten_tol,
-        "prior_text": spec.prior,
-        "max_actions": spec.max_actions,
+        "engine": engine,
+        "plan": plan,
+        "seed": seed,
+        "trials": trials,
+        "noise_deg": noise_deg,
+        "noise_kind": noise_kind,
+        "offset_mm": offset_mm or None,
+        "units": units,
+        "workers": workers,
     }

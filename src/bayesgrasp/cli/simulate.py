@@ -8,7 +8,7 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import chosen_plan, emit_json, run_inputs, with_progress
+from .common import chosen_plan, emit_json, run_inputs, simulate_inputs, with_progress
 from .options import ForceOpt, JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
 from .specs import Engine, PartSpec, ProblemSpec
 
@@ -143,9 +143,11 @@ def simulate(
     res = with_progress(f"{engine.value} trials", n, run)
     if as_json:
         doc = report.simulate_json(res, p)
-        how: dict[str, Any] = {"engine": engine.value, "plan": which, "seed": seed, "trials": n}
-        how |= {"noise_deg": noise, "noise_kind": noise_kind.value, "offset_mm": offset}
-        how |= {"units": units, "workers": workers if engine is Engine.mujoco else None}
+        mujoco = engine is Engine.mujoco
+        how = simulate_inputs(
+            engine.value, which, seed, n, noise, noise_kind.value, offset, units,
+            workers if mujoco else None,
+        )  # fmt: skip
         doc["provenance"] = provenance(pb, None, **how, **run_inputs(part, spec))
         emit_json(doc)
     else:

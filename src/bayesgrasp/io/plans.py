@@ -183,7 +183,8 @@ def prior_document(prior: Prior) -> dict[str, Any]:
 
     ``{"kind": "uniform"}``; a von Mises prior by its parameters (``mean_rad``, ``kappa``,
     ``bins``); any other histogram by its normalised ``weights``; a sample by its
-    ``angles_rad``. Every form has the prior's ``name``.
+    ``angles_rad``. (Not its display name, which names the file a prior was read from: the
+    same prior given inline or from a file is the same document.)
 
     Examples
     --------
@@ -195,13 +196,13 @@ def prior_document(prior: Prior) -> dict[str, Any]:
     0.6...
     """
     if isinstance(prior, UniformPrior):
-        return {"kind": "uniform", "name": prior.name}
+        return {"kind": "uniform"}
     if isinstance(prior, HistogramPrior):
         if prior.recipe:
-            return {**dict(prior.recipe), "name": prior.name}
-        return {"kind": "histogram", "name": prior.name, "weights": prior.weights.tolist()}
+            return dict(prior.recipe)
+        return {"kind": "histogram", "weights": prior.weights.tolist()}
     if isinstance(prior, SamplePrior):
-        return {"kind": "sample", "name": prior.name, "angles_rad": prior.angles.tolist()}
+        return {"kind": "sample", "angles_rad": prior.angles.tolist()}
     return {"kind": type(prior).__name__, "name": prior.name}  # recorded, not rebuilt
 
 
@@ -211,7 +212,7 @@ def prior_from_document(doc: Any) -> Prior:
 
     if not isinstance(doc, Mapping):
         raise SimulationError(f"a prior must be a JSON object; got {type(doc).__name__}")
-    kind, name = doc.get("kind"), doc.get("name")
+    kind, name = doc.get("kind"), doc.get("name", doc.get("kind"))
     try:
         if kind == "uniform":
             return UniformPrior()
@@ -229,8 +230,9 @@ def prior_from_document(doc: Any) -> Prior:
 def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict[str, Any]:
     """How a result was made: version, prior, cost model, goal, actions, accuracy, planner.
 
-    ``more`` (the command line's part-file options, the longest plan asked for...) is added
-    as given (``None``: the option was not given, its default applied).
+    ``more`` (the command line's part-file options, the longest plan asked for...) is added;
+    ``None`` values (an option not given, its default applied) are left out, so the command
+    line and the web service, which share no part-file options, write the same document.
     """
     from .. import __version__
 
@@ -244,7 +246,7 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
     }
     if method is not None:
         out["method"] = method
-    out.update(more)
+    out.update({k: v for k, v in more.items() if v is not None})
     return out
 
 
