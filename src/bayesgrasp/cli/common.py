@@ -235,7 +235,7 @@ def run_inputs(part: PartSpec | None, spec: ProblemSpec) -> dict[str, Any]:
     out: dict[str, Any] = {"max_actions": spec.max_actions}
     if part is not None:
         out |= {"format": part.fmt.value if part.fmt else None, "element": part.element}
-        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol}
+        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol, "com": part.com}
     return out
 
 

@@ -49,6 +49,11 @@ FLATTEN_HELP = (
     "Chordal tolerance for flattening curves, in the file's units "
     "(default: 0.1% of the drawing's diagonal)."
 )
+COM_HELP = (
+    "The part's centre of mass, in the file's coordinates (default: the area centroid of "
+    "the outline; a CSV or JSON point list that crosses itself is a point cloud, whose part "
+    "is its convex hull, so its default is the hull's centroid)."
+)
 PRIOR_HELP = (
     "Prior on the initial orientation: uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE "
     "(bin weights over [0, 360) deg) | sample:FILE (observed angles, deg)."
@@ -85,6 +90,7 @@ def _part_params() -> list[inspect.Parameter]:
         _opt("element", str | None, None, metavar="ID", help=ELEMENT_HELP),
         _opt("layer", str | None, None, help="DXF: read only this layer."),
         _opt("flatten_tol", float | None, None, help=FLATTEN_HELP),
+        _opt("com", str | None, None, "--com", metavar="X,Y", help=COM_HELP),
     ]
 
 

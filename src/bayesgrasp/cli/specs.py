@@ -56,15 +56,33 @@ class PartSpec:
     element: str | None = None
     layer: str | None = None
     flatten_tol: float | None = None
+    com: str | None = None
 
     def load(self) -> Part:
-        """Read the part."""
+        """Read the part (with the centre of mass ``--com X,Y``, when given)."""
+        import dataclasses
+
+        from ..errors import PartError
+        from ..geometry.polygon import Part
         from ..io import resolve_part
 
         fmt = self.fmt.value if self.fmt else None
-        return resolve_part(
+        part = resolve_part(
             self.part, fmt, element=self.element, layer=self.layer, tolerance=self.flatten_tol
         )
+        if self.com is None:
+            return part
+        try:
+            xy = [float(v) for v in self.com.split(",")]
+        except ValueError:
+            xy = []
+        if len(xy) != 2 or not all(math.isfinite(v) for v in xy):
+            raise PartError(f"`--com` must be X,Y (two finite numbers); got {self.com!r}")
+        try:  # validated as Part.from_points does: strictly inside the hull
+            com = Part.from_points(part.hull.vertices, center_of_mass=xy).center_of_mass
+        except PartError as exc:
+            raise PartError(f"`--com` {self.com}: {exc}") from None
+        return dataclasses.replace(part, center_of_mass=com)
 
 
 @dataclass(frozen=True, slots=True)
