@@ -157,3 +157,25 @@ def test_input_files(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     assert sorted(p.name for p in got) == ["p.json", "w.txt"]
     assert input_files("-", "uniform") == []
     assert input_files(str(HOUSE), "vonmises:0,1") == [HOUSE]
+
+
+def test_sweep_never_writes_over_its_inputs(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    part = tmp_path / "a.csv"
+    part.write_text("0,0\n3,0\n0,2\n", encoding="utf-8")
+    before = digest(part)
+    argv = ["sweep", str(part), "--out", str(part), "--format", "csv", "--force"]
+    code, _, err = run(capsys, *argv)
+    assert code == 2
+    one_error(err, "input")
+    report = tmp_path / "r.html"
+    report.write_text("mine", encoding="utf-8")
+    argv = ["sweep", str(part), "--out", str(tmp_path / "rows.csv"), "--format", "csv"]
+    code, _, err = run(capsys, *argv, "--report", str(report))
+    assert code == 2
+    one_error(err, "r.html", "exists")
+    code, _, err = run(capsys, *argv, "--report", str(part), "--force")
+    assert code == 2
+    one_error(err, "input")
+    assert digest(part) == before and report.read_text(encoding="utf-8") == "mine"

@@ -96,13 +96,17 @@ def _same_file(a: Path, b: Path) -> bool:
 
 
 def check_outputs(
-    outputs: Sequence[Path], inputs: Iterable[Path], force: bool = False, hint: str = "--out"
+    outputs: Sequence[Path],
+    inputs: Iterable[Path],
+    force: bool = False,
+    hint: str = "--out",
+    folders: bool = False,
 ) -> None:
     """Refuse, before any work, to write over an input or (without ``--force``) any file.
 
     An output that is an input (:func:`_same_file`) is refused even with ``--force``: the
     user's part or prior would be lost. An existing output is refused unless ``force``; a
-    folder where a file would go is always refused.
+    folder where a file would go is refused unless ``folders`` (an output that is a folder).
 
     Raises
     ------
@@ -118,7 +122,7 @@ def check_outputs(
                     "refusing to write over it, choose another name",
                     param_hint=hint,
                 )
-        if out.is_dir():
+        if out.is_dir() and not folders:
             raise typer.BadParameter(f"{str(out)!r} is a folder, not a file", param_hint=hint)
     there = [out for out in outputs if out.exists() or out.is_symlink()]
     if there and not force:
