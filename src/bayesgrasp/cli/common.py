@@ -10,6 +10,7 @@ over any other existing file only with ``--force``.
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 from collections.abc import Callable, Iterable, Sequence
@@ -61,6 +62,38 @@ def no_plan(reason: str) -> NoReturn:
     """No plan reached the requested goal: say why on stderr, exit code 1."""
     typer.echo(f"bayesgrasp: no plan: {reason}", err=True)
     raise typer.Exit(1)
+
+
+def cost_value(value: float | None) -> float | None:
+    """A cost option: a number, >= 0, small enough that expected costs stay finite."""
+    from ..model.cost import MAX_COST
+
+    if value is None:
+        return value
+    if math.isnan(value):
+        raise typer.BadParameter("is not a number; give a cost >= 0")
+    if value < 0:
+        raise typer.BadParameter(f"should be >= 0; got {value:g}")
+    if math.isfinite(value) and value > MAX_COST:  # infinity: the cost model says why
+        raise typer.BadParameter(
+            f"should be at most {MAX_COST:g} (larger costs overflow the expected cost); "
+            f"got {value:g}"
+        )
+    return value
+
+
+def accuracy_value(value: float) -> float:
+    """The gripper accuracy in degrees: a number in [0, 90)."""
+    if math.isnan(value):
+        raise typer.BadParameter("is not a number; give degrees >= 0")
+    if value < 0:
+        raise typer.BadParameter(f"should be >= 0 deg; got {value:g} deg")
+    if value >= 90:
+        raise typer.BadParameter(
+            f"no plan keeps a tolerance of {value:g} deg (stable orientations repeat every "
+            "180 deg at most, so every tolerance is below 90 deg); give less than 90"
+        )
+    return value
 
 
 def input_files(part: str | None, prior: str | None = None, *more: str | Path | None) -> list[Path]:

@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import functools
 import inspect
-import math
 from collections.abc import Callable
 from typing import Annotated, Any, TypeVar
 
 import typer
 
+from .common import accuracy_value, cost_value
 from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -94,40 +94,8 @@ def _part_params() -> list[inspect.Parameter]:
     ]
 
 
-def _cost_value(value: float | None) -> float | None:
-    """A cost option: a number, >= 0, small enough that expected costs stay finite."""
-    from ..model.cost import MAX_COST
-
-    if value is None:
-        return value
-    if math.isnan(value):
-        raise typer.BadParameter("is not a number; give a cost >= 0")
-    if value < 0:
-        raise typer.BadParameter(f"should be >= 0; got {value:g}")
-    if math.isfinite(value) and value > MAX_COST:  # infinity: the cost model says why
-        raise typer.BadParameter(
-            f"should be at most {MAX_COST:g} (larger costs overflow the expected cost); "
-            f"got {value:g}"
-        )
-    return value
-
-
-def _accuracy_value(value: float) -> float:
-    """The gripper accuracy in degrees: a number in [0, 90)."""
-    if math.isnan(value):
-        raise typer.BadParameter("is not a number; give degrees >= 0")
-    if value < 0:
-        raise typer.BadParameter(f"should be >= 0 deg; got {value:g} deg")
-    if value >= 90:
-        raise typer.BadParameter(
-            f"no plan keeps a tolerance of {value:g} deg (stable orientations repeat every "
-            "180 deg at most, so every tolerance is below 90 deg); give less than 90"
-        )
-    return value
-
-
 def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Parameter]:
-    money = {"callback": _cost_value}
+    money = {"callback": cost_value}
     cost = [
         _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", **money, help=f"Cost of a {n}.")
         for i, n in enumerate(names)
@@ -155,7 +123,7 @@ def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Pa
         *cost[1:],
         _opt("goal", GoalKind | None, None, help=GOAL_HELP + from_file.format("single")),
         _opt("actions", str, "squeeze", metavar="KINDS", help=kinds),
-        _opt("accuracy", float, 0.0, callback=_accuracy_value, metavar="DEG", help=ACCURACY_HELP),
+        _opt("accuracy", float, 0.0, callback=accuracy_value, metavar="DEG", help=ACCURACY_HELP),
         _opt("method", Method, Method.exact, help="exact planner or the seed's search."),
         _opt("max_squeezes", int | None, None, min=1, help=MAX_HELP),
     ]
