@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .common import IMAGE_FORMATS, check_outputs, chosen_plan, emit_json, input_files
-from .options import ForceOpt, JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
 from .specs import PartSpec, ProblemSpec
 
 app = command_app()
@@ -20,6 +20,14 @@ FormatsOpt = Annotated[str, typer.Option("--image-formats", help="Comma-separate
 AnimationOpt = Annotated[
     bool,
     typer.Option("--animation/--no-animation", help="Also write the plan's animation (plan.gif)."),
+]
+ForceOpt = Annotated[
+    bool,
+    typer.Option(
+        "--force",
+        help="Replace figures that exist in DIR (an input file never), and draw a --plan FILE "
+        "made for another part.",
+    ),
 ]
 FramesOpt = Annotated[int, typer.Option(min=4, max=240, help="Animation frames per plan step.")]
 

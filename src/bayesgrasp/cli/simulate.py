@@ -9,7 +9,7 @@ from typing import Annotated, Any
 import typer
 
 from .common import chosen_plan, emit_json, run_inputs, simulate_inputs, with_progress
-from .options import ForceOpt, JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
 from .specs import Engine, PartSpec, ProblemSpec
 
 app = command_app()
@@ -58,6 +58,7 @@ NoiseOpt = Annotated[
 ]
 NoiseKindOpt = Annotated[NoiseKind, typer.Option(help="Gripper error distribution.")]
 SeedOpt = Annotated[int, typer.Option(min=0, help="Seed of the random generator (>= 0).")]
+ForceOpt = Annotated[bool, typer.Option("--force", help="Run a --plan FILE made for another part.")]
 UnitsOpt = Annotated[
     str | None,
     typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
