@@ -68,3 +68,15 @@ def test_bad_com(capsys: pytest.CaptureFixture[str], com: str, words: str) -> No
     out, err = capsys.readouterr()
     assert (code, out) == (2, "")
     assert len(err.strip().splitlines()) == 1 and words in err
+
+
+def test_a_point_cloud_is_announced(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    cloud = tmp_path / "cloud.csv"
+    cloud.write_text("".join(f"{x},{y}\n" for x, y in [L[i] for i in (0, 3, 1, 5, 2, 4)]))
+    ordered = tmp_path / "L.csv"
+    ordered.write_text("".join(f"{x},{y}\n" for x, y in L))
+    assert main(["squeeze", str(cloud)]) == 0
+    err = capsys.readouterr().err
+    assert "point cloud: the part is their convex hull" in err and "--com X,Y" in err
+    assert main(["squeeze", str(ordered)]) == 0
+    assert capsys.readouterr().err == ""

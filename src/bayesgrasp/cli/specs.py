@@ -70,6 +70,16 @@ class PartSpec:
         part = resolve_part(
             self.part, fmt, element=self.element, layer=self.layer, tolerance=self.flatten_tol
         )
+        kind = fmt or self.part.rpartition(".")[2].lower()
+        if kind in ("csv", "json") and part.outline is part.hull.vertices:  # a point cloud
+            import typer
+
+            typer.echo(
+                f"bayesgrasp: note: the points of {self.part} cross themselves in file order, "
+                "so they are a point cloud: the part is their convex hull"
+                + ("" if self.com else " (centre of mass its centroid; --com X,Y to set it)"),
+                err=True,
+            )
         if self.com is None:
             return part
         try:
