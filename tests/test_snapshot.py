@@ -2,9 +2,10 @@
 
 Each stored command line is run in-process with the current code from the repository root; the
 exit code must be the same and the document equal to the stored one: floats to a relative or
-absolute 1e-9, everything else (ints, strings, bools, null, list lengths, object keys)
-exactly. Wall times (``VOLATILE_KEYS``) are not compared. To change the snapshot on purpose,
-run ``python tests/snapshots/generate.py`` and review the diff of ``cli.json``.
+absolute 1e-9, everything else (ints, strings, bools, null, list lengths, the stored object
+keys) exactly; keys a document gained since the snapshot are allowed (new fields are fine,
+changed values are not). Wall times (``VOLATILE_KEYS``) are not compared. To change the
+snapshot on purpose, run ``python tests/snapshots/generate.py`` and review the diff of ``cli.json``.
 """
 
 from __future__ import annotations
@@ -35,8 +36,8 @@ def _kind(x: Any) -> str:
 def first_difference(expected: Any, actual: Any, path: str = "$") -> str | None:
     """Where ``actual`` first differs from ``expected`` and how, or ``None`` if they agree.
 
-    Floats agree to a relative or absolute ``1e-9``; ints, strings, bools, null, list lengths
-    and object keys must be equal.
+    Floats agree to a relative or absolute ``1e-9``; ints, strings, bools, null and list
+    lengths must be equal; every stored object key must be there (added keys are allowed).
     """
     ke, ka = _kind(expected), _kind(actual)
     if ke != ka:
@@ -53,11 +54,10 @@ def first_difference(expected: Any, actual: Any, path: str = "$") -> str | None:
             if diff is not None:
                 return diff
         return None
-    if ke == "object":
+    if ke == "object":  # keys added since the snapshot are fine; a key gone is not
         missing = sorted(set(expected) - set(actual))
-        extra = sorted(set(actual) - set(expected))
-        if missing or extra:
-            return f"{path}: keys missing {missing}, unexpected {extra}"
+        if missing:
+            return f"{path}: keys missing {missing}"
         for k in expected:
             diff = first_difference(expected[k], actual[k], f"{path}.{k}")
             if diff is not None:
@@ -87,6 +87,7 @@ def test_first_difference_paths() -> None:
     assert first_difference(doc, json.loads(json.dumps(doc))) is None
     assert first_difference(doc, {"a": [1, 2.0 * (1 + 1e-10), doc["a"][2]]}) is None
     assert first_difference({"x": 0.0}, {"x": 1e-10}) is None
+    assert first_difference({"x": 0.0}, {"x": 0.0, "added": 1}) is None  # new keys are fine
     cases = [
         ({"a": [1, 2.0 + 1e-6, doc["a"][2]]}, "$.a[1]: expected 2.0, got 2.000001"),
         ({"a": [2, 2.0, doc["a"][2]]}, "$.a[0]: expected 1, got 2"),
@@ -95,7 +96,7 @@ def test_first_difference_paths() -> None:
         ({"a": [1, 2.0, {"b": 0.0, "c": "x", "d": True}]}, "$.a[2].b: expected null None"),
         ({"a": [1, 2.0, {"b": None, "c": "y", "d": True}]}, "$.a[2].c: expected 'x', got 'y'"),
         ({"a": [1, 2.0, {"b": None, "c": "x", "d": 1}]}, "$.a[2].d: expected bool True"),
-        ({"a": [1, 2.0, {"b": None, "c": "x"}]}, "$.a[2]: keys missing ['d'], unexpected []"),
+        ({"a": [1, 2.0, {"b": None, "c": "x"}]}, "$.a[2]: keys missing ['d']"),
     ]
     for actual, message in cases:
         diff = first_difference(doc, actual)

@@ -29,7 +29,7 @@ from .io.plans import (
     part_document,
     plan_document,
 )
-from .model.actions import ACTIONS, Action, get_action
+from .model.actions import ACTIONS, SQUEEZE, Action, get_action
 from .model.prior import Prior, UniformPrior
 from .planning.guaranteed import GuaranteedPlan
 from .planning.result import PlanOption, PlanReport
@@ -172,11 +172,17 @@ def _plan_text(o: PlanOption, mixed: bool) -> str:
     return " ".join([first, *rest])
 
 
-def plan_table(report: PlanReport) -> str:
-    """One row per plan length: angles (degrees), success probability, expected cost."""
+def plan_table(report: PlanReport, max_actions: int | None = None) -> str:
+    """One row per plan length: angles (degrees), success probability, expected cost.
+
+    Plans of one action kind other than the squeeze are tagged as mixed plans are (the
+    ``P`` of a push-grasp). ``max_actions``: the longest plan the planner was allowed; when
+    it cut the plans short of certainty, the legend says the C plan is the most certain of
+    those only.
+    """
     pb = report.problem
-    mixed = len(pb.action_kinds) > 1
-    action = "action" if mixed else "squeeze"
+    mixed = len(pb.action_kinds) > 1 or pb.action_kinds != (SQUEEZE.name,)
+    action = "action" if len(pb.action_kinds) > 1 else pb.action_kinds[0]
     texts = [_plan_text(o, mixed) for o in report.options]
     width = max(34, *(len(t) for t in texts))
     head = "steps (deg)" if mixed else "alphas (deg)"
@@ -204,7 +210,12 @@ def plan_table(report: PlanReport) -> str:
             f"{math.degrees(o.final_orientation):11.2f} {o.success_probability:10.4f} "
             f"{o.expected_cost:8.3f} {tol:>9} {marks}".rstrip()
         )
-    lines.append("B = Bayes plan (least expected cost), C = most certain plan")
+    sure = report.most_certain_plan.success_probability >= 1.0 - pb.part.hull.tol.probability
+    if max_actions is not None and len(report.options) >= max_actions and not sure:
+        what = f"the most certain of the plans of at most {max_actions} action(s) considered"
+    else:
+        what = "most certain plan"
+    lines.append(f"B = Bayes plan (least expected cost), C = {what}")
     if report.nodes is not None:
         lines.append(f"breadth-first nodes generated: {report.nodes}")
     return "\n".join(lines)
@@ -231,7 +242,7 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
         "predicted_success": res.predicted_success,
         "observed_success": res.observed_success,
         "ci95": [lo, hi],
-        "p_value": res.p_value,
+        "p_value": json_float(res.p_value),
         "jams": res.jams,
         "final_jams": res.final_jams,
         "near_boundary": res.near_boundary,
@@ -248,6 +259,9 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
         ],
         "seconds": res.seconds,
     }
+    why = res.fit_unavailable
+    if why is not None:
+        out["p_value_unavailable"] = why
     if part is not None:
         out["part"] = part_document(part)
     return out
@@ -273,10 +287,12 @@ def simulate_table(res: SimulationResult, title: str = "") -> str:
             f"{res.observed[i] / res.trials:9.4f}  {res.observed[i]:9d}{mark}"
         )
     rate = res.trials / res.seconds if res.seconds > 0 else math.inf
+    why = res.fit_unavailable
     lines += [
         f"success: predicted {res.predicted_success:.4f}, observed {res.observed_success:.4f}, "
         f"95% interval [{lo:.4f}, {hi:.4f}]",
-        f"goodness of fit (chi-square over final orientations): p = {res.p_value:.3g}",
+        "goodness of fit (chi-square over final orientations): "
+        + (f"p = {res.p_value:.3g}" if why is None else f"n/a ({why})"),
         f"jams: {res.jams} ({res.final_jams} in the last action); near-boundary starts "
         f"(within {math.degrees(res.boundary_margin):.1f} deg of a basin boundary): "
         f"{res.near_boundary}",

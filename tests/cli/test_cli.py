@@ -39,7 +39,7 @@ SQUEEZE_KEYS = {
     "probabilities",
     "period_rad",
 }
-PART_KEYS = {"name", "vertices", "n_sides", "symmetry_order"}
+PART_KEYS = {"name", "vertices", "n_sides", "symmetry_order", "center_of_mass", "id"}
 PLAN_KEYS = {
     "schema",
     "part",

@@ -124,7 +124,7 @@ def test_files_are_read(tmp_path: Path) -> None:
     ("doc", "message"),
     [
         ([1, 2], "a plan must be a JSON object; got list"),
-        ({"schema": "bayesgrasp.simulate/1", "plan": {}}, "'bayesgrasp.simulate/1' is not a plan"),
+        ({"schema": "bayesgrasp.simulate/1", "plan": {}}, "needs `steps` or `first_squeeze_rad`"),
         ({"schema": "bayesgrasp.plan/3", "options": []}, "expected one of bayesgrasp.plan/1"),
         ({"options": [], "bayes": 0}, "needs `options` and a valid `bayes` index"),
         ({"options": [{}, {}], "bayes": True}, "valid `bayes` index"),

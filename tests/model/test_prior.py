@@ -350,7 +350,7 @@ def test_parse_prior_good(tmp_path: Path) -> None:
         vm.mass(math.radians(30) - 0.2, math.radians(30) + 0.2),
         von_mises(math.radians(30), 4.0).mass(math.radians(30) - 0.2, math.radians(30) + 0.2),
     )
-    assert parse_prior("von-mises:0,1").name == "von-mises(0,1)"
+    assert parse_prior("von-mises:0,1").name == "von-mises(0deg,1)"
     hist = tmp_path / "h.txt"
     hist.write_text("1, 3\n0 0\n", encoding="utf-8")
     hp = parse_prior(f"histogram:{hist}")

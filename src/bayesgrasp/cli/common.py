@@ -1,14 +1,19 @@
-"""What the commands share besides options: printing, progress, figure files, plans.
+"""What the commands share besides options: printing, progress, output files, plans.
 
 :func:`chosen_plan` is the one way to get the plan a command acts on, by name (bayes,
-most-certain, guaranteed) or from a plan file.
+most-certain, guaranteed) or from a plan file. :func:`check_outputs` is the one way a
+command decides that it may write a file: never over one of its inputs (the part file, a
+prior file, a plan file; also through a symlink, a hard link or another letter case), and
+over any other existing file only with ``--force``.
 """
 
 from __future__ import annotations
 
 import json
+import math
+import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
@@ -19,7 +24,7 @@ if TYPE_CHECKING:
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
     from ..planning.result import PlanOption
-    from .specs import ProblemSpec
+    from .specs import PartSpec, ProblemSpec
 
 IMAGE_FORMATS = ("png", "svg", "pdf")
 PLAN_NAMES = {"bayes": "Bayes", "most-certain": "most certain", "guaranteed": "guaranteed"}
@@ -59,6 +64,107 @@ def no_plan(reason: str) -> NoReturn:
     raise typer.Exit(1)
 
 
+def cost_value(value: float | None) -> float | None:
+    """A cost option: a number, >= 0, small enough that expected costs stay finite."""
+    from ..model.cost import MAX_COST
+
+    if value is None:
+        return value
+    if math.isnan(value):
+        raise typer.BadParameter("is not a number; give a cost >= 0")
+    if value < 0:
+        raise typer.BadParameter(f"should be >= 0; got {value:g}")
+    if math.isfinite(value) and value > MAX_COST:  # infinity: the cost model says why
+        raise typer.BadParameter(
+            f"should be at most {MAX_COST:g} (larger costs overflow the expected cost); "
+            f"got {value:g}"
+        )
+    return value
+
+
+def accuracy_value(value: float) -> float:
+    """The gripper accuracy in degrees: a number in [0, 90)."""
+    if math.isnan(value):
+        raise typer.BadParameter("is not a number; give degrees >= 0")
+    if value < 0:
+        raise typer.BadParameter(f"should be >= 0 deg; got {value:g} deg")
+    if value >= 90:
+        raise typer.BadParameter(
+            f"no plan keeps a tolerance of {value:g} deg (stable orientations repeat every "
+            "180 deg at most, so every tolerance is below 90 deg); give less than 90"
+        )
+    return value
+
+
+def input_files(part: str | None, prior: str | None = None, *more: str | Path | None) -> list[Path]:
+    """The files a command reads: the part file, the prior's file, plan files and the like.
+
+    ``part`` is PART as given (a catalogue name or ``-`` is no file); ``prior`` the
+    ``--prior`` text (``histogram:FILE`` and ``sample:FILE`` name a file).
+    """
+    names: list[str | Path] = [m for m in more if m is not None]
+    if part is not None:
+        names.append(part)
+    if prior is not None:
+        kind, _, arg = prior.partition(":")
+        if kind.strip().lower() in ("histogram", "sample") and arg:
+            names.append(arg)
+    return [Path(n) for n in names if str(n) != "-" and Path(n).exists()]
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether writing ``a`` would write ``b``.
+
+    One path after symlinks, the same inode (a hard link), or the same path but for letter
+    case (one file on a case-insensitive file system; refused on every system, so that a
+    command line means the same everywhere).
+    """
+    ra, rb = a.resolve(), b.resolve()
+    if ra == rb or str(ra).casefold() == str(rb).casefold():
+        return True
+    try:
+        return os.path.samefile(ra, rb)
+    except OSError:  # one of them does not exist
+        return False
+
+
+def check_outputs(
+    outputs: Sequence[Path],
+    inputs: Iterable[Path],
+    force: bool = False,
+    hint: str = "--out",
+    folders: bool = False,
+) -> None:
+    """Refuse, before any work, to write over an input or (without ``--force``) any file.
+
+    An output that is an input (:func:`_same_file`) is refused even with ``--force``: the
+    user's part or prior would be lost. An existing output is refused unless ``force``; a
+    folder where a file would go is refused unless ``folders`` (an output that is a folder).
+
+    Raises
+    ------
+    typer.BadParameter
+        Exit code 2, one line naming the file.
+    """
+    given = list(inputs)
+    for out in outputs:
+        for src in given:
+            if _same_file(out, src):
+                raise typer.BadParameter(
+                    f"{str(out)!r} is an input of this command ({str(src)!r}); "
+                    "refusing to write over it, choose another name",
+                    param_hint=hint,
+                )
+        if out.is_dir() and not folders:
+            raise typer.BadParameter(f"{str(out)!r} is a folder, not a file", param_hint=hint)
+    there = [out for out in outputs if out.exists() or out.is_symlink()]
+    if there and not force:
+        more = f" (and {len(there) - 1} more the command writes)" if len(there) > 1 else ""
+        raise typer.BadParameter(
+            f"{str(there[0])!r} exists{more}; use --force to replace", param_hint=hint
+        )
+
+
 def check_figure_path(path: Path, hint: str = "--plot") -> None:
     """Refuse a figure file name that cannot be written, before any work is done."""
     if path.suffix.lstrip(".").lower() not in IMAGE_FORMATS:
@@ -67,6 +173,19 @@ def check_figure_path(path: Path, hint: str = "--plot") -> None:
         )
     if not path.parent.is_dir():
         raise typer.BadParameter(f"no folder {str(path.parent)!r} to write into", param_hint=hint)
+
+
+def check_export(path: Path, inputs: Iterable[Path], force: bool = False) -> None:
+    """Refuse a robot file name that cannot be written, before any work is done."""
+    if path.suffix.lstrip(".").lower() not in ("csv", "json"):
+        raise typer.BadParameter(
+            f"the robot file must end in .csv or .json; got {path.name!r}", param_hint="--export"
+        )
+    if not path.parent.is_dir():
+        raise typer.BadParameter(
+            f"no folder {str(path.parent)!r} to write into", param_hint="--export"
+        )
+    check_outputs([path], inputs, force, "--export")
 
 
 def save_figure(fig: Any, path: Path) -> None:
@@ -87,11 +206,17 @@ def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
     return found if found.status == "ok" else str(found.reason or "no guaranteed plan")
 
 
-def chosen_plan(which: str, spec: ProblemSpec, part: Part) -> tuple[Problem, PlanOption, str]:
+def chosen_plan(
+    which: str, spec: ProblemSpec, part: Part, force: bool = False
+) -> tuple[Problem, PlanOption, str]:
     """The problem and the plan ``--plan`` names (bayes, most-certain, guaranteed, a file).
 
     Returns the problem (with the action kinds of a plan file added), the plan and its name
     for titles. No guaranteed plan: exit code 1. A bad name or file: exit code 2.
+
+    A plan file made for another part (:func:`bayesgrasp.io.plans.same_part`) is refused
+    unless ``force``; the prior and goal it was made under apply unless ``--prior`` or
+    ``--goal`` was given, so the prediction is the plan's own.
     """
     path = Path(which)
     if which not in PLAN_NAMES and path.suffix.lower() != ".json":
@@ -99,18 +224,78 @@ def chosen_plan(which: str, spec: ProblemSpec, part: Part) -> tuple[Problem, Pla
         raise typer.BadParameter(
             f"expected {names} or a .json plan file; got {which!r}", param_hint="--plan"
         )
+    if which not in PLAN_NAMES:
+        return _plan_file(path, spec, part, force)
     problem = spec.build(part)
     if which == "guaranteed":
         found = guaranteed_plan(problem)
         if isinstance(found, str):
             no_plan(found)
         return problem, found.option, PLAN_NAMES[which]
-    if which in PLAN_NAMES:
-        result = spec.plan(problem)
-        plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
-        return problem, plan, PLAN_NAMES[which]
-    from ..io.plans import read_plan_document
+    result = spec.plan(problem)
+    plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
+    return problem, plan, PLAN_NAMES[which]
 
-    plan = read_plan_document(path)
-    missing = tuple(k for k in plan.kinds if k not in problem.action_kinds)
-    return (spec.build(part, missing) if missing else problem), plan, path.name
+
+def _plan_file(
+    path: Path, spec: ProblemSpec, part: Part, force: bool
+) -> tuple[Problem, PlanOption, str]:
+    """The plan of a plan file, checked against the part, and the problem it was made for."""
+    import dataclasses
+
+    from ..io.plans import part_id, read_plan, same_part
+    from .specs import GoalKind
+
+    src = read_plan(path)
+    if same_part(src.part, part) is False and not force:
+        theirs = src.part or {}
+        raise typer.BadParameter(
+            f"plan file {path.name!r} is for part {theirs.get('name', '?')!r} "
+            f"({theirs.get('id', 'other vertices')}), not {part.name!r} ({part_id(part)}); "
+            "use --force to run it anyway",
+            param_hint="--plan",
+        )
+    if "goal" not in spec.given and src.goal in tuple(GoalKind):
+        spec = dataclasses.replace(spec, goal=GoalKind(src.goal))
+    prior = None if "prior" in spec.given else src.prior
+    plan = src.option
+    missing = tuple(k for k in plan.kinds if k not in spec.actions)
+    return spec.build(part, missing, prior), plan, path.name
+
+
+def run_inputs(part: PartSpec | None, spec: ProblemSpec) -> dict[str, Any]:
+    """What a command adds to a document's provenance: the longest plan, the part-file options.
+
+    Options not given are ``None`` (left out of the document); the web service, which
+    reads no part files, gives ``part=None``.
+    """
+    out: dict[str, Any] = {"max_actions": spec.max_actions}
+    if part is not None:
+        out |= {"format": part.fmt.value if part.fmt else None, "element": part.element}
+        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol, "com": part.com}
+    return out
+
+
+def simulate_inputs(
+    engine: str,
+    plan: str,
+    seed: int,
+    trials: int,
+    noise_deg: float,
+    noise_kind: str,
+    offset_mm: float = 0.0,
+    units: str | None = None,
+    workers: int | None = None,
+) -> dict[str, Any]:
+    """How a simulation was run, for its document's provenance (defaults left out)."""
+    return {
+        "engine": engine,
+        "plan": plan,
+        "seed": seed,
+        "trials": trials,
+        "noise_deg": noise_deg,
+        "noise_kind": noise_kind,
+        "offset_mm": offset_mm or None,
+        "units": units,
+        "workers": workers,
+    }

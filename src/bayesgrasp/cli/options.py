@@ -19,6 +19,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
+from .common import accuracy_value, cost_value
 from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -28,6 +29,12 @@ PartArg = Annotated[
     typer.Argument(help="Catalogue name or part file (.json, .csv, .wkt, .geojson, .svg, .dxf)."),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON for machines.")]
+ForceOpt = Annotated[
+    bool,
+    typer.Option(
+        "--force", help="Replace output files that exist (an input file is never replaced)."
+    ),
+]
 PlanChoiceOpt = Annotated[
     str,
     typer.Option("--plan", metavar="PLAN", help="bayes | most-certain | guaranteed | FILE.json"),
@@ -43,6 +50,11 @@ FLATTEN_HELP = (
     "Chordal tolerance for flattening curves, in the file's units "
     "(default: 0.1% of the drawing's diagonal)."
 )
+COM_HELP = (
+    "The part's centre of mass, in the file's coordinates (default: the area centroid of "
+    "the outline; a CSV or JSON point list that crosses itself is a point cloud, whose part "
+    "is its convex hull, so its default is the hull's centroid)."
+)
 PRIOR_HELP = (
     "Prior on the initial orientation: uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE "
     "(bin weights over [0, 360) deg) | sample:FILE (observed angles, deg)."
@@ -53,6 +65,7 @@ ACTIONS_HELP = (
     "Action types a plan may use, comma-separated: {} (the pushing jaw is on the gripper's "
     "-x side)."
 )
+MAX_HELP = "Longest plan to consider, counting actions of every kind (push-grasps too)."
 ACCURACY_HELP = (
     "Gripper accuracy: each turn between actions may err by up to DEG degrees; only plans "
     "whose tolerance is at least DEG are returned (exact planner)."
@@ -109,36 +122,42 @@ def _part_params() -> list[inspect.Parameter]:
         _opt("element", str | None, None, metavar="ID", help=ELEMENT_HELP),
         _opt("layer", str | None, None, help="DXF: read only this layer."),
         _opt("flatten_tol", float | None, None, help=FLATTEN_HELP),
+        _opt("com", str | None, None, "--com", metavar="X,Y", help=COM_HELP),
     ]
 
 
 def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Parameter]:
+    money = {"callback": cost_value}
     cost = [
-        _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", min=0, help=f"Cost of a {n}.")
+        _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", **money, help=f"Cost of a {n}.")
         for i, n in enumerate(names)
     ]
     first_help = "Cost of the first {} (default: as others)."
     first = [
         _opt(
-            f"first_{i}", float | None, None, f"--first-{n}-cost", min=0, help=first_help.format(n)
+            f"first_{i}",
+            float | None,
+            None,
+            f"--first-{n}-cost",
+            **money,
+            help=first_help.format(n),
         )
         for i, n in enumerate(names)
     ]
     kinds = ACTIONS_HELP.format(", ".join(names))
+    from_file = " (default: {}; with --plan FILE: the file's)"
     params = [
-        inspect.Parameter(
-            "prior", inspect.Parameter.KEYWORD_ONLY, default="uniform", annotation=PriorOpt
-        ),
+        _opt("prior", str | None, None, help=PRIOR_HELP + from_file.format("uniform")),
         cost[0],
-        _opt("verify_cost", float, 1.0, min=0, help="Cost of the verification."),
+        _opt("verify_cost", float, 1.0, **money, help="Cost of the verification."),
         *first,
-        _opt("retry_cost", float, 0.0, min=0, help="Overhead paid on each failed verification."),
+        _opt("retry_cost", float, 0.0, **money, help="Overhead paid on each failed verification."),
         *cost[1:],
-        _opt("goal", GoalKind, GoalKind.single, help=GOAL_HELP),
+        _opt("goal", GoalKind | None, None, help=GOAL_HELP + from_file.format("single")),
         _opt("actions", str, "squeeze", metavar="KINDS", help=kinds),
-        _opt("accuracy", float, 0.0, min=0, metavar="DEG", help=ACCURACY_HELP),
+        _opt("accuracy", float, 0.0, callback=accuracy_value, metavar="DEG", help=ACCURACY_HELP),
         _opt("method", Method, Method.exact, help="exact planner or the seed's search."),
-        _opt("max_squeezes", int | None, None, min=1, help="Longest plan to consider."),
+        _opt("max_squeezes", int | None, None, min=1, help=MAX_HELP),
     ]
     if push_grasp_alias:  # the old spelling of simulate and plot, kept working
         alias = "Same as --actions squeeze,push-grasp."
@@ -153,17 +172,19 @@ def _problem_spec(names: list[str], values: dict[str, Any]) -> ProblemSpec:
     if values.get("push_grasp"):  # exactly --actions squeeze,push-grasp (order breaks ties)
         actions = [SQUEEZE.name, PUSH_GRASP.name, *actions]
     first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
+    given = frozenset(k for k in ("prior", "goal") if values[k] is not None)
     return ProblemSpec(
-        prior=values["prior"],
+        prior=values["prior"] or "uniform",
         costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
         first={n: c for n, c in first.items() if c is not None},
         verify=values["verify_cost"],
         retry=values["retry_cost"],
-        goal=values["goal"],
+        goal=values["goal"] or GoalKind.single,
         actions=tuple(dict.fromkeys(actions)),
         accuracy_deg=values["accuracy"],
         method=values["method"],
         max_actions=values["max_squeezes"],
+        given=given,
     )
 
 

@@ -7,9 +7,19 @@ from typing import Annotated
 
 import typer
 
-from .common import check_figure_path, emit_json, guaranteed_plan, save_figure
+from .common import (
+    check_export,
+    check_figure_path,
+    check_outputs,
+    emit_json,
+    guaranteed_plan,
+    input_files,
+    run_inputs,
+    save_figure,
+)
 from .options import (
     ContactNoiseOpt,
+    ForceOpt,
     JsonOpt,
     PayoffOpt,
     TurnNoiseOpt,
@@ -66,6 +76,16 @@ PlotOpt = Annotated[
     ),
 ]
 
+ExportOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--export",
+        metavar="FILE",
+        help="Also write the Bayes plan for a robot into FILE (.csv or .json): per step the "
+        "action, the absolute gripper angle (deg and rad) and the jaw widths to expect.",
+    ),
+]
+
 
 @app.command()
 @part_options
@@ -83,6 +103,8 @@ def plan(
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
     payoff: PayoffOpt = None,
+    force: ForceOpt = False,
+    export: ExportOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -94,8 +116,10 @@ def plan(
     from . import noisy
 
     if noisy.asked(turn_noise, contact_noise, payoff):
-        if sense is not None or guaranteed or plot_file is not None:
-            raise typer.BadParameter("--sense, --guaranteed and --plot do not take noise yet")
+        if sense is not None or guaranteed or plot_file is not None or export is not None:
+            raise typer.BadParameter(
+                "--sense, --guaranteed, --plot and --export do not take noise yet"
+            )
         noisy.plan_noisy_command(part.load(), spec, turn_noise, contact_noise, payoff, as_json)
         return
     if sense is not None:
@@ -105,14 +129,18 @@ def plan(
         raise typer.BadParameter("--also and --part-prior need --sense")
     if plot_file is not None:
         check_figure_path(plot_file)
+        check_outputs([plot_file], input_files(part.part, spec.prior), force, "--plot")
+    if export is not None:
+        check_export(export, input_files(part.part, spec.prior), force)
     pb = spec.build(part.load())
     result = spec.plan(pb)
     found = guaranteed_plan(pb) if guaranteed else None
     sure, missing = (None, found) if isinstance(found, str) else (found, None)
     if as_json:
-        emit_json(plan_document(result, guaranteed=sure, guaranteed_missing=missing))
+        inputs = run_inputs(part, spec)
+        emit_json(plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs))
     else:
-        typer.echo(report.plan_table(result))
+        typer.echo(report.plan_table(result, spec.max_actions))
         if sure is not None:
             typer.echo(report.guaranteed_text(sure))
         if missing is not None:
@@ -122,6 +150,11 @@ def plan(
 
         save_figure(plan_figure(result), plot_file)
         typer.echo(f"bayesgrasp: wrote {plot_file}", err=True)
+    if export is not None:
+        from ..io.export import write_robot
+
+        write_robot(export, pb, result.bayes_plan)
+        typer.echo(f"bayesgrasp: wrote {export}", err=True)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)
 

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .common import IMAGE_FORMATS, chosen_plan, emit_json
+from .common import IMAGE_FORMATS, check_outputs, chosen_plan, emit_json, input_files
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
 from .specs import PartSpec, ProblemSpec
 
@@ -21,7 +21,26 @@ AnimationOpt = Annotated[
     bool,
     typer.Option("--animation/--no-animation", help="Also write the plan's animation (plan.gif)."),
 ]
+ForceOpt = Annotated[
+    bool,
+    typer.Option(
+        "--force",
+        help="Replace figures that exist in DIR (an input file never), and draw a --plan FILE "
+        "made for another part.",
+    ),
+]
 FramesOpt = Annotated[int, typer.Option(min=4, max=240, help="Animation frames per plan step.")]
+
+FIGURES = ("part", "diameter", "transfer", "plan")
+"""The figure files, one per image format (:func:`bayesgrasp.figures.files.write_figures`)."""
+ANIMATIONS = ("plan.gif", "plan.mp4")
+"""The animation files (the MP4 only when ffmpeg is present)."""
+
+
+def figure_files(out: Path, formats: list[str], animation: bool) -> list[Path]:
+    """Every file ``plot`` may write into ``out``."""
+    files = [out / f"{name}.{fmt}" for name in FIGURES for fmt in formats]
+    return files + ([out / a for a in ANIMATIONS] if animation else [])
 
 
 @app.command()
@@ -36,8 +55,13 @@ def plot(
     animation: AnimationOpt = True,
     frames: FramesOpt = 20,
     as_json: JsonOpt = False,
+    force: ForceOpt = False,
 ) -> None:
-    """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif."""
+    """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif.
+
+    Files that exist in the folder are replaced only with --force; an input (the part, the
+    prior or the plan file) never is.
+    """
     from ..figures.plots import write_figures
     from ..model.actions import PUSH_GRASP
 
@@ -47,7 +71,11 @@ def plot(
             f"expected a comma-separated list of png, svg, pdf; got {image_formats!r}",
             param_hint="--image-formats",
         )
-    pb, option, label = chosen_plan(which, spec, part.load())
+    if out.exists() and not out.is_dir():
+        raise typer.BadParameter(f"{str(out)!r} is a file, not a folder", param_hint="--out")
+    inputs = input_files(part.part, spec.prior, which)
+    check_outputs(figure_files(out, formats, animation), inputs, force, "--out")
+    pb, option, label = chosen_plan(which, spec, part.load(), force)
     try:
         files = write_figures(
             pb,

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..model.prior import Prior
     from ..model.problem import Problem
     from ..planning.result import PlanReport
 
@@ -55,15 +56,43 @@ class PartSpec:
     element: str | None = None
     layer: str | None = None
     flatten_tol: float | None = None
+    com: str | None = None
 
     def load(self) -> Part:
-        """Read the part."""
+        """Read the part (with the centre of mass ``--com X,Y``, when given)."""
+        import dataclasses
+
+        from ..errors import PartError
+        from ..geometry.polygon import Part
         from ..io import resolve_part
 
         fmt = self.fmt.value if self.fmt else None
-        return resolve_part(
+        part = resolve_part(
             self.part, fmt, element=self.element, layer=self.layer, tolerance=self.flatten_tol
         )
+        kind = fmt or self.part.rpartition(".")[2].lower()
+        if kind in ("csv", "json") and part.outline is part.hull.vertices:  # a point cloud
+            import typer
+
+            typer.echo(
+                f"bayesgrasp: note: the points of {self.part} cross themselves in file order, "
+                "so they are a point cloud: the part is their convex hull"
+                + ("" if self.com else " (centre of mass its centroid; --com X,Y to set it)"),
+                err=True,
+            )
+        if self.com is None:
+            return part
+        try:
+            xy = [float(v) for v in self.com.split(",")]
+        except ValueError:
+            xy = []
+        if len(xy) != 2 or not all(math.isfinite(v) for v in xy):
+            raise PartError(f"`--com` must be X,Y (two finite numbers); got {self.com!r}")
+        try:  # validated as Part.from_points does: strictly inside the hull
+            com = Part.from_points(part.hull.vertices, center_of_mass=xy).center_of_mass
+        except PartError as exc:
+            raise PartError(f"`--com` {self.com}: {exc}") from None
+        return dataclasses.replace(part, center_of_mass=com)
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,9 +109,16 @@ class ProblemSpec:
     accuracy_deg: float = 0.0
     method: Method = Method.exact
     max_actions: int | None = None
+    given: frozenset[str] = frozenset()
+    """The options of ``prior`` and ``goal`` the user gave (a plan file's own apply otherwise)."""
 
-    def build(self, part: Part, more_actions: tuple[str, ...] = ()) -> Problem:
-        """The problem for ``part`` (with ``more_actions`` added to the action kinds)."""
+    def build(
+        self, part: Part, more_actions: tuple[str, ...] = (), prior: Prior | None = None
+    ) -> Problem:
+        """The problem for ``part`` (with ``more_actions`` added to the action kinds).
+
+        ``prior`` replaces the ``--prior`` text (a plan file's prior).
+        """
         from ..model.cost import CostModel
         from ..model.goal import Goal
         from ..model.prior import parse_prior
@@ -91,7 +127,7 @@ class ProblemSpec:
         cost = CostModel(self.costs or {}, self.verify, self.first or {}, self.retry)
         return Problem.build(
             part,
-            prior=parse_prior(self.prior),
+            prior=parse_prior(self.prior) if prior is None else prior,
             cost=cost,
             goal=Goal(self.goal.value),
             actions=tuple(dict.fromkeys((*self.actions, *more_actions))),

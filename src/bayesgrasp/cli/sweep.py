@@ -71,6 +71,12 @@ def sweep(
     (`dask scheduler` / `dask worker`).
     """
     from ..sweep import SweepInterrupted, SweepOptions, run_sweep, write_report
+    from .common import check_outputs, input_files
+
+    inputs = input_files(None, spec.prior, *paths)  # RESULTS has its own --resume / --force
+    check_outputs([out], inputs, force=True, hint="--out", folders=True)
+    if report_file is not None:
+        check_outputs([report_file], [*inputs, out], force, "--report")
 
     options = SweepOptions(
         prior=spec.prior,

@@ -12,9 +12,18 @@ FILE`` (or :func:`read_plan_document`) reads back. Two schemas:
   (``"guaranteed"``: an option plus its ``period_rad``, or ``null`` and
   ``"guaranteed_missing"``, the reason none exists).
 
-Both are read; so are a bare option object (as a document's ``options`` hold, or as
-``bayesgrasp.simulate/1`` shows under ``"plan"``) and the older option without ``steps``.
+Both are read; so are a bare option object (as a document's ``options`` hold), a
+``bayesgrasp.simulate/1`` document (its ``"plan"``) and the older option without ``steps``.
 Angles are radians; statistics a reader does not find are unknown (NaN).
+
+Every document names its part: the ``part`` object holds the hull's vertices, the centre of
+mass and ``id`` (:func:`part_id`, a hash of the hull about the centre of mass rounded to the
+part's symmetry tolerance), so a plan read for another part is noticed
+(:func:`same_part`). A plan document also records how it was made (``"provenance"``:
+package version, prior, cost model, goal, actions, accuracy, planner; the command line adds
+the part-file options such as the flattening tolerance), and the prior in a form that
+rebuilds it (:func:`prior_document`, :func:`prior_from_document`), so a re-run from the
+document gives the same numbers. Documents written before these fields are read as before.
 
 Examples
 --------
@@ -31,16 +40,21 @@ Examples
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
 from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..errors import SimulationError
-from ..geometry.polygon import Part
+import numpy as np
+
+from ..errors import BayesGraspError, SimulationError
+from ..geometry.polygon import ConvexPolygon, Part
 from ..model.actions import ACTIONS, SQUEEZE
+from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
 from ..model.problem import Problem
 from ..planning.guaranteed import GuaranteedPlan
 from ..planning.result import PlanOption, PlanReport, PlanStep
@@ -50,13 +64,21 @@ __all__ = [
     "PLAN_SCHEMAS",
     "PLAN_SCHEMA_1",
     "PLAN_SCHEMA_2",
+    "SIMULATE_SCHEMA",
+    "PlanSource",
     "guaranteed_document",
     "json_float",
     "option_document",
     "part_document",
+    "part_id",
     "plan_document",
     "plan_schema",
+    "prior_document",
+    "prior_from_document",
+    "provenance",
+    "read_plan",
     "read_plan_document",
+    "same_part",
 ]
 
 PLAN_SCHEMA_1 = "bayesgrasp.plan/1"
@@ -65,6 +87,8 @@ PLAN_SCHEMA = PLAN_SCHEMA_2
 """The schema of plans that use any action (the newest)."""
 PLAN_SCHEMAS = (PLAN_SCHEMA_1, PLAN_SCHEMA_2)
 """Every plan schema :func:`read_plan_document` reads."""
+SIMULATE_SCHEMA = "bayesgrasp.simulate/1"
+"""A simulation's document; its ``"plan"`` is read as a plan."""
 
 #: Which plan of a document to read: the key of its index (``"guaranteed"`` is an option).
 _PLAN_INDEX = {"bayes": "bayes", "most-certain": "most_certain"}
@@ -77,8 +101,70 @@ def json_float(x: float | None) -> float | None:
     return float(x)
 
 
+def _grid(hull: ConvexPolygon) -> float:
+    """The rounding step of a part's identity: its symmetry tolerance (``symmetry * size``)."""
+    return hull.tol.symmetry_for(hull.size)
+
+
+def part_id(part: Part) -> str:
+    """The identity of a part for plans: ``"sha256:"`` and 16 hex digits.
+
+    A plan's angles hold for the part's hull and centre of mass in the user's coordinates,
+    whatever the translation (design.md). So the hash is of the hull's vertices relative to
+    the centre of mass, counter-clockwise from the lexicographically least, rounded to the
+    part's symmetry tolerance ``tol.symmetry * size`` (:class:`~bayesgrasp.tolerance.
+    Tolerance`): the same part read from another file, moved, or rounded to 7 digits has the
+    same id, a rotated or different part another. Two parts a rounding step apart can hash
+    differently; :func:`same_part` then compares the vertices themselves.
+
+    Examples
+    --------
+    >>> a = Part.from_points([(0, 0), (3, 0), (0, 1)])
+    >>> b = Part.from_points([(10, 5), (10, 6), (13, 5)])  # moved, another vertex order
+    >>> part_id(a) == part_id(b), part_id(a) == part_id(Part.from_points([(0, 0), (1, 0), (0, 3)]))
+    (True, False)
+    """
+    q = _grid(part.hull)
+    ints = np.rint((part.hull.vertices - part.center_of_mass) / q).astype(np.int64)  # (N, 2)
+    start = min(range(len(ints)), key=lambda i: (int(ints[i, 0]), int(ints[i, 1])))
+    ints = np.roll(ints, -start, axis=0)
+    return "sha256:" + hashlib.sha256(ints.tobytes()).hexdigest()[:16]
+
+
+def same_part(doc: Any, part: Part) -> bool | None:
+    """Whether a document's ``part`` object is ``part`` (``None``: it names no part).
+
+    The same :func:`part_id`, or else the same number of hull vertices, each within the
+    part's symmetry tolerance of its counterpart after both hulls are moved to their area
+    centroids, and the centre of mass (when the document has one) as near its place.
+    """
+    if not isinstance(doc, Mapping) or "vertices" not in doc:
+        return None
+    if isinstance(doc.get("id"), str) and doc["id"] == part_id(part):
+        return True
+    try:
+        other = ConvexPolygon.from_points(doc["vertices"])
+    except (BayesGraspError, TypeError, ValueError):
+        return False
+    q = _grid(part.hull)
+    a = part.hull.vertices - part.hull.centroid  # (N, 2)
+    b = other.vertices - other.centroid
+    if len(a) != len(b):
+        return False
+    if not any(np.max(np.hypot(*(a - np.roll(b, k, axis=0)).T)) <= q for k in range(len(b))):
+        return False
+    com = doc.get("center_of_mass")
+    if com is None:
+        return True
+    try:
+        there = np.asarray(com, dtype=np.float64).reshape(2) - other.centroid
+    except (TypeError, ValueError):
+        return False
+    return bool(np.hypot(*(there - (part.center_of_mass - part.hull.centroid))) <= q)
+
+
 def part_document(part: Part) -> dict[str, Any]:
-    """The ``part`` object that every bayesgrasp document embeds."""
+    """The ``part`` object that every bayesgrasp document embeds (with its :func:`part_id`)."""
     out: dict[str, Any] = {
         "name": part.name,
         "vertices": part.hull.vertices.tolist(),
@@ -87,6 +173,80 @@ def part_document(part: Part) -> dict[str, Any]:
     }
     if part.units is not None:
         out["units"] = part.units
+    out["center_of_mass"] = part.center_of_mass.tolist()
+    out["id"] = part_id(part)
+    return out
+
+
+def prior_document(prior: Prior) -> dict[str, Any]:
+    """A prior as JSON that :func:`prior_from_document` rebuilds exactly.
+
+    ``{"kind": "uniform"}``; a von Mises prior by its parameters (``mean_rad``, ``kappa``,
+    ``bins``); any other histogram by its normalised ``weights``; a sample by its
+    ``angles_rad``. (Not its display name, which names the file a prior was read from: the
+    same prior given inline or from a file is the same document.)
+
+    Examples
+    --------
+    >>> from bayesgrasp.model.prior import von_mises
+    >>> prior_document(von_mises(0.5, 4.0))["kind"]
+    'von-mises'
+    >>> float(prior_from_document(prior_document(von_mises(0.5, 4.0))).mass(0.0, 1.0))
+    ...  # doctest: +ELLIPSIS
+    0.6...
+    """
+    if isinstance(prior, UniformPrior):
+        return {"kind": "uniform"}
+    if isinstance(prior, HistogramPrior):
+        if prior.recipe:
+            return dict(prior.recipe)
+        return {"kind": "histogram", "weights": prior.weights.tolist()}
+    if isinstance(prior, SamplePrior):
+        return {"kind": "sample", "angles_rad": prior.angles.tolist()}
+    return {"kind": type(prior).__name__, "name": prior.name}  # recorded, not rebuilt
+
+
+def prior_from_document(doc: Any) -> Prior:
+    """The prior of :func:`prior_document` (``SimulationError`` for a form it cannot rebuild)."""
+    from ..model.prior import von_mises
+
+    if not isinstance(doc, Mapping):
+        raise SimulationError(f"a prior must be a JSON object; got {type(doc).__name__}")
+    kind, name = doc.get("kind"), doc.get("name", doc.get("kind"))
+    try:
+        if kind == "uniform":
+            return UniformPrior()
+        if kind == "von-mises":
+            return von_mises(float(doc["mean_rad"]), float(doc["kappa"]), int(doc["bins"]))
+        if kind == "histogram":
+            return HistogramPrior(np.asarray(doc["weights"], dtype=np.float64), name=str(name))
+        if kind == "sample":
+            return SamplePrior(np.asarray(doc["angles_rad"], dtype=np.float64), name=str(name))
+    except (KeyError, TypeError, ValueError, OverflowError, BayesGraspError) as exc:
+        raise SimulationError(f"the {kind} prior of the document is malformed ({exc})") from None
+    raise SimulationError(f"a prior of kind {kind!r} ({name}) cannot be rebuilt from a document")
+
+
+def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict[str, Any]:
+    """How a result was made: version, prior, cost model, goal, actions, accuracy, planner.
+
+    ``more`` (the command line's part-file options, the longest plan asked for...) is added;
+    ``None`` values (an option not given, its default applied) are left out, so the command
+    line and the web service, which share no part-file options, write the same document.
+    """
+    from .. import __version__
+
+    out: dict[str, Any] = {
+        "version": __version__,
+        "prior": prior_document(problem.prior),
+        "cost": problem.cost.to_json(),
+        "goal": problem.goal.kind,
+        "actions": list(problem.action_kinds),
+        "accuracy_rad": float(problem.accuracy),
+    }
+    if method is not None:
+        out["method"] = method
+    out.update({k: v for k, v in more.items() if v is not None})
     return out
 
 
@@ -122,6 +282,7 @@ def plan_document(
     *,
     guaranteed: GuaranteedPlan | None = None,
     guaranteed_missing: str | None = None,
+    inputs: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The plan document of a planner's result (top-level fields follow the Bayes plan).
 
@@ -137,6 +298,8 @@ def plan_document(
     guaranteed_missing : str, optional
         A guaranteed plan was asked for and none exists, for this reason: ``"guaranteed"``
         is ``null`` and ``"guaranteed_missing"`` the reason.
+    inputs : mapping, optional
+        More of how the plans were made, added to ``"provenance"`` (:func:`provenance`).
 
     Returns
     -------
@@ -169,6 +332,7 @@ def plan_document(
     elif guaranteed_missing is not None:
         out["guaranteed"] = None
         out["guaranteed_missing"] = guaranteed_missing
+    out["provenance"] = provenance(pb, result.method, **dict(inputs or {}))
     return out
 
 
@@ -203,6 +367,53 @@ def read_plan_document(
     ...                     "final_orientation_rad": 1.0}).n_actions
     2
     """
+    return read_plan(source, which).option
+
+
+@dataclass(frozen=True, slots=True)
+class PlanSource:
+    """A plan read from a document, with what the document says about it.
+
+    Attributes
+    ----------
+    option : PlanOption
+        The plan (see :func:`read_plan_document`).
+    part : mapping or None
+        The document's ``part`` object (check it with :func:`same_part`).
+    provenance : mapping
+        The document's ``"provenance"`` (empty for older documents and bare options).
+    """
+
+    option: PlanOption
+    part: Mapping[str, Any] | None = None
+    provenance: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def prior(self) -> Prior | None:
+        """The prior the plan was made under, when the document records one."""
+        doc = self.provenance.get("prior")
+        return None if doc is None else prior_from_document(doc)
+
+    @property
+    def goal(self) -> str | None:
+        """The goal the plan was made for, when the document records one."""
+        goal = self.provenance.get("goal")
+        return goal if isinstance(goal, str) else None
+
+
+def read_plan(
+    source: Mapping[str, Any] | str | os.PathLike[str], which: str = "bayes"
+) -> PlanSource:
+    """A plan with its document's part and provenance (see :func:`read_plan_document`).
+
+    Examples
+    --------
+    >>> rect = Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)], name="rectangle")
+    >>> from bayesgrasp.planning import plan_exact
+    >>> src = read_plan(plan_document(plan_exact(Problem.build(rect))))
+    >>> same_part(src.part, rect), src.provenance["goal"], src.prior.name
+    (True, 'single', 'uniform')
+    """
     if isinstance(source, str | os.PathLike):
         path = Path(source)
         try:
@@ -214,10 +425,22 @@ def read_plan_document(
             why = exc.msg if isinstance(exc, json.JSONDecodeError) else "not UTF-8"
             raise SimulationError(f"plan file {str(path)!r} is not valid JSON ({why})") from None
         try:
-            return _read(doc, which)
+            return _read_source(doc, which)
         except SimulationError as exc:
             raise SimulationError(f"plan file {str(path)!r}: {exc}") from None
-    return _read(source, which)
+    return _read_source(source, which)
+
+
+def _read_source(doc: Any, which: str) -> PlanSource:
+    """The plan, part and provenance of a parsed document (see :func:`read_plan`)."""
+    option = _read(doc, which)
+    part = doc.get("part")
+    prov = doc.get("provenance")
+    return PlanSource(
+        option,
+        part if isinstance(part, Mapping) else None,
+        prov if isinstance(prov, Mapping) else {},
+    )
 
 
 def _read(doc: Any, which: str) -> PlanOption:
@@ -227,6 +450,8 @@ def _read(doc: Any, which: str) -> PlanOption:
     if not isinstance(doc, Mapping):
         raise SimulationError(f"a plan must be a JSON object; got {type(doc).__name__}")
     schema = doc.get("schema")
+    if schema == SIMULATE_SCHEMA:
+        return _read_option(doc.get("plan"))
     if schema is not None and schema not in PLAN_SCHEMAS:
         raise SimulationError(
             f"schema {schema!r} is not a plan document; expected one of {', '.join(PLAN_SCHEMAS)}"

@@ -19,14 +19,21 @@ from types import MappingProxyType
 
 from ..errors import CostError
 
-__all__ = ["DEFAULT_ACTION_COST", "CostModel"]
+__all__ = ["DEFAULT_ACTION_COST", "MAX_COST", "CostModel"]
 
 DEFAULT_ACTION_COST = 1.0
 """Cost of an action the model does not name (the seed: every squeeze costs 1)."""
 
+MAX_COST = 1e280
+"""The largest cost of one action, verification or retry. An expected cost is an attempt's
+cost (a few dozen costs at most) over the success probability ``p``; with costs up to 1e280
+it stays below the float limit (1.8e308) for every ``p`` above about 1e-26, where a cost of
+1e308 made every expected cost infinite and the Bayes choice one among infinities. Scaling
+all costs by a factor up to there leaves the Bayes plan as it is."""
+
 
 def _check(name: str, value: object) -> float:
-    """A finite number >= 0, or :class:`CostError` naming the cost."""
+    """A finite number in ``[0, MAX_COST]``, or :class:`CostError` naming the cost."""
     if (
         isinstance(value, bool)
         or not isinstance(value, int | float)
@@ -34,6 +41,11 @@ def _check(name: str, value: object) -> float:
         or value < 0
     ):
         raise CostError(f"cost `{name}` must be a finite number >= 0; got {value!r}")
+    if value > MAX_COST:
+        raise CostError(
+            f"cost `{name}` must be at most {MAX_COST:g} (larger costs overflow the expected "
+            f"cost); got {value!r}"
+        )
     return float(value)
 
 

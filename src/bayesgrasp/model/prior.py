@@ -148,6 +148,9 @@ class HistogramPrior(Prior):
 
     weights: FloatArray
     name: str = "histogram"
+    recipe: tuple[tuple[str, object], ...] = field(default=(), repr=False)
+    """How the histogram was made, when it is a tabulated formula (:func:`von_mises`): its
+    parameters, so a document can name them instead of listing every bin."""
     _cum: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -241,9 +244,11 @@ def von_mises(mean: float, kappa: float, bins: int = 3600) -> HistogramPrior:
     """
     if not (math.isfinite(mean) and math.isfinite(kappa)) or kappa < 0:
         raise PriorError(f"von Mises needs a finite mean and kappa >= 0; got {mean}, {kappa}")
-    return DensityPrior(
-        lambda t: np.exp(kappa * (np.cos(t - mean) - 1.0)), bins, f"von-mises({mean:g},{kappa:g})"
-    )
+    name = f"von-mises({math.degrees(mean):g}deg,{kappa:g})"  # people read degrees
+    hist = DensityPrior(lambda t: np.exp(kappa * (np.cos(t - mean) - 1.0)), bins, name)
+    recipe = (("kind", "von-mises"), ("mean_rad", float(mean)), ("kappa", float(kappa)))
+    object.__setattr__(hist, "recipe", (*recipe, ("bins", int(bins))))
+    return hist
 
 
 @dataclass(frozen=True, eq=False)
@@ -328,7 +333,7 @@ def parse_prior(spec: str) -> Prior:
     Examples
     --------
     >>> parse_prior("vonmises:30,4").name
-    'von-mises(0.523599,4)'
+    'von-mises(30deg,4)'
     """
     kind, _, arg = spec.partition(":")
     kind = kind.strip().lower()

@@ -385,7 +385,8 @@ def search_bfs(
         # plan's tolerance, so filtering on it would lose plans the exact planner finds.
         raise PlanningError(
             "the breadth-first baseline assumes exact gripper turns: the problem's "
-            f"`accuracy` must be 0; got {problem.accuracy!r} rad (use the exact planner)"
+            f"`accuracy` must be 0; got {problem.accuracy:.6g} rad = "
+            f"{math.degrees(problem.accuracy):g} deg (use the exact planner)"
         )
     if node_limit < 1 or fallback_limit < 1:
         raise PlanningError(

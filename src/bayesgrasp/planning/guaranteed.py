@@ -143,10 +143,13 @@ def plan_guaranteed(problem: Problem, max_actions: int | None = None) -> Guarant
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
-    poly = problem.part.hull
     planner = ArcPlanner.for_problem(problem)
     tol, period = planner.tol, planner.period
-    reach = period - max(tol, poly.tol.symmetry)
+    # An arc reaches the period to the angle tolerance only. (The symmetry tolerance is a
+    # length relative to the part's size, not an angle: taken as one it accepted arcs 1e-5
+    # rad short, whose plans leave a sliver of starts off the goal.) A part symmetric
+    # within its symmetry tolerance is exactly symmetric here, its period exact.
+    reach = period - tol
     limit = max_plan_length(problem) if max_actions is None else max_actions
     widths: list[float] = []
     level = [(0,) * len(problem.action_kinds)]

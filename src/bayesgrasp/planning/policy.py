@@ -791,7 +791,8 @@ def plan_policy(
     if any(p.accuracy > 0 for p in space.problems):
         raise PlanningError(
             "the policy planner assumes exact gripper turns: the problem's `accuracy` must be "
-            f"0; got {max(p.accuracy for p in space.problems)!r} rad"
+            f"0; got {max(p.accuracy for p in space.problems):.6g} rad = "
+            f"{math.degrees(max(p.accuracy for p in space.problems)):g} deg"
         )
     cost = main.cost
     kinds: list[_Kind] = []

@@ -37,6 +37,7 @@ __all__ = [
     "boundary_distance",
     "check_steps",
     "check_trials",
+    "combine",
     "predicted_distribution",
     "summarize",
 ]
@@ -221,14 +222,86 @@ class SimulationResult:
         return wilson_interval(self.successes, self.trials)
 
     @property
+    def fit_unavailable(self) -> str | None:
+        """Why the goodness of fit says nothing, or ``None`` when it does.
+
+        When most trials jam, the few that end in a stable orientation are not a sample of
+        the plan's outcomes (the jams are not spread over the states as the prediction is),
+        and a p-value of their fit would read as agreement. So it is not given.
+        """
+        unjammed = self.trials - self.final_jams
+        if self.trials and 2 * self.jams > self.trials:
+            return f"{self.jams} of {self.trials} trials jammed"
+        if unjammed <= 0:
+            return "no trial ended in a stable orientation"
+        return None
+
+    @property
     def p_value(self) -> float:
-        """Chi-square p-value of the final states (jammed trials left out) against prediction."""
+        """Chi-square p-value of the final states (jammed trials left out) against prediction.
+
+        NaN when :attr:`fit_unavailable` gives a reason.
+        """
+        if self.fit_unavailable is not None:
+            return math.nan
         return goodness_of_fit(self.observed, self.predicted)
 
     @property
     def executions_per_second(self) -> float:
         """Trials per second of wall time."""
         return self.trials / self.seconds if self.seconds > 0 else math.inf
+
+
+def combine(results: Sequence[SimulationResult]) -> SimulationResult:
+    """One result of several runs of the same plan on the same problem (counts added).
+
+    What streaming the trials in blocks needs: memory stays that of one block. The
+    per-trial arrays (``final``, ``jammed_trials``, ``near_trials``) are joined only when
+    one run is given; a combined result has none (length 0).
+
+    Raises
+    ------
+    SimulationError
+        No results, or results of different plans or states.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    >>> opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+    >>> one = summarize("kinematic", pb, opt, np.array([0.0, np.pi / 2]),
+    ...                 np.zeros(2, bool), np.zeros(2, bool), 1.0, 1e-6)
+    >>> both = combine([one, one])
+    >>> both.trials, both.observed.tolist(), len(both.final)
+    (4, [2, 2, 0, 0], 0)
+    """
+    if not results:
+        raise SimulationError("`results` must hold at least one simulation result")
+    first = results[0]
+    if len(results) == 1:
+        return first
+    for r in results[1:]:
+        same = r.option.steps == first.option.steps and r.engine == first.engine
+        if not same or not np.array_equal(r.orientations, first.orientations):
+            raise SimulationError("only results of one plan on one problem can be combined")
+    empty = np.zeros(0, dtype=bool)
+    return SimulationResult(
+        engine=first.engine,
+        option=first.option,
+        trials=sum(r.trials for r in results),
+        orientations=first.orientations,
+        predicted=first.predicted,
+        observed=np.sum([r.observed for r in results], axis=0).astype(np.intp),
+        goal=first.goal,
+        jams=sum(r.jams for r in results),
+        final_jams=sum(r.final_jams for r in results),
+        near_boundary=sum(r.near_boundary for r in results),
+        boundary_margin=first.boundary_margin,
+        seconds=sum(r.seconds for r in results),
+        final=np.zeros(0, dtype=np.float64),
+        jammed_trials=empty,
+        near_trials=empty,
+    )
 
 
 def summarize(

@@ -431,7 +431,9 @@ def _plan(part: Any, options: SweepOptions, prior: Prior) -> tuple[Any, dict[str
             sure = found
         else:
             missing = str(found.reason or "no guaranteed plan")
-    doc = plan_document(rep, guaranteed=sure, guaranteed_missing=missing)
+    given: dict[str, Any] = {"max_actions": options.max_actions, "layer": options.layer}
+    given["flatten_tolerance"] = options.flatten_tol  # what the CLI records
+    doc = plan_document(rep, guaranteed=sure, guaranteed_missing=missing, inputs=given)
     return rep, doc, "ok" if missing is None else "no-plan"
 
 
@@ -456,7 +458,17 @@ def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
             rng=options.seed,
             workers=1,
         )
-    return report.simulate_json(res, pb.part)
+    from ..cli.common import simulate_inputs
+    from ..io.plans import provenance
+
+    doc = report.simulate_json(res, pb.part)  # with the provenance `bayesgrasp simulate` writes
+    how = simulate_inputs(
+        str(options.simulate), "bayes", options.seed, options.n_trials, options.noise_deg,
+        options.noise_kind, options.offset_mm, None, 1 if options.simulate == "mujoco" else None,
+    )  # fmt: skip
+    given = {"max_actions": options.max_actions, "layer": options.layer}
+    doc["provenance"] = provenance(pb, None, **how, **given, flatten_tolerance=options.flatten_tol)
+    return doc
 
 
 def _fill(row: dict[str, Any], part: Any, doc: dict[str, Any]) -> None:

@@ -392,7 +392,7 @@ def push_document(service: Service, req: PartRequest) -> dict[str, Any]:
 
 def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     """``bayesgrasp plan PART [options] [--guaranteed] --json``."""
-    from ..cli.common import guaranteed_plan
+    from ..cli.common import guaranteed_plan, run_inputs
     from ..io.plans import plan_document
 
     spec = problem_spec(req)
@@ -401,7 +401,8 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     result = spec.plan(pb)
     found = guaranteed_plan(pb) if req.guaranteed else None
     sure, missing = (None, found) if isinstance(found, str) else (found, None)
-    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing)
+    inputs = run_inputs(None, spec)  # the provenance the command line writes
+    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
     if service.gallery is not None:
         options = req.model_dump(exclude={"part"}, exclude_defaults=True)
         bayes = doc["options"][doc["bayes"]] if doc["options"] else {}
@@ -421,7 +422,13 @@ def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
     pb, option, _ = _chosen(req.plan, req, p, spec)
     err = GripperNoise(req.noise_kind, math.radians(req.noise))
     res = simulate_kinematic(pb, option, req.trials, err, rng=req.seed)
-    return report.simulate_json(res, p)
+    from ..cli.common import run_inputs, simulate_inputs
+    from ..io.plans import provenance
+
+    doc = report.simulate_json(res, p)  # with the provenance the command line writes
+    how = simulate_inputs("kinematic", req.plan, req.seed, req.trials, req.noise, req.noise_kind)
+    doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec))
+    return doc
 
 
 def figure_bytes(service: Service, req: FigureRequest, name: str, fmt: str) -> bytes:

@@ -1,0 +1,92 @@
+"""What the text output says: the right action names, the right tags, degrees for people.
+
+Each case is a line the issue found wrong (issue 15, item 6).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bayesgrasp import Part, Problem
+from bayesgrasp.cli import main
+from bayesgrasp.model.prior import parse_prior, von_mises
+from bayesgrasp.planning.result import PlanOption, PlanStep
+from bayesgrasp.report import simulate_json, simulate_table
+from bayesgrasp.sim.result import summarize
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_push_grasp_plans_say_push_grasp_and_are_tagged(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, out, _ = run(capsys, "plan", "house", "--actions", "push-grasp")
+    assert code == 0
+    assert "squeeze" not in out
+    assert "first push-grasp" in out and "each further push-grasp" in out
+    assert "P = push-grasp" in out
+    rows = [line for line in out.splitlines() if line.strip().startswith(("1 ", "2 "))]
+    assert rows and all(" P" in r for r in rows)
+
+
+def test_capped_plans_do_not_claim_most_certain(capsys: pytest.CaptureFixture[str]) -> None:
+    _, out, _ = run(capsys, "plan", "house", "--actions", "push-grasp", "--max-squeezes", "2")
+    assert "C = the most certain of the plans of at most 2 action(s)" in out
+    _, out, _ = run(capsys, "plan", "house", "--actions", "push-grasp")
+    assert out.rstrip().endswith("C = most certain plan")  # not capped: it is
+    _, out, _ = run(capsys, "plan", "house", "--actions", "push-grasp", "--max-squeezes", "9")
+    assert out.rstrip().endswith("C = most certain plan")  # a cap that did not bind
+
+
+def test_max_squeezes_help_says_every_action(capsys: pytest.CaptureFixture[str]) -> None:
+    _, out, _ = run(capsys, "plan", "--help")
+    assert "push-grasps too" in " ".join(out.split())
+
+
+def test_von_mises_prior_in_degrees(capsys: pytest.CaptureFixture[str]) -> None:
+    assert parse_prior("vonmises:135,6").name == "von-mises(135deg,6)"
+    assert von_mises(math.pi / 2, 2.5).name == "von-mises(90deg,2.5)"
+    _, out, _ = run(capsys, "plan", "house", "--prior", "vonmises:135,6")
+    assert "prior von-mises(135deg,6)" in out and "2.35619" not in out
+
+
+def test_fit_is_not_applicable_when_most_trials_jam() -> None:
+    pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+    final = np.zeros(10)
+    jammed = np.arange(10) < 8  # 8 of 10 jam
+    res = summarize("mujoco", pb, opt, final, jammed, np.zeros(10, bool), 1.0, 1e-6)
+    assert res.fit_unavailable == "8 of 10 trials jammed"
+    assert math.isnan(res.p_value)
+    text = simulate_table(res)
+    assert "goodness of fit (chi-square over final orientations): n/a (8 of 10 trials" in text
+    assert "p = 1" not in text
+    doc = simulate_json(res)
+    assert doc["p_value"] is None and doc["p_value_unavailable"] == "8 of 10 trials jammed"
+    fine = summarize("mujoco", pb, opt, final, np.zeros(10, bool), np.zeros(10, bool), 1.0, 1e-6)
+    assert fine.fit_unavailable is None and "p = " in simulate_table(fine)
+
+
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (["plan", "triangle", "--squeeze-cost", "nan"], "is not a number"),
+        (["plan", "triangle", "--accuracy", "nan"], "is not a number"),
+        (["plan", "triangle", "--accuracy", "2", "--method", "bfs"], "0.0349066 rad = 2 deg"),
+    ],
+)
+def test_messages_name_the_problem(
+    capsys: pytest.CaptureFixture[str], argv: list[str], words: str
+) -> None:
+    code, out, err = run(capsys, *argv)
+    assert (code, out) == (2, "")
+    assert words in err and "should be >= 0" not in err
