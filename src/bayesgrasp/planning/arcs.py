@@ -103,6 +103,8 @@ from .result import PlanOption, plan_actions, short_turns
 
 __all__ = [
     "ARC_CHUNK",
+    "PRUNE_STATES",
+    "STAIR_CELLS",
     "Arc",
     "ArcFront",
     "ArcPlanner",
@@ -195,7 +197,9 @@ class ArcFront:
         return self.width_list[n] if n >= 0 else 0.0
 
 
-def arc_front(f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK) -> ArcFront:
+def arc_front(
+    f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK, prune: bool | None = None
+) -> ArcFront:
     """The front of the arcs of ``f`` whose image spans less than ``max_span``.
 
     Single basins (span 0) are always arcs, even when ``max_span <= 0``. Of arcs equal in
@@ -208,6 +212,10 @@ def arc_front(f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK) -
         Only arcs whose image spans less than this count.
     chunk : int
         Candidate arcs enumerated at once (the front does not depend on it).
+    prune : bool, optional
+        Enumerate only the arcs that can be on the front (:func:`_pruned_candidates`; the
+        default above :data:`PRUNE_STATES` states) or every arc (O(K^2)). The front is the
+        same, bit for bit.
 
     Returns
     -------
@@ -222,31 +230,190 @@ def arc_front(f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK) -
     >>> np.degrees(front.span).round(6).tolist(), np.degrees(front.width).round(6).tolist()
     ([0.0, 90.0, 180.0, 270.0], [126.869898, 180.0, 306.869898, 360.0])
     """
-    k = f.n_states
-    s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
-    hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
+    geo = _ArcGeometry(f, max_span)
+    cand = None
+    if prune if prune is not None else f.n_states > PRUNE_STATES:
+        cand = _pruned_candidates(geo)
+    if cand is not None:
+        lo, width, first, span = geo.arcs(*cand)
+        keep = pareto_front(span, width)
+        lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
+        return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+    k = geo.k
     i_all = np.arange(k)
-    # Last basin j of an arc starting at basin i: at most K basins, image span < max_span,
-    # at least basin i itself.
-    last = np.clip(np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1)
-    n_off = int(np.max(last - i_all)) + 1
+    n_off = int(np.max(geo.last - i_all)) + 1
     rows = max(1, chunk // n_off)
     parts: list[tuple[FloatArray, ...]] = []
     for start in range(0, k, rows):
         i = i_all[start : start + rows]
         j = i[:, None] + np.arange(n_off)[None, :]  # (R, J) candidate last basins
-        ok = j <= last[i, None]
-        ii = np.broadcast_to(i[:, None], j.shape)[ok]
-        jj = j[ok]
-        lo = f.basin_lo[ii]
-        width = hi2[jj] - lo
-        span = s2[jj] - f.stable[ii]
+        ok = j <= geo.last[i, None]
+        lo, width, first, span = geo.arcs(np.broadcast_to(i[:, None], j.shape)[ok], j[ok])
         keep = pareto_front(span, width)
-        parts.append((lo[keep], width[keep], f.stable[ii][keep], span[keep]))
+        parts.append((lo[keep], width[keep], first[keep], span[keep]))
     lo, width, first, span = (np.concatenate(x) for x in zip(*parts, strict=True))
     keep = pareto_front(span, width)
     lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
     return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+
+
+PRUNE_STATES = 256
+"""Above this many states :func:`arc_front` enumerates only the arcs that can be on the front."""
+
+# An arc's width less its span is computed as left(i) + right(j) for the pruning; the two
+# differ from ``width - span`` by rounding (a few ulps of 4 pi), far below this.
+_EXCESS_SLACK = 1e-12
+STAIR_CELLS = 2_000_000
+"""Most staircase entries one witness chain may build; longer chains bisect on the margin."""
+
+# Steps of the front filled by enumeration in one round; more, and the threshold is lowered.
+_MAX_STEPS = 16
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _ArcGeometry:
+    """The arcs of one transfer function: arc ``(i, j)`` covers basins ``i..j`` (j < i + K).
+
+    ``j`` indexes the basins repeated once round the circle (``j >= K`` is basin ``j - K``
+    2 pi on); ``last[i]`` is the last basin an arc from ``i`` may reach (its image spans
+    less than ``max_span``, and at least basin ``i`` itself).
+    """
+
+    f: TransferFunction
+    k: int
+    s2: FloatArray
+    hi2: FloatArray
+    last: NDArray[np.intp]
+
+    def __init__(self, f: TransferFunction, max_span: float) -> None:
+        k = f.n_states
+        s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
+        hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
+        i_all = np.arange(k)
+        last = np.clip(
+            np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1
+        )
+        for name, value in (("f", f), ("k", k), ("s2", s2), ("hi2", hi2), ("last", last)):
+            object.__setattr__(self, name, value)
+
+    def arcs(self, ii: NDArray[np.intp], jj: NDArray[np.intp]) -> tuple[FloatArray, ...]:
+        """``lo``, ``width``, ``s_first`` and ``span`` of the arcs ``(ii, jj)``."""
+        lo = self.f.basin_lo[ii]
+        return lo, self.hi2[jj] - lo, self.f.stable[ii], self.s2[jj] - self.f.stable[ii]
+
+    def spans_between(self, a: float, b: float) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """Every arc whose image spans between ``a`` and ``b`` (a little more, never less)."""
+        s, k = self.f.stable, self.k
+        i_all = np.arange(k)
+        j0 = np.maximum(np.searchsorted(self.s2, s + (a - _EXCESS_SLACK), side="left"), i_all)
+        j1 = np.minimum(
+            np.searchsorted(self.s2, s + (b + _EXCESS_SLACK), side="right") - 1, self.last
+        )
+        return _ranges(i_all, j0, j1)
+
+
+def _ranges(
+    i: NDArray[np.intp], j0: NDArray[np.intp], j1: NDArray[np.intp]
+) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The pairs ``(i[r], j)`` for ``j0[r] <= j <= j1[r]``, by ``r`` then ``j``."""
+    count = np.maximum(j1 - j0 + 1, 0)
+    total = int(count.sum())
+    ii = np.repeat(i, count)
+    starts = np.repeat(np.cumsum(count) - count, count)
+    jj = np.repeat(j0, count) + (np.arange(total) - starts)
+    return ii, jj
+
+
+def _pruned_candidates(geo: _ArcGeometry) -> tuple[NDArray[np.intp], NDArray[np.intp]] | None:
+    """The arcs that can be on the front (or tie with it), in the order ``(i, j)``.
+
+    An arc's width is its span plus its *excess* ``l_i + r_j``: the half of basin ``i``
+    before its stable orientation and the half of basin ``j`` after. The front is a
+    staircase of points ``(span_n, width_n)``; an arc of span in ``[span_n, span_{n+1})``
+    and excess below ``T`` is strictly narrower than point ``n`` when
+    ``width_n >= span_{n+1} + T``. So: take the arcs of excess at least ``T`` (a few per
+    state, the threshold found by bisection on the counts) and the arcs of one or two
+    basins, compute their front, and enumerate every arc whose span falls in a step where
+    that inequality fails (also past the last point); repeat until no step fails. Each
+    round only adds arcs, so the front found is that of all arcs, and every arc tied with
+    a front point has an excess above ``T`` and is among the candidates. When the steps to
+    fill grow too many the threshold is lowered; ``None`` when the candidates would be
+    nearly all arcs (a regular polygon: every excess is equal), which are then enumerated
+    in chunks. Memory O(C), time O((K + C) log K) for C candidates (a few per state on
+    random parts).
+    """
+    k, f = geo.k, geo.f
+    left = f.stable - f.basin_lo  # (K,) l_i
+    right = f.basin_hi - f.stable  # (K,) r_j
+    r_order = np.argsort(-right, kind="stable")
+    r_desc = right[r_order]
+    neg = -r_desc  # increasing
+    i_all = np.arange(k)
+    max_span = float(np.max(geo.s2[geo.last] - f.stable))
+    total = int(np.sum(geo.last - i_all + 1))
+    budget = 8 * k
+    while True:
+        if 16 * budget >= total:  # nearly as many as all arcs
+            return None
+        # Threshold T with about `budget` pairs of excess >= T - slack.
+        lo_t, hi_t = float(left.min() + right.min()), float(left.max() + right.max())
+        for _ in range(60):
+            mid = 0.5 * (lo_t + hi_t)
+            n = int(np.searchsorted(neg, left - (mid - _EXCESS_SLACK), side="right").sum())
+            lo_t, hi_t = (mid, hi_t) if n > budget else (lo_t, mid)
+        t = hi_t
+        count = np.searchsorted(neg, left - (t - _EXCESS_SLACK), side="right")
+        ii = np.repeat(i_all, count)
+        starts = np.repeat(np.cumsum(count) - count, count)
+        jj = r_order[np.arange(len(ii)) - starts]
+        jj = np.where(jj >= ii, jj, jj + k)
+        ok = jj <= geo.last[ii]
+        few_i, few_j = _ranges(i_all, i_all, np.minimum(i_all + 1, geo.last))
+        ii, jj = np.concatenate([ii[ok], few_i]), np.concatenate([jj[ok], few_j])
+        done: list[tuple[float, float]] = []  # span intervals enumerated in full
+        limit = 16 * budget
+        while True:
+            key = np.sort(ii * (2 * k) + jj)  # by (i, j), without repeats
+            key = key[np.append(True, key[1:] != key[:-1])]
+            ii, jj = key // (2 * k), key % (2 * k)
+            if len(ii) > limit:
+                break
+            _, width, _, span = geo.arcs(ii, jj)
+            keep = pareto_front(span, width)
+            fs, fw = span[keep], width[keep]
+            nxt = np.append(fs[1:], max_span)
+            bad = np.flatnonzero(fw < nxt + t)
+            todo = [
+                (float(fs[n]), float(nxt[n]))
+                for n in bad
+                if not any(a <= fs[n] and nxt[n] <= b for a, b in done)
+            ]
+            if not todo:
+                return ii, jj
+            steps = _merge(todo)
+            if len(steps) > _MAX_STEPS:  # the threshold is too high: lower it
+                break
+            new_i, new_j = [ii], [jj]
+            for a, b in steps:
+                more_i, more_j = geo.spans_between(a, b)
+                new_i.append(more_i)
+                new_j.append(more_j)
+                done.append((a, b))
+            ii, jj = np.concatenate(new_i), np.concatenate(new_j)
+            if len(ii) > limit:
+                break
+        budget *= 4
+
+
+def _merge(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """Touching or overlapping intervals joined (sorted by start)."""
+    out: list[tuple[float, float]] = []
+    for a, b in sorted(intervals):
+        if out and a <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
 
 
 def pareto_front(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
@@ -407,6 +574,7 @@ class ArcPlanner:
     # none), with its own id: a suffix of a plan is found in O(1) from the next one.
     stairs: dict[tuple[str, int], tuple[int, Staircase]] = field(default_factory=dict)
     best: dict[Counts, tuple[float, str]] = field(default_factory=dict)
+    orders: dict[Counts, tuple[str, ...]] = field(default_factory=dict)  # see _rest_order
     index: dict[str, int] = field(init=False)  # position of each action type in a Counts
     period: float = field(init=False)
 
@@ -478,14 +646,26 @@ class ArcPlanner:
 
     def order(self, counts: Counts, first: str) -> tuple[str, ...]:
         """Action types of a plan in order: ``first``, then the best order of the rest."""
-        kinds = [first]
         left = list(counts)
         left[self.index[first]] -= 1
-        while any(left):
-            kind = self.best[tuple(left)][1]
-            kinds.append(kind)
-            left[self.index[kind]] -= 1
-        return tuple(kinds)
+        return (first, *self._rest_order(tuple(left)))
+
+    def _rest_order(self, counts: Counts) -> tuple[str, ...]:
+        """The best order of actions of these counts (memoised: each is one longer)."""
+        if counts in self.orders:
+            return self.orders[counts]
+        chain: list[Counts] = []  # counts whose order is not known yet, longest first
+        c = counts
+        while any(c) and c not in self.orders:
+            chain.append(c)
+            left = list(c)
+            left[self.index[self.best[c][1]]] -= 1
+            c = tuple(left)
+        out = self.orders.get(c, ())
+        for c in reversed(chain):
+            out = (self.best[c][1], *out)
+            self.orders[c] = out
+        return out
 
     def staircases(self, kinds: tuple[str, ...]) -> list[Staircase]:
         """The staircase of ``kinds[m:]`` for each ``m``."""
@@ -504,12 +684,17 @@ class ArcPlanner:
         """The chain of witness arcs of largest least margin, and that margin.
 
         ``length`` is the success arc's length; the first witness is an arc that wide.
-        The margin is ``None`` for a single action.
+        The margin is ``None`` for a single action. Chains whose staircases would hold more
+        than :data:`STAIR_CELLS` entries are found by :meth:`witnesses_by_margin` (the same
+        margin, in memory O(F)).
         """
         front = self.front(kinds[0])
         wide = bisect.bisect_left(front.width_list, length - self.tol)  # arcs wide..end
         if len(kinds) == 1:
             return [front.arc(wide + int(np.flatnonzero(front.span[wide:] <= 0.0)[0]))], None
+        cells = len(kinds) * max(len(self.front(t)) for t in set(kinds))
+        if cells > STAIR_CELLS:
+            return self.witnesses_by_margin(kinds, length)
         stairs = self.staircases(kinds[1:])
         rest = stairs[0].tau(front.span[wide:])
         best = float(rest.max())
@@ -519,6 +704,55 @@ class ArcPlanner:
         for stair in stairs:
             chain.append(stair.pick(chain[-1].span))
         return chain, best
+
+    def witnesses_by_margin(
+        self, kinds: tuple[str, ...], length: float
+    ) -> tuple[list[Arc], float | None]:
+        """:meth:`witnesses` by bisection on the margin, without staircases.
+
+        A least margin ``t`` is attainable when, from the last action back,
+        ``U_{k-1}`` = the widest single basin and ``U_m`` = the widest front arc of action
+        ``m`` whose image spans at most ``U_{m+1} - 2 t`` give ``U_0 >= length - tol``: the
+        image of each witness then fits the next with ``t`` to spare on each side, and no
+        chain does better (a wider witness is never worse for the actions before it). The
+        largest such ``t`` is found by bisection to the last bit (O(k log F) a step), and
+        the chain is read off its ``U``: the first witness is the narrowest arc at least
+        ``length - tol`` wide, each later one the widest that still fits. The margin reported
+        is that chain's least ``(W(a_{m+1}) - span(a_m)) / 2``, the staircases' value to
+        rounding; the witnesses may differ from theirs where several chains attain it.
+        """
+        k = len(kinds)
+        fronts = [self.front(t) for t in kinds]
+        need = length - self.tol
+
+        def widths(t: float) -> list[float] | None:
+            u = [0.0] * k
+            u[-1] = fronts[-1].width_list[0]  # the widest single basin (span 0)
+            for m in range(k - 2, -1, -1):
+                n = bisect.bisect_right(fronts[m].span_list, u[m + 1] - 2.0 * t) - 1
+                if n < 0:
+                    return None
+                u[m] = fronts[m].width_list[n]
+            return u if u[0] >= need else None
+
+        lo, hi = max(self.tol, self.problem.accuracy), 4.0  # attainable, not attainable
+        if widths(lo) is None:  # pragma: no cover - the lengths guarantee a chain
+            raise PlanningError("internal error: no witness chain for a plan the lengths allow")
+        while True:
+            mid = 0.5 * (lo + hi)
+            if mid in (lo, hi):
+                break
+            lo, hi = (mid, hi) if widths(mid) is not None else (lo, mid)
+        u = widths(lo)
+        assert u is not None
+        first = fronts[0]
+        chain = [first.arc(bisect.bisect_left(first.width_list, need))]
+        for m in range(1, k - 1):
+            fr = fronts[m]
+            chain.append(fr.arc(bisect.bisect_right(fr.span_list, u[m + 1] - 2.0 * lo) - 1))
+        chain.append(fronts[-1].arc(0))
+        margin = min(0.5 * (b.width - a.span) for a, b in itertools.pairwise(chain))
+        return chain, margin
 
 
 def chain_option(

@@ -39,6 +39,7 @@ __all__ = [
     "PlanResult",
     "PlanStep",
     "Status",
+    "choose_among",
     "choose_indices",
     "execute_plan",
     "max_plan_length",
@@ -283,8 +284,23 @@ def choose_indices(
     >>> choose_indices(tuple(opts))
     (0, 1)
     """
-    costs = np.array([o.expected_cost for o in options])
-    probs = np.array([o.success_probability for o in options])
+    return choose_among(
+        [o.expected_cost for o in options], [o.success_probability for o in options], tol
+    )
+
+
+def choose_among(
+    costs: Sequence[float], probs: Sequence[float], tol: float = DEFAULT_TOLERANCE.probability
+) -> tuple[int, int]:
+    """:func:`choose_indices` from the plans' expected costs and success probabilities.
+
+    Examples
+    --------
+    >>> choose_among([6.0, 6.0, 7.0], [0.3, 0.5, 0.5])
+    (0, 1)
+    """
+    costs = np.asarray(costs, dtype=np.float64)
+    probs = np.asarray(probs, dtype=np.float64)
     m = float(costs.min())
     tie = costs - m <= COST_RTOL * abs(m) if math.isfinite(m) else np.ones(len(costs), bool)
     bayes = int(np.flatnonzero(tie)[0])
