@@ -134,6 +134,24 @@ def plan_exact(
         """The action types of the cheapest attempt of ``n`` actions."""
         return (first_kind,) + (next_kind,) * (n - 1)
 
+    cost = problem.cost
+    runs: dict[tuple[str, str], list[float]] = {}
+
+    def attempt(order: tuple[str, ...]) -> float:
+        """``cost.attempt_cost(order)``, in O(1) amortised for plans of one repeated action.
+
+        Its sum is left to right, so the partial sums of ``first, kind, kind, ...`` are
+        kept and extended (the plans of each length are one action longer): bit for bit
+        the same value.
+        """
+        if len(order) < 3 or order.count(order[1]) - (order[0] == order[1]) != len(order) - 1:
+            return cost.attempt_cost(order)
+        partial = runs.setdefault(order[:2], [0 + cost.action_cost(order[0], True)])
+        step = cost.action_cost(order[1])
+        while len(partial) < len(order):
+            partial.append(partial[-1] + step)
+        return cost.verify + partial[len(order) - 1]
+
     certain_at: int | None = None  # the length of the most certain plan, once found
     extra: tuple[float, float, tuple[str, ...], float] | None = None
     k = 0
@@ -144,7 +162,7 @@ def plan_exact(
         for key, t, width in candidates:
             p, _ = prior.max_arc_mass(min(width, cap), group)
             order = planner.order(key, t)
-            scored.append((p, problem.cost.expected_cost(order, p), order, width))
+            scored.append((p, cost.expected_from_attempt(attempt(order), p), order, width))
         cheapest = min(scored, key=lambda s: (s[1], -s[0]))
         if certain_at is None:
             top_p = max(s[0] for s in scored)
@@ -181,6 +199,7 @@ def plan_exact(
         keep = sorted({bayes, most})
         options = [options[i] for i in keep]
         bayes, most = keep.index(bayes), keep.index(most)
+    planner.prepare_margins([(order, width) for _, _, order, width in options])
     plans = tuple(
         _option(planner, order, width, min(width, cap), p, cost)
         for p, cost, order, width in options
