@@ -126,7 +126,7 @@ def test_margin_bisection_equals_the_staircases(accuracy: float, actions: tuple[
         if opt.n_actions < 2:
             continue
         width = opt.success_arc[1] - opt.success_arc[0]
-        by_stairs, best = planner.witnesses(opt.kinds, width)
+        _, best = planner.witnesses(opt.kinds, width)
         by_margin, margin = planner.witnesses_by_margin(opt.kinds, width)
         assert best is not None and margin is not None
         assert margin == pytest.approx(best, rel=1e-12, abs=1e-15)

@@ -210,14 +210,15 @@ def _hull_indices(points: FloatArray) -> NDArray[np.intp]:
 def _pruned_chain(
     xs: FloatArray, ys: FloatArray, idx: NDArray[np.intp], rounds: int = 64
 ) -> NDArray[np.intp] | None:
-    """One half of Andrew's monotone chain by array operations: the points ``idx`` (sorted),
-    less every point that does not turn strictly left between its neighbours, until none.
+    """One half of Andrew's monotone chain by array operations.
 
-    A point that turns right or goes straight between two others lies on or above the
-    segment joining them (below, for the upper half), so it is no strict vertex of this
-    half of the hull; removing every such point at once is safe, and what remains (a chain
-    from the first point to the last turning strictly left at every point) is exactly what
-    the monotone chain keeps. Usually a few rounds of O(N); ``None`` after ``rounds`` rounds
+    The points ``idx`` (sorted) less every point that does not turn strictly left between
+    its neighbours, until none does. A point that turns right or goes straight between two
+    others lies on or above the segment joining them (below, for the upper half), so it is
+    no strict vertex of this half of the hull; removing every such point at once is safe,
+    and what remains (a chain from the first point to the last turning strictly left at
+    every point) is exactly what the monotone chain keeps. Usually a few rounds of O(N);
+    ``None`` after ``rounds`` rounds
     (the caller then runs the sequential chain).
 
     Repeated points are first reduced to the one the monotone chain keeps: the first of

@@ -146,7 +146,7 @@ def plan_exact(
         """
         if len(order) < 3 or order.count(order[1]) - (order[0] == order[1]) != len(order) - 1:
             return cost.attempt_cost(order)
-        partial = runs.setdefault(order[:2], [0 + cost.action_cost(order[0], True)])
+        partial = runs.setdefault((order[0], order[1]), [0 + cost.action_cost(order[0], True)])
         step = cost.action_cost(order[1])
         while len(partial) < len(order):
             partial.append(partial[-1] + step)

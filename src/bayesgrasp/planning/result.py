@@ -299,12 +299,12 @@ def choose_among(
     >>> choose_among([6.0, 6.0, 7.0], [0.3, 0.5, 0.5])
     (0, 1)
     """
-    costs = np.asarray(costs, dtype=np.float64)
-    probs = np.asarray(probs, dtype=np.float64)
-    m = float(costs.min())
-    tie = costs - m <= COST_RTOL * abs(m) if math.isfinite(m) else np.ones(len(costs), bool)
+    cost = np.asarray(costs, dtype=np.float64)
+    prob = np.asarray(probs, dtype=np.float64)
+    m = float(cost.min())
+    tie = cost - m <= COST_RTOL * abs(m) if math.isfinite(m) else np.ones(len(cost), bool)
     bayes = int(np.flatnonzero(tie)[0])
-    most = int(np.flatnonzero(probs >= probs.max() - tol)[0])
+    most = int(np.flatnonzero(prob >= prob.max() - tol)[0])
     return bayes, most
 
 
