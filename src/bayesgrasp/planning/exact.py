@@ -195,7 +195,7 @@ def plan_exact(
     if extra is not None:
         options.append(extra)
     bayes, most = choose_among([o[1] for o in options], [o[0] for o in options], p_tol)
-    if report == "best":
+    if report == "best":  # as PlanResult.best_only, before the angles are computed
         keep = sorted({bayes, most})
         options = [options[i] for i in keep]
         bayes, most = keep.index(bayes), keep.index(most)

@@ -17,6 +17,7 @@ their shortest form (:func:`short_turns`), the choice of the Bayes and most cert
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -246,6 +247,29 @@ class PlanResult:
             If ``status`` is ``"no-plan"`` (the message is the ``reason``).
         """
         return self._plan(self.most_certain)
+
+    def best_only(self) -> PlanResult:
+        """The same result with only the Bayes and the most certain plans (in that order of
+        length; one when they are the same), as ``plan_exact(..., report="best")`` gives.
+
+        Examples
+        --------
+        >>> from bayesgrasp.geometry.polygon import Part
+        >>> from bayesgrasp.planning import plan
+        >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
+        >>> res = plan(Problem.build(rect)).best_only()
+        >>> [o.n_actions for o in res.options], res.bayes, res.most_certain
+        ([2], 0, 0)
+        """
+        if self.status != "ok":
+            return self
+        keep = sorted({self.bayes, self.most_certain})
+        return dataclasses.replace(
+            self,
+            options=tuple(self.options[i] for i in keep),
+            bayes=keep.index(self.bayes),
+            most_certain=keep.index(self.most_certain),
+        )
 
 
 PlanReport = PlanResult
