@@ -99,12 +99,15 @@ class ProblemSpec:
         )
 
     def plan(self, problem: Problem, best_only: bool = False) -> PlanReport:
-        """The best plan of every length, by the chosen planner (``best_only``: only the
-        Bayes and the most certain plans)."""
+        """The best plan of every length, by the chosen planner.
+
+        ``best_only``: only the Bayes and the most certain plans.
+        """
         from ..planning import plan_bfs, plan_exact
 
         if self.method is Method.bfs:
             found = plan_bfs(problem, max_actions=self.max_actions)
             return found.best_only() if best_only else found
-        report = "best" if best_only else "all"
-        return plan_exact(problem, max_actions=self.max_actions, report=report)
+        return plan_exact(
+            problem, max_actions=self.max_actions, report="best" if best_only else "all"
+        )

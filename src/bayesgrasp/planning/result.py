@@ -249,8 +249,10 @@ class PlanResult:
         return self._plan(self.most_certain)
 
     def best_only(self) -> PlanResult:
-        """The same result with only the Bayes and the most certain plans (in that order of
-        length; one when they are the same), as ``plan_exact(..., report="best")`` gives.
+        """The same result with only the Bayes and the most certain plans.
+
+        In order of length, one when they are the same: what ``plan_exact(...,
+        report="best")`` gives.
 
         Examples
         --------
