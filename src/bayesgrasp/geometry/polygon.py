@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import PartError
+from ..sizes import SMALL
 from ..tolerance import DEFAULT_TOLERANCE, Tolerance
 
 __all__ = ["ConvexPolygon", "Part", "as_points", "find_crossing", "polygon_area_centroid"]
@@ -356,7 +357,7 @@ def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
 
 
 # Up to this many points, ConvexPolygon.from_points works on Python floats (faster there).
-_SMALL = 64
+_SMALL = SMALL
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -861,11 +862,22 @@ def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
 def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
     """Whether ``point`` lies strictly inside the convex polygon (by more than the tolerance)."""
     v = hull.vertices
+    margin = hull.tol.length_for(hull.size)
+    if len(v) <= SMALL:  # on Python floats (math.hypot may differ from numpy's by an ulp)
+        xs, ys = v[:, 0].tolist(), v[:, 1].tolist()
+        px, py = float(point[0]), float(point[1])
+        n = len(xs)
+        for i in range(n):
+            ex, ey = xs[(i + 1) % n] - xs[i], ys[(i + 1) % n] - ys[i]
+            cross = ex * (py - ys[i]) - ey * (px - xs[i])
+            if not cross / math.hypot(ex, ey) > margin:
+                return False
+        return True
     e = np.roll(v, -1, axis=0) - v
     rel = point - v
     cross = e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0]
     lengths = np.hypot(e[:, 0], e[:, 1])
-    return bool(np.all(cross / lengths > hull.tol.length_for(hull.size)))
+    return bool(np.all(cross / lengths > margin))
 
 
 def _clean_ring(points: ArrayLike, what: str) -> FloatArray:

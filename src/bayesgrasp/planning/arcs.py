@@ -99,6 +99,7 @@ from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.problem import Problem
+from ..sizes import SMALL
 from .result import PlanOption, plan_actions, short_turns
 
 __all__ = [
@@ -230,6 +231,8 @@ def arc_front(
     >>> np.degrees(front.span).round(6).tolist(), np.degrees(front.width).round(6).tolist()
     ([0.0, 90.0, 180.0, 270.0], [126.869898, 180.0, 306.869898, 360.0])
     """
+    if f.n_states <= SMALL and prune is None:
+        return _arc_front_python(f, max_span)
     geo = _ArcGeometry(f, max_span)
     cand = None
     if prune if prune is not None else f.n_states > PRUNE_STATES:
@@ -255,6 +258,40 @@ def arc_front(
     keep = pareto_front(span, width)
     lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
     return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+
+
+def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
+    """:func:`arc_front` in plain Python floats for a few states, step for step.
+
+    The same candidates in the same order (first basin, then last), the same float
+    operations and the same Pareto rule (:func:`pareto_front`: by span, a stable sort,
+    widths strictly increasing, the last of equal spans): the same front, bit for bit.
+    """
+    k = f.n_states
+    stable, lo, hi = f.stable.tolist(), f.basin_lo.tolist(), f.basin_hi.tolist()
+    s2 = stable + [x + TWO_PI for x in stable]
+    hi2 = hi + [x + TWO_PI for x in hi]
+    cand: list[tuple[float, float, int, int]] = []  # (span, width, i, j), in (i, j) order
+    for i in range(k):
+        last = min(max(bisect.bisect_left(s2, stable[i] + max_span) - 1, i), i + k - 1)
+        si, li = stable[i], lo[i]
+        cand.extend((s2[j] - si, hi2[j] - li, i, j) for j in range(i, last + 1))
+    cand.sort(key=lambda c: c[0])  # stable: equal spans keep the (i, j) order
+    kept: list[tuple[float, float, int, int]] = []
+    best = -math.inf
+    for c in cand:
+        if c[1] > best:
+            best = c[1]
+            if kept and kept[-1][0] == c[0]:
+                kept[-1] = c  # of equal spans only the last (the widest) stays
+            else:
+                kept.append(c)
+    span = [c[0] for c in kept]
+    width = [c[1] for c in kept]
+    first = [stable[c[2]] for c in kept]
+    lo_kept = [lo[c[2]] for c in kept]
+    arrays = [np.array(x, dtype=np.float64) for x in (lo_kept, width, first, span)]
+    return ArcFront(f.kind, *arrays, span, width)
 
 
 PRUNE_STATES = 256
@@ -492,6 +529,26 @@ class Staircase:
     c_list: list[float]
     tol: float
     accuracy: float
+    rest_list: list[float] = field(default_factory=list)
+    width_list: list[float] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if len(self.rest_list) != len(self.c_list):
+            object.__setattr__(self, "rest_list", self.rest.tolist())
+            object.__setattr__(self, "width_list", self.width.tolist())
+
+    def tau_list(self, xs: list[float]) -> list[float]:
+        """:meth:`tau` in plain Python floats (the same operations, for a few spans)."""
+        n, c, rest, width = len(self.c_list), self.c_list, self.rest_list, self.width_list
+        floor = self.accuracy - _ROUNDING
+        out = []
+        for x in xs:
+            r = bisect.bisect_left(c, x)
+            at = rest[r] if r < n else -math.inf
+            before = 0.5 * (width[r - 1] - x) if r > 0 else -math.inf
+            value = at if at >= before else before
+            out.append(value if value > self.tol and value >= floor else -math.inf)
+        return out
 
     def tau(self, x: FloatArray) -> FloatArray:
         """Best least margin for images of spans ``x`` (``-inf`` where none fits)."""
@@ -506,8 +563,8 @@ class Staircase:
     def pick(self, x: float) -> Arc:
         """The arc that attains ``tau(x)`` for one span ``x``."""
         r = bisect.bisect_left(self.c_list, x)
-        at = float(self.rest[r]) if r < len(self.c_list) else -math.inf
-        before = 0.5 * (float(self.width[r - 1]) - x) if r > 0 else -math.inf
+        at = self.rest_list[r] if r < len(self.c_list) else -math.inf
+        before = 0.5 * (self.width_list[r - 1] - x) if r > 0 else -math.inf
         return self.front.arc(int(self.index[r if at >= before else r - 1]))
 
 
@@ -533,6 +590,8 @@ def staircase(
     >>> np.degrees(last.tau(np.radians([0.0, 90.0, 130.0]))).round(6).tolist()
     [63.434949, 18.434949, -inf]
     """
+    if len(front) <= SMALL:
+        return _staircase_python(front, after, tol, accuracy)
     if after is None:  # the last action collapses one basin: only single basins count
         index = np.flatnonzero(front.span <= 0.0)
         rest = np.full(len(index), np.inf)
@@ -545,6 +604,49 @@ def staircase(
     width = front.width[index]
     c = width - 2.0 * rest
     return Staircase(front, index, rest, width, c, c.tolist(), tol, accuracy)
+
+
+def _staircase_python(
+    front: ArcFront, after: Staircase | None, tol: float, accuracy: float
+) -> Staircase:
+    """:func:`staircase` in plain Python floats for a small front, step for step."""
+    spans, widths = front.span_list, front.width_list
+    if after is None:
+        index = [n for n, x in enumerate(spans) if x <= 0.0]
+        rest = [math.inf] * len(index)
+    else:
+        values = after.tau_list(spans)
+        index = [n for n, v in enumerate(values) if v > tol]
+        rest = [values[n] for n in index]
+    # pareto_front(-rest, width): most rest first (a stable sort), widths strictly
+    # increasing, of equal rests the last kept.
+    neg = [-r for r in rest]
+    kept: list[int] = []
+    best = -math.inf
+    for o in sorted(range(len(neg)), key=neg.__getitem__):
+        w = widths[index[o]]
+        if w > best:
+            best = w
+            if kept and neg[kept[-1]] == neg[o]:
+                kept[-1] = o
+            else:
+                kept.append(o)
+    idx = [index[o] for o in kept]
+    rest_kept = [rest[o] for o in kept]
+    width = [widths[n] for n in idx]
+    c = [w - 2.0 * r for w, r in zip(width, rest_kept, strict=True)]
+    return Staircase(
+        front,
+        np.array(idx, dtype=np.intp),
+        np.array(rest_kept, dtype=np.float64),
+        np.array(width, dtype=np.float64),
+        np.array(c, dtype=np.float64),
+        c,
+        tol,
+        accuracy,
+        rest_kept,
+        width,
+    )
 
 
 @dataclass(slots=True)
@@ -745,16 +847,23 @@ class ArcPlanner:
         front = self.front(kinds[0])
         wide = bisect.bisect_left(front.width_list, length - self.tol)  # arcs wide..end
         if len(kinds) == 1:
-            return [front.arc(wide + int(np.flatnonzero(front.span[wide:] <= 0.0)[0]))], None
+            single = next(n for n, x in enumerate(front.span_list[wide:]) if x <= 0.0)
+            return [front.arc(wide + single)], None
         cells = len(kinds) * max(len(self.front(t)) for t in set(kinds))
         if cells > STAIR_CELLS:
             return self.witnesses_by_margin(kinds, length)
         stairs = self.staircases(kinds[1:])
-        rest = stairs[0].tau(front.span[wide:])
-        best = float(rest.max())
+        if len(front) <= SMALL:
+            values = stairs[0].tau_list(front.span_list[wide:])
+            best = max(values)
+            at = next(n for n, v in enumerate(values) if v >= best - self.tol)
+        else:
+            rest = stairs[0].tau(front.span[wide:])
+            best = float(rest.max())
+            at = int(np.flatnonzero(rest >= best - self.tol)[0])
         if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
             raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-        chain = [front.arc(wide + int(np.flatnonzero(rest >= best - self.tol)[0]))]
+        chain = [front.arc(wide + at)]
         for stair in stairs:
             chain.append(stair.pick(chain[-1].span))
         return chain, best

@@ -325,12 +325,15 @@ def choose_among(
     >>> choose_among([6.0, 6.0, 7.0], [0.3, 0.5, 0.5])
     (0, 1)
     """
-    cost = np.asarray(costs, dtype=np.float64)
-    prob = np.asarray(probs, dtype=np.float64)
-    m = float(cost.min())
-    tie = cost - m <= COST_RTOL * abs(m) if math.isfinite(m) else np.ones(len(cost), bool)
-    bayes = int(np.flatnonzero(tie)[0])
-    most = int(np.flatnonzero(prob >= prob.max() - tol)[0])
+    cost = [float(c) for c in costs]
+    prob = [float(p) for p in probs]
+    m = min(cost)
+    if math.isfinite(m):
+        bayes = next(i for i, c in enumerate(cost) if c - m <= COST_RTOL * abs(m))
+    else:
+        bayes = 0
+    top = max(prob) - tol
+    most = next(i for i, p in enumerate(prob) if p >= top)
     return bayes, most
 
 
