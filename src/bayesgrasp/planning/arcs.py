@@ -290,8 +290,10 @@ def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
     width = [c[1] for c in kept]
     first = [stable[c[2]] for c in kept]
     lo_kept = [lo[c[2]] for c in kept]
-    arrays = [np.array(x, dtype=np.float64) for x in (lo_kept, width, first, span)]
-    return ArcFront(f.kind, *arrays, span, width)
+    lo_a, width_a, first_a, span_a = (
+        np.array(x, dtype=np.float64) for x in (lo_kept, width, first, span)
+    )
+    return ArcFront(f.kind, lo_a, width_a, first_a, span_a, span, width)
 
 
 PRUNE_STATES = 256
