@@ -9,6 +9,8 @@ Cases:
 
 - ``study``: the seed's 2000-polygon study (hull, diameter, squeeze function, exact Bayes
   plans with angles), as ``run_study(2000, seed=1)`` runs it;
+- ``batch``: ``plan --batch`` of the study's 2000 hulls as JSON lines, in one process (the
+  command's ``main``), beside the in-process study;
 - ``bfs``: the breadth-first baseline (``planning/bfs.py``) on the same 2000 polygons, beside
   the exact planner on the same problems (this branch only);
 - ``circle N``: N random points on the unit circle (N = 10^3, 10^4, 10^5);
@@ -93,6 +95,24 @@ elif case == "bfs":
         search_bfs(pbs[k], tree_count=False)
     c5 = time.process_time()
     out["over100"], out["exact100"], out["bfs100"] = len(over), c4 - c3, c5 - c4
+elif case == "batch":
+    import contextlib, io, os, tempfile
+    from bayesgrasp.cli import main
+    rng = np.random.default_rng(1)
+    path = os.path.join(tempfile.mkdtemp(), "parts.jsonl")
+    with open(path, "w") as fh:
+        for k in range(n):
+            hull = random_polygon(rng).hull.vertices.tolist()
+            fh.write(json.dumps({"name": f"p{k}", "vertices": hull}) + "\n")
+    sink = io.StringIO()
+    c0 = time.process_time()
+    with contextlib.redirect_stdout(sink):
+        code = main(["plan", "--batch", path])
+    out["cpu"] = time.process_time() - c0
+    out["lines"] = sink.getvalue().count("\n")
+    c0 = time.process_time()
+    run_study(n, 1)
+    out["study"] = time.process_time() - c0
 else:
     pts = points(case, n)
     if traced:
@@ -138,7 +158,7 @@ def best_of(src: Path, case: str, n: int, repeat: int, timeout: float) -> dict[s
     if not ok:
         return runs[0]
     out = min(ok, key=lambda r: r["cpu"])
-    if case not in ("study", "bfs"):
+    if case not in ("study", "bfs", "batch"):
         out["peak_mb"] = run(src, case, n, True, timeout).get("peak_mb")
     return out
 
@@ -189,6 +209,12 @@ def main() -> None:
             f"{b['exact']:.3f} s ({b['cpu'] / b['exact']:.1f}x); {b['over100']} polygons over "
             f"100 nodes: bfs {b['bfs100']:.3f} s, exact {b['exact100']:.3f} s "
             f"({b['bfs100'] / max(b['exact100'], 1e-9):.1f}x)"
+        )
+    r = best_of(HERE, "batch", args.polygons, args.repeat, args.timeout)
+    if "cpu" in r:
+        print(
+            f"plan --batch, {r['lines']} parts in one process: cpu {r['cpu']:.3f} s; the "
+            f"in-process study {r['study']:.3f} s ({r['cpu'] / r['study']:.2f}x)"
         )
     cases = [("circle", 1000), ("circle", 10_000), ("circle", 100_000)]
     cases += [("regular", 100_000), ("ellipse", 100_000)]

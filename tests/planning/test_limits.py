@@ -22,7 +22,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from bayesgrasp.errors import PlanningError
+from bayesgrasp.errors import PartError, PlanningError
 from bayesgrasp.geometry.polygon import Part
 from bayesgrasp.geometry.transfer import TransferFunction
 from bayesgrasp.model.cost import CostModel
@@ -208,3 +208,42 @@ def test_memory_of_a_many_state_part_is_bounded() -> None:
     assert rep.most_certain_plan.success_probability == pytest.approx(0.5)  # period pi
     # O(K) memory: the K^2 arcs would be 8 bytes x 1.4e8 = 1.1 GB each array.
     assert peak < 200e6, f"{peak / 1e6:.0f} MB for {k} states"
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    pts=st.one_of(
+        st.integers(0, 2**32 - 1).map(lambda s: np.random.default_rng(s).random((10, 2))),
+        st.integers(0, 2**32 - 1).map(
+            lambda s: np.round(np.random.default_rng(s).random((14, 2)) * 4) / 4
+        ),
+        st.integers(3, 40).map(lambda n: near_regular(n, 1e-9, n)),
+        st.integers(0, 2**32 - 1).map(lambda s: thin(30, s)),
+    ),
+    accuracy=st.sampled_from([0.0, 0.01]),
+    actions=st.sampled_from([("squeeze",), ("squeeze", "push-grasp")]),
+)
+def test_plain_python_and_numpy_plans_are_bit_identical(
+    pts: np.ndarray, accuracy: float, actions: tuple[str, ...]
+) -> None:
+    import bayesgrasp.planning.arcs as arcs
+
+    try:
+        part = Part.from_points(pts)
+    except PartError:
+        return
+    pb = Problem.build(part, actions=actions, accuracy=accuracy)
+    small = plan_exact(pb)
+    for f in pb.transfers.values():
+        for limit in (0.0, 1.0, TWO_PI):
+            a, b = arcs.arc_front(f, limit), arcs.arc_front(f, limit, prune=False)
+            assert a.span_list == b.span_list and a.width_list == b.width_list
+            assert np.array_equal(a.lo, b.lo) and np.array_equal(a.s_first, b.s_first)
+    saved = arcs.SMALL
+    arcs.SMALL = 0  # every front, staircase and pick by numpy
+    try:
+        large = plan_exact(Problem.build(part, actions=actions, accuracy=accuracy))
+    finally:
+        arcs.SMALL = saved
+    assert large.options == small.options
+    assert (large.bayes, large.most_certain) == (small.bayes, small.most_certain)
