@@ -794,7 +794,7 @@ class ArcPlanner:
             for kinds, length in plans
             if len(kinds) > 1 and len(kinds) * len(self.front(kinds[0])) > STAIR_CELLS
         ]
-        if len(todo) < 2:
+        if len(todo) < 16:  # one array pass per step pays off only for many chains
             return
         front = self.front(todo[0][0][0])
         spans, widths = front.span, front.width
