@@ -172,7 +172,7 @@ def test_batched_margins_equal_one_chain_at_a_time(monkeypatch: pytest.MonkeyPat
 
 @pytest.mark.parametrize(
     "points",
-    [circle_points(2000, 1), near_regular(500, 1e-3, 2), np.random.default_rng(4).random((12, 2))],
+    [circle_points(400, 1), near_regular(200, 1e-3, 2), np.random.default_rng(4).random((12, 2))],
     ids=["circle", "near-regular", "random"],
 )
 def test_report_best_is_the_bayes_and_most_certain_of_all(points: np.ndarray) -> None:
