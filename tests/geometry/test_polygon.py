@@ -442,3 +442,38 @@ def test_many_points(rng: np.random.Generator) -> None:
     assert poly.n_sides > 4000
     assert_allclose(poly.area, 3 * math.pi, rtol=1e-4)
     assert_allclose(poly.centroid, [0, 0], atol=1e-3)
+
+
+def sequential_hull(points: np.ndarray) -> np.ndarray:
+    """Andrew's monotone chain, one point at a time (the reference of the array version)."""
+    order = np.lexsort((points[:, 1], points[:, 0]))
+    pts = points[order]
+    chain = geometry._monotone_chain(pts[:, 0].tolist(), pts[:, 1].tolist())
+    return order[np.array(chain, dtype=np.intp)]
+
+
+@given(
+    pts=st.one_of(
+        lattice_points(min_size=3, max_size=300, bound=4),
+        lattice_points(min_size=3, max_size=200, bound=1000),
+        convex_points(),
+    )
+)
+def test_array_hull_is_the_sequential_chain(pts: np.ndarray) -> None:
+    # Duplicates, collinear runs, vertical edges: the same vertices, the same indices.
+    assert_array_equal(geometry._hull_indices(pts), sequential_hull(pts))
+
+
+def test_array_hull_on_large_clouds(rng: np.random.Generator) -> None:
+    t = rng.uniform(0, 2 * math.pi, 20_000)
+    clouds = [
+        rng.random((20_000, 2)),
+        np.column_stack([np.cos(t), np.sin(t)]),
+        np.round(rng.random((20_000, 2)) * 50) / 50,  # many repeated and collinear points
+        np.column_stack([2 * np.cos(np.sort(t)), np.sin(np.sort(t))]),
+    ]
+    for pts in clouds:
+        assert_array_equal(geometry._hull_indices(pts), sequential_hull(pts))
+    # Without rounds the array version gives up and the sequential chain runs.
+    xs, ys = clouds[0][:, 0], clouds[0][:, 1]
+    assert geometry._pruned_chain(xs, ys, np.arange(len(xs)), rounds=0) is None

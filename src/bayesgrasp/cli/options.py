@@ -28,6 +28,10 @@ PartArg = Annotated[
     str,
     typer.Argument(help="Catalogue name or part file (.json, .csv, .wkt, .geojson, .svg, .dxf)."),
 ]
+OptionalPartArg = Annotated[
+    str | None,
+    typer.Argument(metavar="PART", help=PartArg.__metadata__[0].help, show_default=False),
+]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print JSON for machines.")]
 ForceOpt = Annotated[
     bool,
@@ -114,8 +118,10 @@ def _opt(name: str, kind: Any, default: Any, *decls: str, **info: Any) -> inspec
     return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=hint)
 
 
-def _part_params() -> list[inspect.Parameter]:
+def _part_params(optional: bool = False) -> list[inspect.Parameter]:
     part = inspect.Parameter("part", inspect.Parameter.KEYWORD_ONLY, annotation=PartArg)
+    if optional:  # PART may be left out (plan --batch)
+        part = part.replace(annotation=OptionalPartArg, default=None)
     return [
         part,
         _opt("fmt", PartFormat | None, None, "--format", help=FORMAT_HELP),
@@ -207,9 +213,12 @@ def _replace(func: F, name: str, params: list[inspect.Parameter], make: Callable
     return command  # type: ignore[return-value]
 
 
-def part_options(func: F) -> F:
-    """Give a command PART and the part-file options, as its parameter ``part: PartSpec``."""
-    return _replace(func, "part", _part_params(), lambda values: PartSpec(**values))
+def part_options(func: F, optional: bool = False) -> F:
+    """Give a command PART and the part-file options, as its parameter ``part: PartSpec``.
+
+    ``optional``: PART may be left out (``PartSpec.part`` is then ``None``).
+    """
+    return _replace(func, "part", _part_params(optional), lambda values: PartSpec(**values))
 
 
 def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:

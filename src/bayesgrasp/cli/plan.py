@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import enum
+import functools
+import json
+import sys
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -29,7 +34,18 @@ from .options import (
 )
 from .specs import PartSpec, ProblemSpec
 
+if TYPE_CHECKING:
+    from ..geometry.polygon import Part
+
 app = command_app()
+
+
+class Only(enum.StrEnum):
+    """Which plans ``plan`` reports."""
+
+    all = "all"
+    best = "best"
+
 
 GuaranteedOpt = Annotated[
     bool,
@@ -87,12 +103,42 @@ ExportOpt = Annotated[
 ]
 
 
+MorePartsArg = Annotated[
+    list[str] | None,
+    typer.Argument(
+        metavar="[PART]...",
+        show_default=False,
+        help="More parts: each is planned on its own, one JSON document a line (with --sense: "
+        "candidate parts, as --also).",
+    ),
+]
+OnlyOpt = Annotated[
+    Only,
+    typer.Option(
+        "--only",
+        help="all: the best plan of every length; best: only the Bayes and the most certain "
+        "plans (for parts of thousands of states).",
+    ),
+]
+BatchOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--batch",
+        metavar="FILE.jsonl",
+        help='Plan one part a line ({"name": ..., "vertices": [...]} as a .json part file, or '
+        "a catalogue name or path as a JSON string; '-' reads stdin); one JSON document a "
+        "line, an error in its line.",
+    ),
+]
+
+
 @app.command()
-@part_options
+@functools.partial(part_options, optional=True)
 @problem_options()
 def plan(
     part: PartSpec,
     spec: ProblemSpec,
+    more_parts: MorePartsArg = None,
     guaranteed: GuaranteedOpt = False,
     as_json: JsonOpt = False,
     plot_file: PlotOpt = None,
@@ -105,11 +151,17 @@ def plan(
     payoff: PayoffOpt = None,
     force: ForceOpt = False,
     export: ExportOpt = None,
+    only: OnlyOpt = Only.all,
+    batch: BatchOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
     With --sense: the policy of least expected cost that branches on the jaw widths read
     after each action (and tells the candidate parts apart), beside the sensorless Bayes plan.
+
+    Several PARTs or --batch: each part planned in turn, one JSON document a line (as
+    --json prints it); a part that fails gets {"part": ..., "error": ..., "exit_code": ...}
+    on its line and the others go on; the exit code is the largest of the parts'.
     """
     from .. import report
     from ..io.plans import plan_document
@@ -120,20 +172,32 @@ def plan(
             raise typer.BadParameter(
                 "--sense, --guaranteed, --plot and --export do not take noise yet"
             )
+        if part.part is None or batch is not None or more_parts:
+            raise typer.BadParameter("noise options take one PART (no --batch)")
         noisy.plan_noisy_command(part.load(), spec, turn_noise, contact_noise, payoff, as_json)
         return
     if sense is not None:
-        _policy(part, spec, sense, also or [], part_prior, max_actions, as_json)
+        if part.part is None or batch is not None:
+            raise typer.BadParameter("--sense needs PART and takes no --batch")
+        more = [*(more_parts or []), *(also or [])]
+        _policy(part, spec, sense, more, part_prior, max_actions, as_json)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
+    if batch is not None or more_parts:
+        if plot_file is not None:
+            raise typer.BadParameter("--plot takes one PART", param_hint="--plot")
+        _many(part, more_parts or [], batch, spec, guaranteed, only is Only.best)
+        return
+    if part.part is None:
+        raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
     if plot_file is not None:
         check_figure_path(plot_file)
         check_outputs([plot_file], input_files(part.part, spec.prior), force, "--plot")
     if export is not None:
         check_export(export, input_files(part.part, spec.prior), force)
     pb = spec.build(part.load())
-    result = spec.plan(pb)
+    result = spec.plan(pb, best_only=only is Only.best)
     found = guaranteed_plan(pb) if guaranteed else None
     sure, missing = (None, found) if isinstance(found, str) else (found, None)
     if as_json:
@@ -190,3 +254,90 @@ def _policy(
             f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
             f"(bits): {entropy}"
         )
+
+
+def _many(
+    part: PartSpec,
+    more: list[str],
+    batch: Path | None,
+    spec: ProblemSpec,
+    guaranteed: bool,
+    best_only: bool,
+) -> None:
+    """Plan each part in turn, one JSON document a line; errors stay in their line."""
+    code = 0
+    inputs = run_inputs(part, spec)
+    for label, load in _batch_parts(part, more, batch):
+        doc, status = _one_document(label, load, spec, guaranteed, best_only, inputs)
+        code = max(code, status)
+        typer.echo(json.dumps(doc, allow_nan=False))
+    if code:
+        raise typer.Exit(code)
+
+
+def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterator[tuple[str, Any]]:
+    """(label, loader) of each part: PART, the more PARTs, then each line of ``batch``.
+
+    A loader returns the :class:`Part` or raises a BayesGraspError with its one-line reason.
+    """
+    import dataclasses
+
+    from ..errors import PartFileError
+    from ..io import read_part_bytes
+
+    names = ([part.part] if part.part is not None else []) + more
+    for name in names:
+        yield name, dataclasses.replace(part, part=name).load
+    if batch is None:
+        return
+    stream = sys.stdin if str(batch) == "-" else None
+    try:
+        handle = stream or batch.open(encoding="utf-8")
+    except OSError as exc:
+        raise typer.BadParameter(
+            f"cannot read {batch}: {exc.strerror or exc}", param_hint="--batch"
+        ) from None
+    with handle:
+        for number, line in enumerate(handle, start=1):
+            text = line.strip()
+            if not text:
+                continue
+            label = f"{batch}:{number}"
+
+            def load(text: str = text, label: str = label) -> Part:
+                try:
+                    value = json.loads(text)
+                except ValueError as exc:
+                    raise PartFileError(f"{label}: not a JSON value: {exc}") from None
+                if isinstance(value, str):
+                    return dataclasses.replace(part, part=value).load()
+                if isinstance(value, dict):  # a .json part file on one line
+                    return read_part_bytes(text.encode(), "json", label)
+                raise PartFileError(
+                    f"{label}: expected a part object or a part name; got {type(value).__name__}"
+                )
+
+            yield label, load
+
+
+def _one_document(
+    label: str,
+    load: Any,
+    spec: ProblemSpec,
+    guaranteed: bool,
+    best_only: bool,
+    inputs: dict[str, Any],
+) -> tuple[dict[str, Any], int]:
+    """The plan document of one part (as ``plan --json``) and its exit code, or its error."""
+    from ..errors import BayesGraspError
+    from ..io.plans import plan_document
+
+    try:
+        pb = spec.build(load())
+        result = spec.plan(pb, best_only=best_only)
+        found = guaranteed_plan(pb) if guaranteed else None
+    except BayesGraspError as exc:
+        return {"part": label, "error": str(exc), "exit_code": 2}, 2
+    sure, missing = (None, found) if isinstance(found, str) else (found, None)
+    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+    return doc, 1 if missing is not None else 0

@@ -134,9 +134,16 @@ class ProblemSpec:
             accuracy=math.radians(self.accuracy_deg),
         )
 
-    def plan(self, problem: Problem) -> PlanReport:
-        """The best plan of every length, by the chosen planner."""
+    def plan(self, problem: Problem, best_only: bool = False) -> PlanReport:
+        """The best plan of every length, by the chosen planner.
+
+        ``best_only``: only the Bayes and the most certain plans.
+        """
         from ..planning import plan_bfs, plan_exact
 
-        planner = plan_bfs if self.method is Method.bfs else plan_exact
-        return planner(problem, max_actions=self.max_actions)
+        if self.method is Method.bfs:
+            found = plan_bfs(problem, max_actions=self.max_actions)
+            return found.best_only() if best_only else found
+        return plan_exact(
+            problem, max_actions=self.max_actions, report="best" if best_only else "all"
+        )

@@ -46,6 +46,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..angles import TWO_PI
 from ..errors import BayesGraspError
+from ..sizes import SMALL
 from .polygon import ConvexPolygon
 
 __all__ = ["DiameterFunction", "diameter_function"]
@@ -191,9 +192,9 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     return DiameterFunction(polygon, *arrays)
 
 
-# Below this many vertices plain Python floats beat numpy's cost per call; both paths make
-# the same decisions (tests/geometry/test_diameter.py and test_numerics.py compare them).
-_SMALL = 40
+# At or below this many vertices plain Python floats beat numpy's cost per call; both paths
+# make the same decisions (tests/geometry/test_diameter.py and test_numerics.py compare them).
+_SMALL = SMALL
 
 Extrema = tuple[list[float], list[float], list[float], list[float]]
 """Angles and values of d at the minima, then angles and values at the maxima."""

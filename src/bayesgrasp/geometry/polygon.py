@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import PartError
+from ..sizes import SMALL
 from ..tolerance import DEFAULT_TOLERANCE, Tolerance
 
 __all__ = ["ConvexPolygon", "Part", "as_points", "find_crossing", "polygon_area_centroid"]
@@ -197,8 +198,53 @@ def _hull_indices(points: FloatArray) -> NDArray[np.intp]:
     """
     order = np.lexsort((points[:, 1], points[:, 0]))
     pts = points[order]
-    chain = _monotone_chain(pts[:, 0].tolist(), pts[:, 1].tolist())
-    return order[np.array(chain, dtype=np.intp)]
+    xs, ys = pts[:, 0], pts[:, 1]
+    idx = np.arange(len(pts))
+    lower, upper = _pruned_chain(xs, ys, idx), _pruned_chain(xs, ys, idx[::-1])
+    if lower is None or upper is None:
+        chain = np.array(_monotone_chain(xs.tolist(), ys.tolist()), dtype=np.intp)
+    else:
+        chain = np.concatenate([lower[:-1], upper[:-1]])
+    return order[chain]
+
+
+def _pruned_chain(
+    xs: FloatArray, ys: FloatArray, idx: NDArray[np.intp], rounds: int = 64
+) -> NDArray[np.intp] | None:
+    """One half of Andrew's monotone chain by array operations.
+
+    The points ``idx`` (sorted) less every point that does not turn strictly left between
+    its neighbours, until none does. A point that turns right or goes straight between two
+    others lies on or above the segment joining them (below, for the upper half), so it is
+    no strict vertex of this half of the hull; removing every such point at once is safe,
+    and what remains (a chain from the first point to the last turning strictly left at
+    every point) is exactly what the monotone chain keeps. Usually a few rounds of O(N);
+    ``None`` after ``rounds`` rounds
+    (the caller then runs the sequential chain).
+
+    Repeated points are first reduced to the one the monotone chain keeps: the first of
+    those equal to the starting point, the last of every other run.
+    """
+    x, y = xs[idx], ys[idx]
+    same = (x[1:] == x[:-1]) & (y[1:] == y[:-1])  # point i + 1 repeats point i
+    if same.any():
+        run0 = int(np.argmin(np.append(same, False)))  # points 1..run0 repeat the first
+        drop = np.append(same, False)  # keep the last of a run ...
+        drop[: run0 + 1] = False
+        drop[1 : run0 + 1] = True  # ... but the first of the starting run
+        idx = idx[~drop]
+    for _ in range(rounds):
+        if len(idx) < 3:
+            return idx
+        x, y = xs[idx], ys[idx]
+        cross = (x[1:-1] - x[:-2]) * (y[2:] - y[:-2]) - (y[1:-1] - y[:-2]) * (x[2:] - x[:-2])
+        bad = cross <= 0.0
+        if not bad.any():
+            return idx
+        keep = np.ones(len(idx), dtype=bool)
+        keep[1:-1] = ~bad
+        idx = idx[keep]
+    return None
 
 
 def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
@@ -311,7 +357,7 @@ def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
 
 
 # Up to this many points, ConvexPolygon.from_points works on Python floats (faster there).
-_SMALL = 64
+_SMALL = SMALL
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -816,11 +862,22 @@ def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
 def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
     """Whether ``point`` lies strictly inside the convex polygon (by more than the tolerance)."""
     v = hull.vertices
+    margin = hull.tol.length_for(hull.size)
+    if len(v) <= SMALL:  # on Python floats (math.hypot may differ from numpy's by an ulp)
+        xs, ys = v[:, 0].tolist(), v[:, 1].tolist()
+        px, py = float(point[0]), float(point[1])
+        n = len(xs)
+        for i in range(n):
+            ex, ey = xs[(i + 1) % n] - xs[i], ys[(i + 1) % n] - ys[i]
+            cross = ex * (py - ys[i]) - ey * (px - xs[i])
+            if not cross / math.hypot(ex, ey) > margin:
+                return False
+        return True
     e = np.roll(v, -1, axis=0) - v
     rel = point - v
     cross = e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0]
     lengths = np.hypot(e[:, 0], e[:, 1])
-    return bool(np.all(cross / lengths > hull.tol.length_for(hull.size)))
+    return bool(np.all(cross / lengths > margin))
 
 
 def _clean_ring(points: ArrayLike, what: str) -> FloatArray:

@@ -146,7 +146,13 @@ class CostModel:
         """Expected cost of repeating the plan until verification succeeds (inf if p = 0)."""
         if p <= 0.0:
             return math.inf
-        return self.attempt_cost(names) / p + self.retry * (1.0 / p - 1.0)
+        return self.expected_from_attempt(self.attempt_cost(names), p)
+
+    def expected_from_attempt(self, attempt: float, p: float) -> float:
+        """:meth:`expected_cost` of a plan whose :meth:`attempt_cost` is ``attempt``."""
+        if p <= 0.0:
+            return math.inf
+        return attempt / p + self.retry * (1.0 / p - 1.0)
 
     def to_json(self) -> dict[str, object]:
         """The cost model as a JSON object (for documents that record their inputs)."""

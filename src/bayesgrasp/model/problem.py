@@ -289,7 +289,9 @@ class Problem:
     def goal_group(self) -> int:
         """Number of orientations the goal counts as one (the part's symmetry only if asked)."""
         if "goal_group" not in self._cache:
-            self._cache["goal_group"] = self.goal.group_order(self.part.hull.symmetry_order)
+            # The symmetry test only when the goal counts symmetric orientations as one.
+            order = self.part.hull.symmetry_order if self.goal.kind == "symmetry" else 1
+            self._cache["goal_group"] = self.goal.group_order(order)
         return int(self._cache["goal_group"])
 
     def success_states(self, final_orientation: float) -> NDArray[np.bool_]:

@@ -99,10 +99,13 @@ from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.problem import Problem
+from ..sizes import SMALL
 from .result import PlanOption, plan_actions, short_turns
 
 __all__ = [
     "ARC_CHUNK",
+    "PRUNE_STATES",
+    "STAIR_CELLS",
     "Arc",
     "ArcFront",
     "ArcPlanner",
@@ -195,7 +198,9 @@ class ArcFront:
         return self.width_list[n] if n >= 0 else 0.0
 
 
-def arc_front(f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK) -> ArcFront:
+def arc_front(
+    f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK, prune: bool | None = None
+) -> ArcFront:
     """The front of the arcs of ``f`` whose image spans less than ``max_span``.
 
     Single basins (span 0) are always arcs, even when ``max_span <= 0``. Of arcs equal in
@@ -208,6 +213,10 @@ def arc_front(f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK) -
         Only arcs whose image spans less than this count.
     chunk : int
         Candidate arcs enumerated at once (the front does not depend on it).
+    prune : bool, optional
+        Enumerate only the arcs that can be on the front (:func:`_pruned_candidates`; the
+        default above :data:`PRUNE_STATES` states) or every arc (O(K^2)). The front is the
+        same, bit for bit.
 
     Returns
     -------
@@ -222,31 +231,228 @@ def arc_front(f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK) -
     >>> np.degrees(front.span).round(6).tolist(), np.degrees(front.width).round(6).tolist()
     ([0.0, 90.0, 180.0, 270.0], [126.869898, 180.0, 306.869898, 360.0])
     """
-    k = f.n_states
-    s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
-    hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
+    if f.n_states <= SMALL and prune is None:
+        return _arc_front_python(f, max_span)
+    geo = _ArcGeometry(f, max_span)
+    cand = None
+    if prune if prune is not None else f.n_states > PRUNE_STATES:
+        cand = _pruned_candidates(geo)
+    if cand is not None:
+        lo, width, first, span = geo.arcs(*cand)
+        keep = pareto_front(span, width)
+        lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
+        return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+    k = geo.k
     i_all = np.arange(k)
-    # Last basin j of an arc starting at basin i: at most K basins, image span < max_span,
-    # at least basin i itself.
-    last = np.clip(np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1)
-    n_off = int(np.max(last - i_all)) + 1
+    n_off = int(np.max(geo.last - i_all)) + 1
     rows = max(1, chunk // n_off)
     parts: list[tuple[FloatArray, ...]] = []
     for start in range(0, k, rows):
         i = i_all[start : start + rows]
         j = i[:, None] + np.arange(n_off)[None, :]  # (R, J) candidate last basins
-        ok = j <= last[i, None]
-        ii = np.broadcast_to(i[:, None], j.shape)[ok]
-        jj = j[ok]
-        lo = f.basin_lo[ii]
-        width = hi2[jj] - lo
-        span = s2[jj] - f.stable[ii]
+        ok = j <= geo.last[i, None]
+        lo, width, first, span = geo.arcs(np.broadcast_to(i[:, None], j.shape)[ok], j[ok])
         keep = pareto_front(span, width)
-        parts.append((lo[keep], width[keep], f.stable[ii][keep], span[keep]))
+        parts.append((lo[keep], width[keep], first[keep], span[keep]))
     lo, width, first, span = (np.concatenate(x) for x in zip(*parts, strict=True))
     keep = pareto_front(span, width)
     lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
     return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+
+
+def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
+    """:func:`arc_front` in plain Python floats for a few states, step for step.
+
+    The same candidates in the same order (first basin, then last), the same float
+    operations and the same Pareto rule (:func:`pareto_front`: by span, a stable sort,
+    widths strictly increasing, the last of equal spans): the same front, bit for bit.
+    """
+    k = f.n_states
+    stable, lo, hi = f.stable.tolist(), f.basin_lo.tolist(), f.basin_hi.tolist()
+    s2 = stable + [x + TWO_PI for x in stable]
+    hi2 = hi + [x + TWO_PI for x in hi]
+    cand: list[tuple[float, float, int, int]] = []  # (span, width, i, j), in (i, j) order
+    for i in range(k):
+        last = min(max(bisect.bisect_left(s2, stable[i] + max_span) - 1, i), i + k - 1)
+        si, li = stable[i], lo[i]
+        cand.extend((s2[j] - si, hi2[j] - li, i, j) for j in range(i, last + 1))
+    cand.sort(key=lambda c: c[0])  # stable: equal spans keep the (i, j) order
+    kept: list[tuple[float, float, int, int]] = []
+    best = -math.inf
+    for c in cand:
+        if c[1] > best:
+            best = c[1]
+            if kept and kept[-1][0] == c[0]:
+                kept[-1] = c  # of equal spans only the last (the widest) stays
+            else:
+                kept.append(c)
+    span = [c[0] for c in kept]
+    width = [c[1] for c in kept]
+    first = [stable[c[2]] for c in kept]
+    lo_kept = [lo[c[2]] for c in kept]
+    lo_a, width_a, first_a, span_a = (
+        np.array(x, dtype=np.float64) for x in (lo_kept, width, first, span)
+    )
+    return ArcFront(f.kind, lo_a, width_a, first_a, span_a, span, width)
+
+
+PRUNE_STATES = 256
+"""Above this many states :func:`arc_front` enumerates only the arcs that can be on the front."""
+
+# An arc's width less its span is computed as left(i) + right(j) for the pruning; the two
+# differ from ``width - span`` by rounding (a few ulps of 4 pi), far below this.
+_EXCESS_SLACK = 1e-12
+STAIR_CELLS = 2_000_000
+"""Most staircase entries one witness chain may build; longer chains bisect on the margin."""
+
+# Steps of the front filled by enumeration in one round; more, and the threshold is lowered.
+_MAX_STEPS = 16
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _ArcGeometry:
+    """The arcs of one transfer function: arc ``(i, j)`` covers basins ``i..j`` (j < i + K).
+
+    ``j`` indexes the basins repeated once round the circle (``j >= K`` is basin ``j - K``
+    2 pi on); ``last[i]`` is the last basin an arc from ``i`` may reach (its image spans
+    less than ``max_span``, and at least basin ``i`` itself).
+    """
+
+    f: TransferFunction
+    k: int
+    s2: FloatArray
+    hi2: FloatArray
+    last: NDArray[np.intp]
+
+    def __init__(self, f: TransferFunction, max_span: float) -> None:
+        k = f.n_states
+        s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
+        hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
+        i_all = np.arange(k)
+        last = np.clip(
+            np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1
+        )
+        for name, value in (("f", f), ("k", k), ("s2", s2), ("hi2", hi2), ("last", last)):
+            object.__setattr__(self, name, value)
+
+    def arcs(self, ii: NDArray[np.intp], jj: NDArray[np.intp]) -> tuple[FloatArray, ...]:
+        """``lo``, ``width``, ``s_first`` and ``span`` of the arcs ``(ii, jj)``."""
+        lo = self.f.basin_lo[ii]
+        return lo, self.hi2[jj] - lo, self.f.stable[ii], self.s2[jj] - self.f.stable[ii]
+
+    def spans_between(self, a: float, b: float) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """Every arc whose image spans between ``a`` and ``b`` (a little more, never less)."""
+        s, k = self.f.stable, self.k
+        i_all = np.arange(k)
+        j0 = np.maximum(np.searchsorted(self.s2, s + (a - _EXCESS_SLACK), side="left"), i_all)
+        j1 = np.minimum(
+            np.searchsorted(self.s2, s + (b + _EXCESS_SLACK), side="right") - 1, self.last
+        )
+        return _ranges(i_all, j0, j1)
+
+
+def _ranges(
+    i: NDArray[np.intp], j0: NDArray[np.intp], j1: NDArray[np.intp]
+) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The pairs ``(i[r], j)`` for ``j0[r] <= j <= j1[r]``, by ``r`` then ``j``."""
+    count = np.maximum(j1 - j0 + 1, 0)
+    total = int(count.sum())
+    ii = np.repeat(i, count)
+    starts = np.repeat(np.cumsum(count) - count, count)
+    jj = np.repeat(j0, count) + (np.arange(total) - starts)
+    return ii, jj
+
+
+def _pruned_candidates(geo: _ArcGeometry) -> tuple[NDArray[np.intp], NDArray[np.intp]] | None:
+    """The arcs that can be on the front (or tie with it), in the order ``(i, j)``.
+
+    An arc's width is its span plus its *excess* ``l_i + r_j``: the half of basin ``i``
+    before its stable orientation and the half of basin ``j`` after. The front is a
+    staircase of points ``(span_n, width_n)``; an arc of span in ``[span_n, span_{n+1})``
+    and excess below ``T`` is strictly narrower than point ``n`` when
+    ``width_n >= span_{n+1} + T``. So: take the arcs of excess at least ``T`` (a few per
+    state, the threshold found by bisection on the counts) and the arcs of one or two
+    basins, compute their front, and enumerate every arc whose span falls in a step where
+    that inequality fails (also past the last point); repeat until no step fails. Each
+    round only adds arcs, so the front found is that of all arcs, and every arc tied with
+    a front point has an excess above ``T`` and is among the candidates. When the steps to
+    fill grow too many the threshold is lowered; ``None`` when the candidates would be
+    nearly all arcs (a regular polygon: every excess is equal), which are then enumerated
+    in chunks. Memory O(C), time O((K + C) log K) for C candidates (a few per state on
+    random parts).
+    """
+    k, f = geo.k, geo.f
+    left = f.stable - f.basin_lo  # (K,) l_i
+    right = f.basin_hi - f.stable  # (K,) r_j
+    r_order = np.argsort(-right, kind="stable")
+    r_desc = right[r_order]
+    neg = -r_desc  # increasing
+    i_all = np.arange(k)
+    max_span = float(np.max(geo.s2[geo.last] - f.stable))
+    total = int(np.sum(geo.last - i_all + 1))
+    budget = 8 * k
+    while True:
+        if 16 * budget >= total:  # nearly as many as all arcs
+            return None
+        # Threshold T with about `budget` pairs of excess >= T - slack.
+        lo_t, hi_t = float(left.min() + right.min()), float(left.max() + right.max())
+        for _ in range(60):
+            mid = 0.5 * (lo_t + hi_t)
+            n = int(np.searchsorted(neg, left - (mid - _EXCESS_SLACK), side="right").sum())
+            lo_t, hi_t = (mid, hi_t) if n > budget else (lo_t, mid)
+        t = hi_t
+        count = np.searchsorted(neg, left - (t - _EXCESS_SLACK), side="right")
+        ii = np.repeat(i_all, count)
+        starts = np.repeat(np.cumsum(count) - count, count)
+        jj = r_order[np.arange(len(ii)) - starts]
+        jj = np.where(jj >= ii, jj, jj + k)
+        ok = jj <= geo.last[ii]
+        few_i, few_j = _ranges(i_all, i_all, np.minimum(i_all + 1, geo.last))
+        ii, jj = np.concatenate([ii[ok], few_i]), np.concatenate([jj[ok], few_j])
+        done: list[tuple[float, float]] = []  # span intervals enumerated in full
+        limit = 16 * budget
+        while True:
+            key = np.sort(ii * (2 * k) + jj)  # by (i, j), without repeats
+            key = key[np.append(True, key[1:] != key[:-1])]
+            ii, jj = key // (2 * k), key % (2 * k)
+            if len(ii) > limit:
+                break
+            _, width, _, span = geo.arcs(ii, jj)
+            keep = pareto_front(span, width)
+            fs, fw = span[keep], width[keep]
+            nxt = np.append(fs[1:], max_span)
+            bad = np.flatnonzero(fw < nxt + t)
+            todo = [
+                (float(fs[n]), float(nxt[n]))
+                for n in bad
+                if not any(a <= fs[n] and nxt[n] <= b for a, b in done)
+            ]
+            if not todo:
+                return ii, jj
+            steps = _merge(todo)
+            if len(steps) > _MAX_STEPS:  # the threshold is too high: lower it
+                break
+            new_i, new_j = [ii], [jj]
+            for a, b in steps:
+                more_i, more_j = geo.spans_between(a, b)
+                new_i.append(more_i)
+                new_j.append(more_j)
+                done.append((a, b))
+            ii, jj = np.concatenate(new_i), np.concatenate(new_j)
+            if len(ii) > limit:
+                break
+        budget *= 4
+
+
+def _merge(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """Touching or overlapping intervals joined (sorted by start)."""
+    out: list[tuple[float, float]] = []
+    for a, b in sorted(intervals):
+        if out and a <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], b))
+        else:
+            out.append((a, b))
+    return out
 
 
 def pareto_front(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
@@ -325,6 +531,26 @@ class Staircase:
     c_list: list[float]
     tol: float
     accuracy: float
+    rest_list: list[float] = field(default_factory=list)
+    width_list: list[float] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if len(self.rest_list) != len(self.c_list):
+            object.__setattr__(self, "rest_list", self.rest.tolist())
+            object.__setattr__(self, "width_list", self.width.tolist())
+
+    def tau_list(self, xs: list[float]) -> list[float]:
+        """:meth:`tau` in plain Python floats (the same operations, for a few spans)."""
+        n, c, rest, width = len(self.c_list), self.c_list, self.rest_list, self.width_list
+        floor = self.accuracy - _ROUNDING
+        out = []
+        for x in xs:
+            r = bisect.bisect_left(c, x)
+            at = rest[r] if r < n else -math.inf
+            before = 0.5 * (width[r - 1] - x) if r > 0 else -math.inf
+            value = at if at >= before else before
+            out.append(value if value > self.tol and value >= floor else -math.inf)
+        return out
 
     def tau(self, x: FloatArray) -> FloatArray:
         """Best least margin for images of spans ``x`` (``-inf`` where none fits)."""
@@ -339,8 +565,8 @@ class Staircase:
     def pick(self, x: float) -> Arc:
         """The arc that attains ``tau(x)`` for one span ``x``."""
         r = bisect.bisect_left(self.c_list, x)
-        at = float(self.rest[r]) if r < len(self.c_list) else -math.inf
-        before = 0.5 * (float(self.width[r - 1]) - x) if r > 0 else -math.inf
+        at = self.rest_list[r] if r < len(self.c_list) else -math.inf
+        before = 0.5 * (self.width_list[r - 1] - x) if r > 0 else -math.inf
         return self.front.arc(int(self.index[r if at >= before else r - 1]))
 
 
@@ -366,6 +592,8 @@ def staircase(
     >>> np.degrees(last.tau(np.radians([0.0, 90.0, 130.0]))).round(6).tolist()
     [63.434949, 18.434949, -inf]
     """
+    if len(front) <= SMALL:
+        return _staircase_python(front, after, tol, accuracy)
     if after is None:  # the last action collapses one basin: only single basins count
         index = np.flatnonzero(front.span <= 0.0)
         rest = np.full(len(index), np.inf)
@@ -378,6 +606,49 @@ def staircase(
     width = front.width[index]
     c = width - 2.0 * rest
     return Staircase(front, index, rest, width, c, c.tolist(), tol, accuracy)
+
+
+def _staircase_python(
+    front: ArcFront, after: Staircase | None, tol: float, accuracy: float
+) -> Staircase:
+    """:func:`staircase` in plain Python floats for a small front, step for step."""
+    spans, widths = front.span_list, front.width_list
+    if after is None:
+        index = [n for n, x in enumerate(spans) if x <= 0.0]
+        rest = [math.inf] * len(index)
+    else:
+        values = after.tau_list(spans)
+        index = [n for n, v in enumerate(values) if v > tol]
+        rest = [values[n] for n in index]
+    # pareto_front(-rest, width): most rest first (a stable sort), widths strictly
+    # increasing, of equal rests the last kept.
+    neg = [-r for r in rest]
+    kept: list[int] = []
+    best = -math.inf
+    for o in sorted(range(len(neg)), key=neg.__getitem__):
+        w = widths[index[o]]
+        if w > best:
+            best = w
+            if kept and neg[kept[-1]] == neg[o]:
+                kept[-1] = o
+            else:
+                kept.append(o)
+    idx = [index[o] for o in kept]
+    rest_kept = [rest[o] for o in kept]
+    width = [widths[n] for n in idx]
+    c = [w - 2.0 * r for w, r in zip(width, rest_kept, strict=True)]
+    return Staircase(
+        front,
+        np.array(idx, dtype=np.intp),
+        np.array(rest_kept, dtype=np.float64),
+        np.array(width, dtype=np.float64),
+        np.array(c, dtype=np.float64),
+        c,
+        tol,
+        accuracy,
+        rest_kept,
+        width,
+    )
 
 
 @dataclass(slots=True)
@@ -407,6 +678,9 @@ class ArcPlanner:
     # none), with its own id: a suffix of a plan is found in O(1) from the next one.
     stairs: dict[tuple[str, int], tuple[int, Staircase]] = field(default_factory=dict)
     best: dict[Counts, tuple[float, str]] = field(default_factory=dict)
+    orders: dict[Counts, tuple[str, ...]] = field(default_factory=dict)  # see _rest_order
+    # Least margins bisected ahead, by (action types, length): see prepare_margins.
+    margins: dict[tuple[tuple[str, ...], float], float] = field(default_factory=dict)
     index: dict[str, int] = field(init=False)  # position of each action type in a Counts
     period: float = field(init=False)
 
@@ -478,14 +752,78 @@ class ArcPlanner:
 
     def order(self, counts: Counts, first: str) -> tuple[str, ...]:
         """Action types of a plan in order: ``first``, then the best order of the rest."""
-        kinds = [first]
         left = list(counts)
         left[self.index[first]] -= 1
-        while any(left):
-            kind = self.best[tuple(left)][1]
-            kinds.append(kind)
-            left[self.index[kind]] -= 1
-        return tuple(kinds)
+        return (first, *self._rest_order(tuple(left)))
+
+    def _rest_order(self, counts: Counts) -> tuple[str, ...]:
+        """The best order of actions of these counts (memoised: each is one longer)."""
+        if counts in self.orders:
+            return self.orders[counts]
+        chain: list[Counts] = []  # counts whose order is not known yet, longest first
+        c = counts
+        while any(c) and c not in self.orders:
+            chain.append(c)
+            left = list(c)
+            left[self.index[self.best[c][1]]] -= 1
+            c = tuple(left)
+        out = self.orders.get(c, ())
+        for c in reversed(chain):
+            out = (self.best[c][1], *out)
+            self.orders[c] = out
+        return out
+
+    def _margin_bracket(self) -> tuple[float, float]:
+        """A least margin every chain attains, and one none does (bisection's start)."""
+        return max(self.tol, self.problem.accuracy), 4.0
+
+    def prepare_margins(self, plans: list[tuple[tuple[str, ...], float]]) -> None:
+        """Bisect the margins of many chains of one action type at once (same results).
+
+        ``plans`` are (action types, success-arc length) pairs. For a single action type
+        the widths ``U`` of :meth:`witnesses_by_margin` depend only on the distance from
+        the last action, so one pass of array operations advances the bisection of every
+        chain by one step: the same steps, hence the same margins, as one chain at a time,
+        in O(62 k_max) array operations instead of O(62 sum k) scalar ones. Only chains that
+        :meth:`witnesses` would bisect are done; the rest are left to it.
+        """
+        if len(self.problem.action_kinds) != 1:
+            return
+        todo = [
+            (kinds, length)
+            for kinds, length in plans
+            if len(kinds) > 1 and len(kinds) * len(self.front(kinds[0])) > STAIR_CELLS
+        ]
+        if len(todo) < 16:  # one array pass per step pays off only for many chains
+            return
+        front = self.front(todo[0][0][0])
+        spans, widths = front.span, front.width
+        steps = np.array([len(kinds) - 1 for kinds, _ in todo])  # fronts after the basin
+        need = np.array([length - self.tol for _, length in todo])
+        lo0, hi0 = self._margin_bracket()
+        lo, hi = np.full(len(todo), lo0), np.full(len(todo), hi0)
+
+        def attainable(t: FloatArray) -> NDArray[np.bool_]:
+            w = np.full(len(t), widths[0])  # the widest single basin
+            ok = np.ones(len(t), dtype=bool)
+            for d in range(int(steps.max())):
+                going = steps > d
+                n = np.searchsorted(spans, w[going] - 2.0 * t[going], side="right") - 1
+                ok[np.flatnonzero(going)[n < 0]] = False
+                w[going] = widths[np.maximum(n, 0)]
+            return ok & (w >= need)
+
+        start = attainable(lo)  # chains that fail here are left to witnesses()
+        active = start.copy()
+        while active.any():
+            mid = 0.5 * (lo + hi)
+            active &= (mid != lo) & (mid != hi)
+            yes = attainable(mid)
+            lo = np.where(active & yes, mid, lo)
+            hi = np.where(active & ~yes, mid, hi)
+        for (kinds, length), t, ok in zip(todo, lo.tolist(), start.tolist(), strict=True):
+            if ok:
+                self.margins[(kinds, length)] = t
 
     def staircases(self, kinds: tuple[str, ...]) -> list[Staircase]:
         """The staircase of ``kinds[m:]`` for each ``m``."""
@@ -504,21 +842,89 @@ class ArcPlanner:
         """The chain of witness arcs of largest least margin, and that margin.
 
         ``length`` is the success arc's length; the first witness is an arc that wide.
-        The margin is ``None`` for a single action.
+        The margin is ``None`` for a single action. Chains whose staircases would hold more
+        than :data:`STAIR_CELLS` entries are found by :meth:`witnesses_by_margin` (the same
+        margin, in memory O(F)).
         """
         front = self.front(kinds[0])
         wide = bisect.bisect_left(front.width_list, length - self.tol)  # arcs wide..end
         if len(kinds) == 1:
-            return [front.arc(wide + int(np.flatnonzero(front.span[wide:] <= 0.0)[0]))], None
+            single = next(n for n, x in enumerate(front.span_list[wide:]) if x <= 0.0)
+            return [front.arc(wide + single)], None
+        cells = len(kinds) * max(len(self.front(t)) for t in set(kinds))
+        if cells > STAIR_CELLS:
+            return self.witnesses_by_margin(kinds, length)
         stairs = self.staircases(kinds[1:])
-        rest = stairs[0].tau(front.span[wide:])
-        best = float(rest.max())
+        if len(front) <= SMALL:
+            values = stairs[0].tau_list(front.span_list[wide:])
+            best = max(values)
+            at = next(n for n, v in enumerate(values) if v >= best - self.tol)
+        else:
+            rest = stairs[0].tau(front.span[wide:])
+            best = float(rest.max())
+            at = int(np.flatnonzero(rest >= best - self.tol)[0])
         if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
             raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-        chain = [front.arc(wide + int(np.flatnonzero(rest >= best - self.tol)[0]))]
+        chain = [front.arc(wide + at)]
         for stair in stairs:
             chain.append(stair.pick(chain[-1].span))
         return chain, best
+
+    def witnesses_by_margin(
+        self, kinds: tuple[str, ...], length: float
+    ) -> tuple[list[Arc], float | None]:
+        """:meth:`witnesses` by bisection on the margin, without staircases.
+
+        A least margin ``t`` is attainable when, from the last action back,
+        ``U_{k-1}`` = the widest single basin and ``U_m`` = the widest front arc of action
+        ``m`` whose image spans at most ``U_{m+1} - 2 t`` give ``U_0 >= length - tol``: the
+        image of each witness then fits the next with ``t`` to spare on each side, and no
+        chain does better (a wider witness is never worse for the actions before it). The
+        largest such ``t`` is found by bisection to the last bit (O(k log F) a step), and
+        the chain is read off its ``U``: the first witness is the narrowest arc at least
+        ``length - tol`` wide, each later one the widest that still fits. The margin reported
+        is that chain's least ``(W(a_{m+1}) - span(a_m)) / 2``, the staircases' value to
+        rounding; the witnesses may differ from theirs where several chains attain it.
+        """
+        k = len(kinds)
+        fronts = [self.front(t) for t in kinds]
+        need = length - self.tol
+
+        lists = [(f.span_list, f.width_list) for f in fronts[-2::-1]]  # last but one first
+        right = bisect.bisect_right
+
+        def widths(t: float) -> list[float] | None:
+            u = [fronts[-1].width_list[0]]  # the widest single basin (span 0), then back
+            w, t2 = u[0], 2.0 * t
+            for spans, widths_ in lists:
+                n = right(spans, w - t2) - 1
+                if n < 0:
+                    return None
+                w = widths_[n]
+                u.append(w)
+            u.reverse()
+            return u if w >= need else None
+
+        lo = self.margins.get((kinds, length))
+        if lo is None:
+            lo, hi = self._margin_bracket()
+            if widths(lo) is None:  # pragma: no cover - the lengths guarantee a chain
+                raise PlanningError("internal error: no witness chain for a plan the lengths allow")
+            while True:
+                mid = 0.5 * (lo + hi)
+                if mid in (lo, hi):
+                    break
+                lo, hi = (mid, hi) if widths(mid) is not None else (lo, mid)
+        u = widths(lo)
+        assert u is not None
+        first = fronts[0]
+        chain = [first.arc(bisect.bisect_left(first.width_list, need))]
+        for m in range(1, k - 1):
+            fr = fronts[m]
+            chain.append(fr.arc(bisect.bisect_right(fr.span_list, u[m + 1] - 2.0 * lo) - 1))
+        chain.append(fronts[-1].arc(0))
+        margin = min(0.5 * (b.width - a.span) for a, b in itertools.pairwise(chain))
+        return chain, margin
 
 
 def chain_option(

@@ -33,15 +33,23 @@ each reported plan for its witnesses (F arcs on the front).
 
 from __future__ import annotations
 
+from typing import Literal
+
 from ..errors import PlanningError
 from ..model.problem import Problem
 from .arcs import ArcPlanner, Counts, chain_option
-from .result import COST_RTOL, PlanOption, PlanResult, choose_indices, max_plan_length
+from .result import COST_RTOL, PlanOption, PlanResult, choose_among, max_plan_length
 
-__all__ = ["plan_exact"]
+__all__ = ["Report", "plan_exact"]
+
+Report = Literal["all", "best"]
+"""What :func:`plan_exact` reports: the best plan of every length, or only the Bayes and the
+most certain plans."""
 
 
-def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
+def plan_exact(
+    problem: Problem, max_actions: int | None = None, report: Report = "all"
+) -> PlanResult:
     """Best plans of every length, exactly, for any prior, cost model and goal.
 
     Parameters
@@ -50,6 +58,11 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
     max_actions : int, optional
         Stop after plans of this many actions even if more would raise the success
         probability (default: go on until the highest attainable probability).
+    report : {"all", "best"}
+        ``"all"``: the best plan of every length (below). ``"best"``: only the Bayes plan
+        and the most certain plan (one option when they are the same), the same plans as
+        in ``"all"``; the angles of the others are never computed, which for parts of
+        thousands of states is most of the work (``k`` angles for each length ``k``).
 
     Honours the problem's gripper ``accuracy``: every plan of two or more actions has
     tolerance at least ``accuracy``, and is the best of those that do.
@@ -66,7 +79,7 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
     Raises
     ------
     PlanningError
-        If ``max_actions`` is less than 1.
+        If ``max_actions`` is less than 1, or ``report`` is neither ``"all"`` nor ``"best"``.
 
     Examples
     --------
@@ -88,9 +101,17 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
     >>> rep = plan_exact(Problem.build(rect, accuracy=math.radians(20)))
     >>> [o.n_actions for o in rep.options]
     [1]
+
+    Only the Bayes and the most certain plans:
+
+    >>> rep = plan_exact(Problem.build(rect), report="best")
+    >>> [o.n_actions for o in rep.options], rep.bayes, rep.most_certain
+    ([2], 0, 0)
     """
     if max_actions is not None and max_actions < 1:
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    if report not in ("all", "best"):
+        raise PlanningError(f"`report` must be 'all' or 'best'; got {report!r}")
     group = problem.goal_group
     prior = problem.prior
     kinds = problem.action_kinds
@@ -103,7 +124,8 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
     reach = planner.widest_reachable(cap, limit_hard)
     p_best, _ = prior.max_arc_mass(min(reach, cap), group)
 
-    options: list[PlanOption] = []
+    # (p, cost, kinds, width) of the best plan of each length; angles come last.
+    options: list[tuple[float, float, tuple[str, ...], float]] = []
     level: list[Counts] = [(0,) * len(kinds)]
     first_kind = min(kinds, key=lambda t: problem.cost.action_cost(t, first=True))
     next_kind = min(kinds, key=lambda t: problem.cost.action_cost(t))
@@ -111,6 +133,24 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
     def cheap_kinds(n: int) -> tuple[str, ...]:
         """The action types of the cheapest attempt of ``n`` actions."""
         return (first_kind,) + (next_kind,) * (n - 1)
+
+    cost = problem.cost
+    runs: dict[tuple[str, str], list[float]] = {}
+
+    def attempt(order: tuple[str, ...]) -> float:
+        """``cost.attempt_cost(order)``, in O(1) amortised for plans of one repeated action.
+
+        Its sum is left to right, so the partial sums of ``first, kind, kind, ...`` are
+        kept and extended (the plans of each length are one action longer): bit for bit
+        the same value.
+        """
+        if len(order) < 3 or order.count(order[1]) - (order[0] == order[1]) != len(order) - 1:
+            return cost.attempt_cost(order)
+        partial = runs.setdefault((order[0], order[1]), [0 + cost.action_cost(order[0], True)])
+        step = cost.action_cost(order[1])
+        while len(partial) < len(order):
+            partial.append(partial[-1] + step)
+        return cost.verify + partial[len(order) - 1]
 
     certain_at: int | None = None  # the length of the most certain plan, once found
     extra: tuple[float, float, tuple[str, ...], float] | None = None
@@ -122,15 +162,14 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
         for key, t, width in candidates:
             p, _ = prior.max_arc_mass(min(width, cap), group)
             order = planner.order(key, t)
-            scored.append((p, problem.cost.expected_cost(order, p), order, width))
+            scored.append((p, cost.expected_from_attempt(attempt(order), p), order, width))
         cheapest = min(scored, key=lambda s: (s[1], -s[0]))
         if certain_at is None:
             top_p = max(s[0] for s in scored)
             done = top_p >= p_best - p_tol or (max_actions is not None and k >= max_actions)
             # The last level shows its most certain plan.
             pick = min(scored, key=lambda s: (-round(s[0], 12), s[1])) if done else cheapest
-            p, cost, order, width = pick
-            options.append(_option(planner, order, width, min(width, cap), p, cost))
+            options.append(pick)
             if done:
                 certain_at = k
         if certain_at is not None:
@@ -138,7 +177,7 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
             # or longer, may cost less (less certain, or cheaper actions): keep the cheapest
             # such plan, and search on while the cheapest attempt of one more action at the
             # highest probability could still beat the best so far.
-            bound = min(o.expected_cost for o in options)
+            bound = min(o[1] for o in options)
             if extra is not None:
                 bound = min(bound, extra[1])
             if cheapest[1] < bound * (1.0 - COST_RTOL):
@@ -154,10 +193,18 @@ def plan_exact(problem: Problem, max_actions: int | None = None) -> PlanResult:
             raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
         level = nxt
     if extra is not None:
-        p, cost, order, width = extra
-        options.append(_option(planner, order, width, min(width, cap), p, cost))
-    bayes, most = choose_indices(tuple(options), p_tol)
-    return PlanResult(problem, tuple(options), bayes, most, "exact")
+        options.append(extra)
+    bayes, most = choose_among([o[1] for o in options], [o[0] for o in options], p_tol)
+    if report == "best":  # as PlanResult.best_only, before the angles are computed
+        keep = sorted({bayes, most})
+        options = [options[i] for i in keep]
+        bayes, most = keep.index(bayes), keep.index(most)
+    planner.prepare_margins([(order, width) for _, _, order, width in options])
+    plans = tuple(
+        _option(planner, order, width, min(width, cap), p, cost)
+        for p, cost, order, width in options
+    )
+    return PlanResult(problem, plans, bayes, most, "exact")
 
 
 def _option(

@@ -17,6 +17,7 @@ their shortest form (:func:`short_turns`), the choice of the Bayes and most cert
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -39,6 +40,7 @@ __all__ = [
     "PlanResult",
     "PlanStep",
     "Status",
+    "choose_among",
     "choose_indices",
     "execute_plan",
     "max_plan_length",
@@ -246,6 +248,31 @@ class PlanResult:
         """
         return self._plan(self.most_certain)
 
+    def best_only(self) -> PlanResult:
+        """The same result with only the Bayes and the most certain plans.
+
+        In order of length, one when they are the same: what ``plan_exact(...,
+        report="best")`` gives.
+
+        Examples
+        --------
+        >>> from bayesgrasp.geometry.polygon import Part
+        >>> from bayesgrasp.planning import plan
+        >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
+        >>> res = plan(Problem.build(rect)).best_only()
+        >>> [o.n_actions for o in res.options], res.bayes, res.most_certain
+        ([2], 0, 0)
+        """
+        if self.status != "ok":
+            return self
+        keep = sorted({self.bayes, self.most_certain})
+        return dataclasses.replace(
+            self,
+            options=tuple(self.options[i] for i in keep),
+            bayes=keep.index(self.bayes),
+            most_certain=keep.index(self.most_certain),
+        )
+
 
 PlanReport = PlanResult
 """The former name of :class:`PlanResult`."""
@@ -283,12 +310,30 @@ def choose_indices(
     >>> choose_indices(tuple(opts))
     (0, 1)
     """
-    costs = np.array([o.expected_cost for o in options])
-    probs = np.array([o.success_probability for o in options])
-    m = float(costs.min())
-    tie = costs - m <= COST_RTOL * abs(m) if math.isfinite(m) else np.ones(len(costs), bool)
-    bayes = int(np.flatnonzero(tie)[0])
-    most = int(np.flatnonzero(probs >= probs.max() - tol)[0])
+    return choose_among(
+        [o.expected_cost for o in options], [o.success_probability for o in options], tol
+    )
+
+
+def choose_among(
+    costs: Sequence[float], probs: Sequence[float], tol: float = DEFAULT_TOLERANCE.probability
+) -> tuple[int, int]:
+    """:func:`choose_indices` from the plans' expected costs and success probabilities.
+
+    Examples
+    --------
+    >>> choose_among([6.0, 6.0, 7.0], [0.3, 0.5, 0.5])
+    (0, 1)
+    """
+    cost = [float(c) for c in costs]
+    prob = [float(p) for p in probs]
+    m = min(cost)
+    if math.isfinite(m):
+        bayes = next(i for i, c in enumerate(cost) if c - m <= COST_RTOL * abs(m))
+    else:
+        bayes = 0
+    top = max(prob) - tol
+    most = next(i for i, p in enumerate(prob) if p >= top)
     return bayes, most
 
 

@@ -1,0 +1,229 @@
+"""Planning at the limit (issue 12): this branch beside commit 373822f and the baseline.
+
+Every case runs in a fresh subprocess, so two versions of bayesgrasp can be timed in one
+run: this worktree's ``src`` and a reference worktree of 373822f (``--ref``; make it with
+``git worktree add /work/wt/ref373 373822f``). Cases of the two versions alternate, and each
+is the best of ``--repeat`` runs (CPU time of the timed work, imports excluded).
+
+Cases:
+
+- ``study``: the seed's 2000-polygon study (hull, diameter, squeeze function, exact Bayes
+  plans with angles), as ``run_study(2000, seed=1)`` runs it;
+- ``batch``: ``plan --batch`` of the study's 2000 hulls as JSON lines, in one process (the
+  command's ``main``), beside the in-process study;
+- ``bfs``: the breadth-first baseline (``planning/bfs.py``) on the same 2000 polygons, beside
+  the exact planner on the same problems (this branch only);
+- ``circle N``: N random points on the unit circle (N = 10^3, 10^4, 10^5);
+- ``regular N``: the regular N-gon (N = 10^5);
+- ``ellipse N``: N points on an ellipse of aspect 2 (N = 10^5).
+
+For the large parts: the hull (``Part.from_points``), the problem, and the exact plans
+(``report="best"``, the Bayes and most certain plans, where the version has it), with the
+``tracemalloc`` peak of a second, traced run. A case that passes ``--timeout`` seconds is
+reported as such. The machine may be shared: the figures are floors, compare them side by
+side.
+
+Run: ``.venv/bin/python benchmarks/bench_limits.py [--ref /work/wt/ref373] [--repeat 3]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent.parent / "src"
+
+# The work of each case, as a script: it prints one JSON object. ``NEW`` is true for this
+# branch's layout (bayesgrasp.paper, bayesgrasp.model), false for 373822f's.
+_SCRIPT = r"""
+import json, math, sys, time, tracemalloc
+import numpy as np
+case, n, traced = sys.argv[1], int(sys.argv[2]), sys.argv[3] == "1"
+try:
+    from bayesgrasp.paper.study import run_study, random_polygon
+    from bayesgrasp.model.problem import Problem
+    from bayesgrasp.geometry.polygon import Part
+    NEW = True
+except ImportError:
+    from bayesgrasp.study import run_study, random_polygon
+    from bayesgrasp.problem import Problem
+    from bayesgrasp.geometry import Part
+    NEW = False
+from bayesgrasp.planning.exact import plan_exact
+from bayesgrasp.planning.bfs import search_bfs
+import inspect
+best = "report" in inspect.signature(plan_exact).parameters
+
+def points(case, n):
+    if case == "circle":
+        t = np.random.default_rng(0).uniform(0.0, 2 * math.pi, n)
+        return np.column_stack([np.cos(t), np.sin(t)])
+    t = 2 * math.pi * np.arange(n) / n
+    if case == "regular":
+        return np.column_stack([np.cos(t), np.sin(t)])
+    return np.column_stack([2.0 * np.cos(t), np.sin(t)])
+
+out = {}
+if case == "study":
+    c0 = time.process_time()
+    res = run_study(n, 1)
+    out["cpu"] = time.process_time() - c0
+    out["better"] = res.shorter_plan_better
+elif case == "bfs":
+    rng = np.random.default_rng(1)
+    pbs = [Problem.build(random_polygon(rng)) for _ in range(n)]
+    c0 = time.process_time()
+    for pb in pbs:
+        plan_exact(pb)
+    c1 = time.process_time()
+    nodes = []
+    for pb in pbs:
+        nodes.append(search_bfs(pb, tree_count=False).stats.bfs_nodes)
+    c2 = time.process_time()
+    out["exact"], out["cpu"] = c1 - c0, c2 - c1
+    over = [k for k, m in enumerate(nodes) if m > 100]
+    c3 = time.process_time()
+    for k in over:
+        plan_exact(pbs[k])
+    c4 = time.process_time()
+    for k in over:
+        search_bfs(pbs[k], tree_count=False)
+    c5 = time.process_time()
+    out["over100"], out["exact100"], out["bfs100"] = len(over), c4 - c3, c5 - c4
+elif case == "batch":
+    import contextlib, io, os, tempfile
+    from bayesgrasp.cli import main
+    rng = np.random.default_rng(1)
+    path = os.path.join(tempfile.mkdtemp(), "parts.jsonl")
+    with open(path, "w") as fh:
+        for k in range(n):
+            hull = random_polygon(rng).hull.vertices.tolist()
+            fh.write(json.dumps({"name": f"p{k}", "vertices": hull}) + "\n")
+    sink = io.StringIO()
+    c0 = time.process_time()
+    with contextlib.redirect_stdout(sink):
+        code = main(["plan", "--batch", path])
+    out["cpu"] = time.process_time() - c0
+    out["lines"] = sink.getvalue().count("\n")
+    c0 = time.process_time()
+    run_study(n, 1)
+    out["study"] = time.process_time() - c0
+else:
+    pts = points(case, n)
+    if traced:
+        tracemalloc.start()
+    c0 = time.process_time()
+    part = Part.from_points(pts)
+    c1 = time.process_time()
+    pb = Problem.build(part)
+    c2 = time.process_time()
+    rep = plan_exact(pb, report="best") if best else plan_exact(pb)
+    c3 = time.process_time()
+    if traced:
+        out["peak_mb"] = tracemalloc.get_traced_memory()[1] / 1e6
+    out.update(hull=c1 - c0, build=c2 - c1, plan=c3 - c2, cpu=c3 - c0, states=pb.n_states,
+               levels=max(o.n_actions for o in rep.options), best=best)
+print(json.dumps(out))
+"""
+
+
+def run(src: Path, case: str, n: int, traced: bool, timeout: float) -> dict[str, Any]:
+    """One case in a subprocess with ``src`` first on the path."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _SCRIPT, case, str(n), "1" if traced else "0"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            check=False,
+        )
+    except subprocess.TimeoutExpired:
+        return {"timeout": timeout}
+    if done.returncode:
+        return {"error": done.stderr.strip().splitlines()[-1] if done.stderr else "failed"}
+    return dict(json.loads(done.stdout.strip().splitlines()[-1]))
+
+
+def best_of(src: Path, case: str, n: int, repeat: int, timeout: float) -> dict[str, Any]:
+    """Best CPU time of ``repeat`` runs, and (large parts) the peak of one traced run."""
+    runs = [run(src, case, n, False, timeout) for _ in range(repeat)]
+    ok = [r for r in runs if "cpu" in r]
+    if not ok:
+        return runs[0]
+    out = min(ok, key=lambda r: r["cpu"])
+    if case not in ("study", "bfs", "batch"):
+        out["peak_mb"] = run(src, case, n, True, timeout).get("peak_mb")
+    return out
+
+
+def show(label: str, r: dict[str, Any]) -> str:
+    """One line of figures."""
+    if "timeout" in r:
+        return f"{label}: no answer in {r['timeout']:.0f} s"
+    if "error" in r:
+        return f"{label}: {r['error']}"
+    parts = [f"cpu {r['cpu']:.3f} s"]
+    for key, fmt in (("hull", "hull {:.3f}"), ("build", "build {:.3f}"), ("plan", "plan {:.3f}")):
+        if key in r:
+            parts.append(fmt.format(r[key]))
+    if "peak_mb" in r and r["peak_mb"] is not None:
+        parts.append(f"peak {r['peak_mb']:.0f} MB")
+    if "states" in r:
+        parts.append(f"K {r['states']}, {r['levels']} actions")
+    if "better" in r:
+        parts.append(f"shorter plan better {r['better']}")
+    return f"{label}: " + ", ".join(parts)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--ref", type=Path, default=Path("/work/wt/ref373/src"))
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--polygons", type=int, default=2000)
+    ap.add_argument("--quick", action="store_true", help="skip the 10^5 cases of 373822f")
+    args = ap.parse_args()
+    ref = args.ref if (args.ref / "bayesgrasp").is_dir() else None
+    if args.ref.name != "src" and (args.ref / "src" / "bayesgrasp").is_dir():
+        ref = args.ref / "src"
+    print(f"load: {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
+
+    new = best_of(HERE, "study", args.polygons, args.repeat, args.timeout)
+    print(show(f"study {args.polygons}, this branch", new))
+    if ref is not None:
+        old = best_of(ref, "study", args.polygons, args.repeat, args.timeout)
+        print(show(f"study {args.polygons}, 373822f    ", old))
+        if "cpu" in old and "cpu" in new:
+            print(f"  speed-up {old['cpu'] / new['cpu']:.2f}x")
+    b = best_of(HERE, "bfs", args.polygons, 1, args.timeout * 5)
+    if "cpu" in b:
+        print(
+            f"breadth-first baseline, {args.polygons} polygons: bfs {b['cpu']:.3f} s, exact "
+            f"{b['exact']:.3f} s ({b['cpu'] / b['exact']:.1f}x); {b['over100']} polygons over "
+            f"100 nodes: bfs {b['bfs100']:.3f} s, exact {b['exact100']:.3f} s "
+            f"({b['bfs100'] / max(b['exact100'], 1e-9):.1f}x)"
+        )
+    r = best_of(HERE, "batch", args.polygons, args.repeat, args.timeout)
+    if "cpu" in r:
+        print(
+            f"plan --batch, {r['lines']} parts in one process: cpu {r['cpu']:.3f} s; the "
+            f"in-process study {r['study']:.3f} s ({r['cpu'] / r['study']:.2f}x)"
+        )
+    cases = [("circle", 1000), ("circle", 10_000), ("circle", 100_000)]
+    cases += [("regular", 100_000), ("ellipse", 100_000)]
+    for case, n in cases:
+        print(show(f"{case} {n}, this branch", best_of(HERE, case, n, args.repeat, args.timeout)))
+        if ref is not None and not (args.quick and n >= 100_000):
+            reps = 1 if n >= 10_000 else args.repeat
+            print(show(f"{case} {n}, 373822f    ", best_of(ref, case, n, reps, args.timeout)))
+
+
+if __name__ == "__main__":
+    main()

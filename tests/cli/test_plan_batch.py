@@ -1,0 +1,141 @@
+"""``plan PART PART ...``, ``plan --batch FILE.jsonl`` and ``plan --only best``.
+
+Each line of a batch is the document ``plan PART --json`` prints for that part alone; a bad
+part is reported in its line and the batch goes on.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from bayesgrasp.cli import main
+from bayesgrasp.shapes import names
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def single(capsys: pytest.CaptureFixture[str], *args: str) -> dict[str, Any]:
+    code, out, err = run(capsys, "plan", *args, "--json")
+    assert (code, err) == (0, ""), err
+    doc = json.loads(out)
+    assert isinstance(doc, dict)
+    return doc
+
+
+def lines(out: str) -> list[dict[str, Any]]:
+    return [json.loads(x) for x in out.splitlines()]
+
+
+OPTION_SETS = [
+    [],
+    ["--actions", "squeeze,push-grasp", "--push-grasp-cost", "0.7"],
+    ["--accuracy", "2", "--goal", "symmetry"],
+    ["--only", "best"],
+    ["--method", "bfs", "--only", "best"],
+]
+
+
+@pytest.mark.parametrize("options", OPTION_SETS, ids=lambda o: " ".join(o) or "default")
+def test_several_parts_equal_each_alone(
+    capsys: pytest.CaptureFixture[str], options: list[str]
+) -> None:
+    parts = names()[:5]
+    code, out, err = run(capsys, "plan", *parts, *options)
+    assert (code, err) == (0, "")
+    assert lines(out) == [single(capsys, p, *options) for p in parts]
+
+
+def test_batch_equals_each_part_alone(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, rng: np.random.Generator
+) -> None:
+    rows, expected = [], []
+    for k in range(6):
+        pts = rng.random((10, 2)).round(6)  # in angular order: an outline, not a point cloud
+        c = pts.mean(axis=0)
+        vertices = pts[np.argsort(np.arctan2(*(pts - c).T[::-1]))].tolist()
+        obj = {"name": f"random-{k}", "vertices": vertices}
+        rows.append(json.dumps(obj))
+        path = tmp_path / f"random-{k}.json"
+        path.write_text(json.dumps(obj))
+        expected.append(single(capsys, str(path)))
+    rows.append(json.dumps("house"))
+    expected.append(single(capsys, "house"))
+    batch = tmp_path / "parts.jsonl"
+    batch.write_text("\n".join(rows) + "\n\n")
+    code, out, err = run(capsys, "plan", "--batch", str(batch))
+    assert (code, err) == (0, "")
+    assert lines(out) == expected
+    # PART arguments come first, then the batch.
+    code, out, _ = run(capsys, "plan", "key", "--batch", str(batch))
+    assert lines(out) == [single(capsys, "key"), *expected]
+
+
+def test_bad_parts_are_reported_in_their_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    batch = tmp_path / "mixed.jsonl"
+    rows = [
+        '"triangle"',
+        '{"name": "segment", "vertices": [[0, 0], [1, 1]]}',
+        "[1, 2]",
+        "not json",
+        '"no-such-part"',
+        '{"name": "square", "vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]}',
+    ]
+    batch.write_text("\n".join(rows))
+    code, out, err = run(capsys, "plan", "--batch", str(batch))
+    assert code == 2 and err == ""
+    docs = lines(out)
+    assert len(docs) == 6
+    assert docs[0] == single(capsys, "triangle")
+    assert docs[5]["part"]["name"] == "square" and "error" not in docs[5]
+    for n, doc in zip([2, 3, 4, 5], docs[1:5], strict=True):
+        assert doc["part"] == f"{batch}:{n}" and doc["exit_code"] == 2
+        assert "\n" not in doc["error"]
+    assert "3 distinct points" in docs[1]["error"]
+    assert "got list" in docs[2]["error"]
+    assert "not a JSON value" in docs[3]["error"]
+    assert "neither a catalogue part" in docs[4]["error"]
+
+
+def test_no_plan_gives_exit_code_one(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "plan", "key", "rectangle", "--guaranteed", "--accuracy", "30")
+    docs = lines(out)
+    assert code == 1 and len(docs) == 2
+    assert docs[0]["guaranteed"] is None and docs[0]["guaranteed_missing"]
+
+
+def test_usage_errors(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    code, _, err = run(capsys, "plan")
+    assert code == 2 and "give a PART" in err
+    code, _, err = run(capsys, "plan", "--batch", str(tmp_path / "missing.jsonl"))
+    assert code == 2 and "cannot read" in err and "\n" == err[-1] and err.count("\n") == 1
+    code, _, err = run(capsys, "plan", "key", "house", "--plot", str(tmp_path / "a.png"))
+    assert code == 2 and "--plot takes one PART" in err
+
+
+def test_only_best_is_the_bayes_and_most_certain(capsys: pytest.CaptureFixture[str]) -> None:
+    for part in ["house", "key", "tuning-fork"]:
+        every, best = single(capsys, part), single(capsys, part, "--only", "best")
+        chosen = sorted({every["bayes"], every["most_certain"]})
+        assert best["options"] == [every["options"][i] for i in chosen]
+        assert best["options"][best["bayes"]] == every["options"][every["bayes"]]
+        assert best["options"][best["most_certain"]] == every["options"][every["most_certain"]]
+        assert {k: v for k, v in best.items() if k not in ("options", "bayes", "most_certain")} == {
+            k: v for k, v in every.items() if k not in ("options", "bayes", "most_certain")
+        }
+
+
+def test_several_parts_with_sense_are_recognition(capsys: pytest.CaptureFixture[str]) -> None:
+    a = run(capsys, "plan", "rectangle", "triangle", "--sense", "width", "--json")
+    b = run(capsys, "plan", "rectangle", "--also", "triangle", "--sense", "width", "--json")
+    assert a[0] == 0 and a == b
