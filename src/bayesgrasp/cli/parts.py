@@ -16,12 +16,12 @@ app = command_app()
 def squeeze(part: PartSpec, prior: PriorOpt = "uniform", as_json: JsonOpt = False) -> None:
     """Stable orientations of a squeeze, their basins and probabilities after one squeeze."""
     from .. import report
-    from ..geometry.transfer import squeeze_function
+    from ..geometry.curved import squeeze_model
     from ..model.prior import parse_prior
 
     p = part.load()
     pr = parse_prior(prior)
-    f = squeeze_function(p.hull)
+    f = squeeze_model(p)[1]
     if as_json:
         emit_json(report.squeeze_json(p, f, pr))
     else:
