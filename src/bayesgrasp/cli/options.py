@@ -42,6 +42,10 @@ FLATTEN_HELP = (
     "Chordal tolerance for flattening curves, in the file's units "
     "(default: 0.1% of the drawing's diagonal)."
 )
+SHAPE_HELP = (
+    "Manufacturing tolerance of the part, in its units: minima of the diameter function that "
+    "a shape error this large could remove are not stable orientations (default 0)."
+)
 PRIOR_HELP = (
     "Prior on the initial orientation: uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE "
     "(bin weights over [0, 360) deg) | sample:FILE (observed angles, deg)."
@@ -77,6 +81,7 @@ def _part_params() -> list[inspect.Parameter]:
         _opt("element", str | None, None, metavar="ID", help=ELEMENT_HELP),
         _opt("layer", str | None, None, help="DXF: read only this layer."),
         _opt("flatten_tol", float | None, None, help=FLATTEN_HELP),
+        _opt("shape_tol", float, 0.0, min=0, help=SHAPE_HELP),
     ]
 
 

@@ -55,15 +55,18 @@ class PartSpec:
     element: str | None = None
     layer: str | None = None
     flatten_tol: float | None = None
+    shape_tol: float = 0.0
 
     def load(self) -> Part:
-        """Read the part."""
+        """Read the part (with ``--shape-tol``, see :func:`~bayesgrasp.geometry.curved.with_shape_tol`)."""
+        from ..geometry.curved import with_shape_tol
         from ..io import resolve_part
 
         fmt = self.fmt.value if self.fmt else None
-        return resolve_part(
+        part = resolve_part(
             self.part, fmt, element=self.element, layer=self.layer, tolerance=self.flatten_tol
         )
+        return with_shape_tol(part, self.shape_tol)
 
 
 @dataclass(frozen=True, slots=True)

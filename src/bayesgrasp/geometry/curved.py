@@ -71,6 +71,7 @@ from .transfer import TransferFunction, squeeze_function, transfer_from_extrema
 
 __all__ = [
     "SHALLOW",
+    "CurvePatches",
     "CurvedDiameter",
     "CurvedHull",
     "CurvedPart",
@@ -111,6 +112,8 @@ class CurvedRing:
     bulges : array_like of shape (N,)
         ``tan(sweep / 4)`` of the piece from point ``i`` to point ``i + 1`` (0: a segment;
         positive: an arc turning counter-clockwise; 1: a half circle).
+    chords : array_like of bool of shape (N,), optional
+        Which pieces are chords of a flattened curve (not straight edges of the part).
 
     Examples
     --------
@@ -122,10 +125,17 @@ class CurvedRing:
 
     points: FloatArray
     bulges: FloatArray
+    chords: NDArray[np.bool_] | None = None
 
     def __post_init__(self) -> None:
         p = as_points(self.points, "points")
         b = np.asarray(self.bulges, dtype=np.float64).reshape(-1)
+        ch = np.zeros(len(p), dtype=bool) if self.chords is None else np.asarray(self.chords, bool)
+        if ch.shape != (len(p),):
+            raise PartError(f"`chords` must have one value per point ({len(p)})")
+        ch = ch.copy()
+        ch.setflags(write=False)
+        object.__setattr__(self, "chords", ch)
         if len(b) != len(p):
             raise PartError(f"`bulges` must have one value per point ({len(p)}); got {len(b)}")
         if not np.all(np.isfinite(b)):
@@ -222,7 +232,8 @@ class CurvedRing:
         """The same outline run the other way."""
         p = self.points[::-1]
         b = -np.roll(self.bulges[::-1], -1)
-        return CurvedRing(p, b)
+        chords = np.asarray(self.chords, dtype=bool)
+        return CurvedRing(p, b, np.roll(chords[::-1], -1))
 
 
 # --------------------------------------------------------------------------------------
@@ -249,6 +260,10 @@ class CurvedHull:
     size : float
         Largest distance of the hull from its area centroid (sets the length tolerance).
     tol : Tolerance
+    chord_edges : ndarray of bool of shape (P,)
+        Whether edge ``k`` is a chord of a flattened curve (not a flat of the part).
+    approximate : ndarray of bool of shape (P,)
+        Whether piece ``k`` is a point of a flattened curve (the true contact is nearby).
 
     Examples
     --------
@@ -263,6 +278,8 @@ class CurvedHull:
     edges: FloatArray
     size: float
     tol: Tolerance = DEFAULT_TOLERANCE
+    chord_edges: NDArray[np.bool_] | None = None
+    approximate: NDArray[np.bool_] | None = None
 
     @property
     def n_pieces(self) -> int:
@@ -487,11 +504,17 @@ def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedH
         k, phi = nxt, at
     else:  # pragma: no cover - a bug
         raise PartError("internal error: the convex hull of the outline does not close")
-    return _finish(c, r, pieces, ltol, tol)
+    return _finish(c, r, pieces, ltol, tol, ring, sites)
 
 
 def _finish(
-    c: FloatArray, r: FloatArray, pieces: list[tuple[int, float]], ltol: float, tol: Tolerance
+    c: FloatArray,
+    r: FloatArray,
+    pieces: list[tuple[int, float]],
+    ltol: float,
+    tol: Tolerance,
+    ring: CurvedRing,
+    orig: IntArray,
 ) -> CurvedHull:
     """Drop pieces of no angular width and measure the edges between the others."""
     site = np.array([s for s, _ in pieces], dtype=np.intp)
@@ -517,13 +540,85 @@ def _finish(
     shift = math.floor(starts[0] / TWO_PI) * TWO_PI
     starts = starts - shift
     centers, radii = c[site].copy(), r[site].copy()
+    # Which pieces and edges come from flattened curves: ring point i of a chord piece.
+    n = len(ring.points)
+    chords = np.asarray(ring.chords, dtype=bool)
+    point = orig[site]  # (P,) ring point of each piece (>= n: an arc)
+    is_point = point < n
+    approx = is_point & (chords[np.minimum(point, n - 1)] | chords[(np.minimum(point, n - 1) - 1) % n])
+    a, b = np.roll(point, 1), point
+    forward = is_point & np.roll(is_point, 1) & (b == (a + 1) % n)
+    backward = is_point & np.roll(is_point, 1) & (a == (b + 1) % n)
+    chord_edges = (forward & chords[np.minimum(a, n - 1)]) | (backward & chords[np.minimum(b, n - 1)])
+    chord_edges &= edges > 0
     # Size: the largest distance from the centroid of the hull's boundary points.
     hull = CurvedHull(starts, centers, radii, edges, 1.0, tol)
     pts = hull.boundary(1e-3 * max(float(np.max(np.ptp(hull.boundary(np.inf), axis=0))), 1e-300))
     size = float(np.max(np.hypot(*(pts - pts.mean(axis=0)).T)))
-    for arr in (starts, centers, radii, edges):
+    for arr in (starts, centers, radii, edges, chord_edges, approx):
         arr.setflags(write=False)
-    return CurvedHull(starts, centers, radii, edges, size, tol)
+    return CurvedHull(starts, centers, radii, edges, size, tol, chord_edges, approx)
+
+
+# --------------------------------------------------------------------------------------
+# Curves that are not arcs, kept exactly to place the extrema they carry
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CurvePatches:
+    """The outline's non-arc curves in exact form: cubic Bezier curves and elliptic arcs.
+
+    The flattened outline is inscribed in them (its points lie on the curves), so the true
+    support function is ``max(h_flat, h_patches)``. Used to place the extrema that the
+    flattened chords only approximate (:func:`curved_diameter`).
+
+    Attributes
+    ----------
+    bezier : ndarray of shape (B, 4, 2)
+        Control points of cubic Bezier curves (quadratic ones raised to degree 3).
+    ellipses : ndarray of shape (E, 8)
+        ``cx, cy, Mx, My, mx, my, t0, span``: ``c + M cos t + m sin t`` over the span.
+    complete : bool
+        Whether every flattened curve is here (rational splines are not).
+    """
+
+    bezier: FloatArray
+    ellipses: FloatArray
+    complete: bool = True
+
+    def support(self, phi: float) -> float:
+        """``max over the curves of <x, u(phi)>`` (closed forms; -inf without curves)."""
+        u = np.array([math.cos(phi), math.sin(phi)])
+        best = -math.inf
+        if len(self.bezier):
+            p = self.bezier @ u  # (B, 4) projections of the control points
+            a0, a1 = p[:, 0], 3.0 * (p[:, 1] - p[:, 0])
+            a2 = 3.0 * (p[:, 2] - 2.0 * p[:, 1] + p[:, 0])
+            a3 = p[:, 3] - 3.0 * p[:, 2] + 3.0 * p[:, 1] - p[:, 0]
+            qa, qb, qc = 3.0 * a3, 2.0 * a2, a1  # f'(t) = qa t^2 + qb t + qc
+            disc = np.maximum(qb * qb - 4.0 * qa * qc, 0.0)
+            root = np.sqrt(disc)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                flat = np.abs(qa) <= 1e-14 * (np.abs(qb) + np.abs(qc) + 1e-300)
+                t1 = np.where(flat, -qc / np.where(qb == 0, 1.0, qb), (-qb + root) / (2 * qa))
+                t2 = np.where(flat, 0.0, (-qb - root) / (2 * qa))
+            ts = np.stack([np.zeros_like(a0), np.ones_like(a0), t1, t2], axis=1)
+            ts = np.clip(np.nan_to_num(ts, nan=0.0, posinf=0.0, neginf=0.0), 0.0, 1.0)
+            f = a0[:, None] + ts * (a1[:, None] + ts * (a2[:, None] + ts * a3[:, None]))
+            best = max(best, float(f.max()))
+        if len(self.ellipses):
+            e = self.ellipses
+            cu = e[:, 0] * u[0] + e[:, 1] * u[1]
+            al, be = e[:, 2] * u[0] + e[:, 3] * u[1], e[:, 4] * u[0] + e[:, 5] * u[1]
+            t0, span = e[:, 6], e[:, 7]
+            star = np.arctan2(be, al)
+            inside = np.mod((star - t0) * np.sign(span), TWO_PI) <= np.abs(span)
+            ends = np.maximum(
+                al * np.cos(t0) + be * np.sin(t0), al * np.cos(t0 + span) + be * np.sin(t0 + span)
+            )
+            f = cu + np.where(inside, np.hypot(al, be), ends)
+            best = max(best, float(f.max()))
+        return best
 
 
 # --------------------------------------------------------------------------------------
@@ -731,7 +826,65 @@ def _cancel(ext: list[Extremum], depth: float) -> list[Extremum]:
     return ext
 
 
-def curved_diameter(hull: CurvedHull, error: float = 0.0) -> CurvedDiameter:
+def _needs_refining(hull: CurvedHull, e: Extremum) -> bool:
+    """Whether an extremum lies where the model only approximates a curve."""
+    if hull.approximate is None or hull.chord_edges is None:
+        return False
+    tol = hull.tol.angle
+    for phi in (-e.theta, math.pi - e.theta):
+        k = int(hull.piece_index(phi + tol))
+        at_start = abs(math.remainder(float(hull.starts[k]) - phi, TWO_PI)) <= tol
+        if at_start and hull.edges[k] > 0:
+            if hull.chord_edges[k]:
+                return True
+            continue  # a straight edge of the part is flush: exact
+        if hull.approximate[int(hull.piece_index(phi))]:
+            return True
+    return False
+
+
+def _refined(
+    hull: CurvedHull, kept: list[Extremum], patches: CurvePatches
+) -> list[Extremum]:
+    """The extrema that flattened curves carry, placed on the exact curves.
+
+    Each such extremum of the flattened model is searched again on the exact diameter
+    ``d(theta) = H(-theta) + H(pi - theta)``, ``H = max(h_flat, h_curves)``, between the
+    midpoints to its neighbours (bounded Brent): a smooth extremum of the true curve, to
+    about 1e-8 rad, instead of a kink of a chord.
+    """
+    from scipy.optimize import minimize_scalar
+
+    def exact(th: float) -> float:
+        return sum(
+            max(float(hull.support(phi)), patches.support(phi)) for phi in (-th, math.pi - th)
+        )
+
+    out = list(kept)
+    m = len(kept)
+    for i, e in enumerate(kept):
+        if not _needs_refining(hull, e):
+            continue
+        if m > 1:
+            before = (e.theta - kept[i - 1].theta) % math.pi or math.pi
+            after = (kept[(i + 1) % m].theta - e.theta) % math.pi or math.pi
+        else:
+            before = after = math.pi
+        sign = -1.0 if e.is_max else 1.0
+        res = minimize_scalar(
+            lambda t: sign * exact(t),
+            bounds=(e.theta - 0.5 * before, e.theta + 0.5 * after),
+            method="bounded",
+            options={"xatol": 1e-12},
+        )
+        th = float(res.x) % math.pi
+        out[i] = Extremum(th, exact(th), e.is_max, False)
+    return out
+
+
+def curved_diameter(
+    hull: CurvedHull, error: float = 0.0, patches: CurvePatches | None = None
+) -> CurvedDiameter:
     """The diameter function of a curved hull, its extrema and the certain ones.
 
     Parameters
@@ -741,6 +894,9 @@ def curved_diameter(hull: CurvedHull, error: float = 0.0) -> CurvedDiameter:
         How far the outline may be from the true part, in its units: the flattening
         tolerance of non-arc curves plus a shape tolerance. Minimum/maximum pairs shallower
         than ``4 error`` (and than ``tol.barrier`` times the size) are not states.
+    patches : CurvePatches, optional
+        The flattened curves in exact form: the certain extrema they carry are placed on
+        them (see :func:`_refined`).
 
     Returns
     -------
@@ -757,6 +913,8 @@ def curved_diameter(hull: CurvedHull, error: float = 0.0) -> CurvedDiameter:
     ext = _extrema(breaks, chords, offsets, hull, atol)
     depth = max(hull.tol.barrier_for(hull.size), 4.0 * float(error))
     kept = _cancel(ext, depth)
+    if patches is not None and (len(patches.bezier) or len(patches.ellipses)):
+        kept = _refined(hull, kept, patches)
     minima = np.array([e.theta for e in kept if not e.is_max], dtype=np.float64)
     maxima = np.array([e.theta for e in kept if e.is_max], dtype=np.float64)
     for arr in (breaks, chords, offsets, minima, maxima):
@@ -787,11 +945,14 @@ class CurvedPart(Part):
     shape_tol : float
         A manufacturing tolerance the user gives (``--shape-tol``): every point of the real
         part lies within it of the drawn outline.
+    patches : CurvePatches or None
+        The flattened curves in exact form (they place the extrema the curves carry).
     """
 
     ring: CurvedRing | None = None
     curve_error: float = 0.0
     shape_tol: float = 0.0
+    patches: CurvePatches | None = None
     _model: dict[str, object] = field(default_factory=dict, repr=False)
 
     @property
@@ -812,7 +973,7 @@ class CurvedPart(Part):
     def diameter_function(self) -> CurvedDiameter:
         """The exact diameter function with the certain extrema (computed once)."""
         if "diameter" not in self._model:
-            self._model["diameter"] = curved_diameter(self.curved_hull, self.error)
+            self._model["diameter"] = curved_diameter(self.curved_hull, self.error, self.patches)
         return self._model["diameter"]  # type: ignore[return-value]
 
 
@@ -825,6 +986,7 @@ def curved_part(
     shape_tol: float = 0.0,
     tol: Tolerance = DEFAULT_TOLERANCE,
     display_tol: float | None = None,
+    patches: CurvePatches | None = None,
 ) -> CurvedPart:
     """A part from an outline of segments and arcs (and holes), exact centre of mass.
 
@@ -872,6 +1034,7 @@ def curved_part(
         ring,
         float(curve_error),
         float(shape_tol),
+        patches,
     )
     part._model["hull"] = hull
     return part

@@ -19,11 +19,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..geometry import Part
-from ..geometry.curved import CurvedRing, curved_part
+from ..geometry.curved import CurvedRing, CurvePatches, curved_part
 from ._common import Ring
-from ._flatten import Curve, EllipticArc, FlattenBudget, Polyline
+from ._flatten import Bezier, Curve, EllipticArc, FlattenBudget, Polyline
 
-__all__ = ["circle_of", "curved_assembly", "curved_ring"]
+__all__ = ["circle_of", "curved_assembly", "curved_ring", "patches_of"]
 
 FloatArray = NDArray[np.float64]
 
@@ -58,7 +58,7 @@ def circle_of(arc: EllipticArc) -> tuple[float, float, float] | None:
 
 
 def curved_ring(
-    curves: Sequence[Curve], tol: float, limit: int
+    curves: Sequence[Curve], tol: float, limit: int, patches: list[Curve] | None = None
 ) -> tuple[CurvedRing, float, bool]:
     """One ring of curves as points and bulges, and how far it may be from the curves.
 
@@ -70,6 +70,8 @@ def curved_ring(
         The chordal tolerance non-arc curves are flattened to.
     limit : int
         Largest number of points (the readers checked the count already).
+    patches : list, optional
+        Receives the curves that were flattened.
 
     Returns
     -------
@@ -81,6 +83,7 @@ def curved_ring(
     """
     points: list[FloatArray] = []
     bulges: list[float] = []
+    chords: list[bool] = []
     error = 0.0
     curved = False
     budget = FlattenBudget(max(limit, 4) * 4)
@@ -94,21 +97,53 @@ def curved_ring(
             pts[0] = c.start()
             points.append(pts)
             bulges += [math.tan(sweep / (4 * k))] * k
+            chords += [False] * k
             curved = True
             continue
         pts = c.points(tol, budget, "curve")
-        if not isinstance(c, Polyline):
+        flat = not isinstance(c, Polyline)
+        if flat:
             error, curved = tol, True
+            if patches is not None:
+                patches.append(c)
         points.append(pts[:-1])
         bulges += [0.0] * (len(pts) - 1)
+        chords += [flat] * (len(pts) - 1)
     p = np.concatenate(points) if points else np.zeros((0, 2))
     b = np.asarray(bulges, dtype=np.float64)
+    ch = np.asarray(chords, dtype=bool)
     # Drop repeated points (a piece of no length), keeping the bulge of the piece that moves.
     if len(p) > 1:
         step = np.roll(p, -1, axis=0) - p
         moves = np.hypot(step[:, 0], step[:, 1]) > 1e-12 * max(float(np.ptp(p)), 1e-300)
-        p, b = p[moves], b[moves]
-    return CurvedRing(p, b), error, curved
+        p, b, ch = p[moves], b[moves], ch[moves]
+    return CurvedRing(p, b, ch), error, curved
+
+
+def patches_of(curves: Sequence[Curve]) -> CurvePatches:
+    """The flattened curves in exact form: Bezier curves of degree <= 3 and elliptic arcs.
+
+    Higher-degree Bezier curves and rational splines are left out (``complete`` False):
+    their extrema keep the flattening's error bound.
+    """
+    bezier: list[FloatArray] = []
+    ellipses: list[list[float]] = []
+    complete = True
+    for c in curves:
+        if isinstance(c, Bezier) and c.degree in (2, 3):
+            q = np.asarray(c.control, dtype=np.float64)
+            if c.degree == 2:  # raise to degree 3
+                q = np.array([q[0], (q[0] + 2 * q[1]) / 3, (2 * q[1] + q[2]) / 3, q[2]])
+            bezier.append(q)
+        elif isinstance(c, EllipticArc):
+            ellipses.append([*c.center, *c.major, *c.minor, c.t0, c.span])
+        else:
+            complete = False
+    return CurvePatches(
+        np.array(bezier, dtype=np.float64).reshape(-1, 4, 2),
+        np.array(ellipses, dtype=np.float64).reshape(-1, 8),
+        complete,
+    )
 
 
 def curved_assembly(outer: Ring, holes: Sequence[Ring], name: str, units: str | None, tol: float) -> Part:
@@ -120,7 +155,8 @@ def curved_assembly(outer: Ring, holes: Sequence[Ring], name: str, units: str | 
     ``tol`` when a non-arc curve was flattened.
     """
     limit = sum(len(r.points) for r in (outer, *holes)) + 16
-    ring, error, curved = curved_ring(outer.curves, tol, limit)
+    flat: list[Curve] = []
+    ring, error, curved = curved_ring(outer.curves, tol, limit, flat)
     rings = [curved_ring(h.curves, tol, limit)[0] for h in holes]
     if not curved:
         part = curved_part(ring, rings, name, units, display_tol=tol)
@@ -131,4 +167,6 @@ def curved_assembly(outer: Ring, holes: Sequence[Ring], name: str, units: str | 
             center_of_mass=part.center_of_mass,
             units=units,
         )
-    return curved_part(ring, rings, name, units, curve_error=error, display_tol=tol)
+    return curved_part(
+        ring, rings, name, units, curve_error=error, display_tol=tol, patches=patches_of(flat)
+    )

@@ -87,6 +87,11 @@ def part_document(part: Part) -> dict[str, Any]:
     }
     if part.units is not None:
         out["units"] = part.units
+    from ..report_curved import curved_document
+
+    curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts only)
+    if curved is not None:
+        out["curved"] = curved
     return out
 
 
