@@ -379,28 +379,45 @@ def _sites(
     )
 
 
-def _prune(c: FloatArray, r: FloatArray, n_points: int) -> NDArray[np.bool_]:
-    """Which sites may lie on the hull: every arc, and the points on the hull of the points.
+def _prune(
+    c: FloatArray, r: FloatArray, lo: FloatArray, w: FloatArray, n_points: int, ltol: float
+) -> NDArray[np.bool_]:
+    """Which sites may lie on the hull, from the convex hull of points on the outline.
 
-    A point strictly inside the convex hull of other points of the outline is inside the
-    outline's hull too, so only the points of the points' own hull (and those on its edges)
-    are kept; arcs are all kept. Pays off for flattened curves (many points).
+    The polygon ``Q`` of the outline's points and of samples of its arcs (every ``_STEP``
+    radians) lies inside the outline's hull. A point strictly inside ``Q`` is inside the
+    hull, so it is dropped; so is an arc all of whose samples lie deeper inside ``Q`` than
+    the arc can bulge between two samples (``r (1 - cos(_STEP / 2))``). What is left are the
+    sites the march must consider (often a small fraction of a detailed outline).
     """
     keep = np.ones(len(c), dtype=bool)
-    if n_points < 64:
+    if len(c) < 48:
         return keep
     from scipy.spatial import ConvexHull, QhullError
 
+    arcs = np.arange(n_points, len(c))
+    counts = np.maximum(2, np.ceil(w[arcs] / _STEP).astype(np.intp) + 1)  # (A,)
+    owner = np.repeat(arcs, counts)
+    frac = np.concatenate([np.linspace(0.0, 1.0, k) for k in counts.tolist()]) if len(arcs) else np.zeros(0)
+    t = lo[owner] + w[owner] * frac
+    samples = c[owner] + r[owner, None] * np.column_stack([np.cos(t), np.sin(t)])
+    pts = np.concatenate([c[:n_points], samples])
     try:
-        hull = ConvexHull(c[:n_points], qhull_options="Qc")
+        hull = ConvexHull(pts)
     except (QhullError, ValueError):
         return keep
-    on = np.zeros(n_points, dtype=bool)
-    on[hull.vertices] = True
-    if hull.coplanar is not None and len(hull.coplanar):
-        on[hull.coplanar[:, 0]] = True  # points on the hull's edges (collinear)
-    keep[:n_points] = on
+    eq = hull.equations  # (F, 3): unit normal and offset, <n, x> + b <= 0 inside
+    depth = -(pts @ eq[:, :2].T + eq[:, 2]).max(axis=1)  # (N,) distance inside Q
+    keep[:n_points] = depth[:n_points] <= ltol
+    if len(arcs):
+        sag = r[arcs] * (1.0 - math.cos(0.5 * _STEP)) + ltol
+        deepest_out = np.minimum.reduceat(depth[n_points:], np.cumsum(counts) - counts)
+        keep[arcs] = deepest_out <= sag
     return keep
+
+
+# Sampling step of arcs (radians) for pruning the sites.
+_STEP = 0.2
 
 
 def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedHull:
@@ -430,9 +447,9 @@ def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedH
     """
     c, r, lo, w, first, last = _sites(ring)
     n_points = len(ring.points)
-    keep = _prune(c, r, n_points)
-    extent = float(np.max(np.ptp(ring.flattened(np.inf), axis=0)))
-    ltol = tol.length_for(max(extent, float(np.max(r, initial=0.0))))
+    box = np.concatenate([c - r[:, None], c + r[:, None]])
+    ltol = tol.length_for(float(np.max(np.ptp(box, axis=0))))
+    keep = _prune(c, r, lo, w, n_points, ltol)
     sites = np.flatnonzero(keep)
     c, r, lo, w, first, last = c[sites], r[sites], lo[sites], w[sites], first[sites], last[sites]
     renum = np.full(len(keep), -1, dtype=np.intp)
@@ -478,7 +495,9 @@ def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedH
             for j in ends_at.get(k, ()):
                 ok[j] = False
         else:
-            ok[first[k]] = ok[last[k]] = False
+            for j in (first[k], last[k]):
+                if j >= 0:  # the arc's own ends (unless pruned) never take over inside it
+                    ok[j] = False
         ok[k] = False
         delta = np.mod(cross - phi + _TIE, TWO_PI) - _TIE
         ok &= valid(idx, cross)
@@ -497,6 +516,8 @@ def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedH
         else:
             if not is_arc[k]:
                 break  # a single vertex supports every direction: no area
+            if last[k] < 0:  # pragma: no cover - an arc on the hull keeps its last end
+                raise PartError("internal error: an arc's end was pruned from the hull")
             at, nxt = phi + max(room, 0.0), int(last[k])
         if at >= phi0 + TWO_PI - _TIE * 1e3:
             break
@@ -551,10 +572,12 @@ def _finish(
     backward = is_point & np.roll(is_point, 1) & (a == (b + 1) % n)
     chord_edges = (forward & chords[np.minimum(a, n - 1)]) | (backward & chords[np.minimum(b, n - 1)])
     chord_edges &= edges > 0
-    # Size: the largest distance from the centroid of the hull's boundary points.
-    hull = CurvedHull(starts, centers, radii, edges, 1.0, tol)
-    pts = hull.boundary(1e-3 * max(float(np.max(np.ptp(hull.boundary(np.inf), axis=0))), 1e-300))
-    size = float(np.max(np.hypot(*(pts - pts.mean(axis=0)).T)))
+    # Size: the largest distance of the hull from the middle of its box (the scale of the
+    # length tolerance; within a factor of 2 of the distance from the area centroid).
+    right = [float((centers[:, 0] + radii).max()), float((centers[:, 1] + radii).max())]
+    left = [float((centers[:, 0] - radii).min()), float((centers[:, 1] - radii).min())]
+    mid = 0.5 * (np.array(right) + np.array(left))
+    size = float(np.max(np.hypot(*(centers - mid).T) + radii))
     for arr in (starts, centers, radii, edges, chord_edges, approx):
         arr.setflags(write=False)
     return CurvedHull(starts, centers, radii, edges, size, tol, chord_edges, approx)
