@@ -278,3 +278,25 @@ def test_exact_area_and_centroid_of_arcs() -> None:
     a, c = CurvedRing([(0.0, 1.0), (0.0, -1.0)], [0.0, 1.0]).area_centroid()  # right half disc
     assert_allclose(a, math.pi / 2, rtol=1e-12)
     assert_allclose(c, [4 / (3 * math.pi), 0.0], atol=1e-12)
+
+
+def cog(pieces: int = 400, seed: int = 3) -> CurvedRing:
+    """A detailed ring of alternating segments and arcs (enough sites to be pruned)."""
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 2 * math.pi, pieces, endpoint=False)
+    r = 50.0 + 1.5 * np.sin(7 * t) + rng.uniform(-0.3, 0.3, pieces)
+    bulges = np.where(np.arange(pieces) % 2 == 1, rng.uniform(-0.3, 0.3, pieces), 0.0)
+    return CurvedRing(np.column_stack([r * np.cos(t), r * np.sin(t)]), bulges)
+
+
+@pytest.mark.parametrize("seed", [1])
+def test_pruned_hull_of_a_detailed_outline_matches_a_dense_sampling(seed: int) -> None:
+    from scipy.spatial import ConvexHull
+
+    ring = cog(seed=seed)
+    hull = curved_hull(ring)
+    pts = dense_outline(ring, 200_000)
+    pts = pts[ConvexHull(pts).vertices]
+    phi = np.linspace(0.0, 2 * math.pi, 601)
+    brute = (np.cos(phi)[:, None] * pts[:, 0] + np.sin(phi)[:, None] * pts[:, 1]).max(axis=1)
+    assert_allclose(hull.support(phi), brute, rtol=0, atol=1e-9 * 50)
