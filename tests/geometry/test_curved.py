@@ -300,3 +300,22 @@ def test_pruned_hull_of_a_detailed_outline_matches_a_dense_sampling(seed: int) -
     phi = np.linspace(0.0, 2 * math.pi, 601)
     brute = (np.cos(phi)[:, None] * pts[:, 0] + np.sin(phi)[:, None] * pts[:, 1]).max(axis=1)
     assert_allclose(hull.support(phi), brute, rtol=0, atol=1e-9 * 50)
+
+
+def test_push_of_a_half_disc() -> None:
+    from bayesgrasp.geometry.curved import curved_push, curved_push_grasp, curved_radius
+
+    # A half disc rests on its flat (the foot from the centre of mass is inside it) and on
+    # its arc like a rocker (a smooth minimum: the centre of mass as near the jaw as it gets).
+    part = curved_part(CurvedRing([(0.0, -1.0), (0.0, 1.0)], [0.0, 1.0]))
+    r = curved_radius(part)
+    c = 4 / (3 * math.pi)
+    th = np.linspace(0, 2 * math.pi, 721)
+    pts = dense_outline(part.ring, 100_000) - part.center_of_mass  # type: ignore[arg-type]
+    brute = (-np.cos(th)[:, None] * pts[:, 0] + np.sin(th)[:, None] * pts[:, 1]).max(axis=1)
+    assert_allclose(r(th), brute, atol=1e-8)
+    p = curved_push(part)
+    assert_allclose(np.degrees(p.stable), [0.0, 180.0], atol=1e-9)  # the arc; the flat
+    assert_allclose(r([0.0, math.pi]), [1 - c, c], rtol=1e-12)
+    g = curved_push_grasp(part)
+    assert set(np.round(g.stable, 12)) <= set(np.round(squeeze_model(part)[1].stable, 12))

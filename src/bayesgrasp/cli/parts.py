@@ -37,13 +37,17 @@ def push(part: PartSpec, prior: PriorOpt = "uniform", as_json: JsonOpt = False) 
     lies flat against the pushing jaw (on the gripper's -x side); the table names that edge.
     """
     from .. import report
+    from ..geometry.curved import CurvedPart, curved_push, curved_push_grasp
     from ..geometry.push import push_function, push_grasp_function, radius_function
     from ..model.prior import parse_prior
 
     p = part.load()
     pr = parse_prior(prior)
     r = radius_function(p)
-    f, g = push_function(r), push_grasp_function(p)
+    if isinstance(p, CurvedPart):  # exact pushes; r names the nearest edges of the polygon
+        f, g = curved_push(p), curved_push_grasp(p)
+    else:
+        f, g = push_function(r), push_grasp_function(p)
     if as_json:
         emit_json(report.push_json(p, r, f, g, pr))
     else:

@@ -73,6 +73,7 @@ __all__ = [
     "SHALLOW",
     "CurvePatches",
     "CurvedDiameter",
+    "CurvedRadius",
     "CurvedHull",
     "CurvedPart",
     "CurvedRing",
@@ -81,6 +82,10 @@ __all__ = [
     "curved_diameter",
     "curved_hull",
     "curved_part",
+    "curved_push",
+    "curved_push_grasp",
+    "curved_radius",
+    "mesh_vertices",
     "resting_states",
     "squeeze_model",
     "with_shape_tol",
@@ -758,10 +763,14 @@ def _sub_pieces(hull: CurvedHull, tol: float) -> tuple[FloatArray, FloatArray, F
     return breaks, chords, offsets
 
 
-def _flush(hull: CurvedHull, theta: float, tol: float) -> float:
+_BOTH = (0.0, math.pi)  # the jaws' outward directions are u(jaw - theta): both jaws
+_PUSHER = (math.pi,)  # the pushing jaw only (the radius function)
+
+
+def _flush(hull: CurvedHull, theta: float, tol: float, jaws: tuple[float, ...] = _BOTH) -> float:
     """Total length of the edges parallel to the jaws at ``theta`` (0: a smooth point)."""
     total = 0.0
-    for phi in (-theta, math.pi - theta):
+    for phi in (j - theta for j in jaws):
         k = int(hull.piece_index(phi + tol))
         if abs(math.remainder(float(hull.starts[k]) - phi, TWO_PI)) <= tol:
             total += float(hull.edges[k])
@@ -769,9 +778,18 @@ def _flush(hull: CurvedHull, theta: float, tol: float) -> float:
 
 
 def _extrema(
-    breaks: FloatArray, chords: FloatArray, offsets: FloatArray, hull: CurvedHull, atol: float
+    breaks: FloatArray,
+    chords: FloatArray,
+    offsets: FloatArray,
+    hull: CurvedHull,
+    atol: float,
+    period: float = math.pi,
+    jaws: tuple[float, ...] = _BOTH,
 ) -> list[Extremum]:
     """Every local extremum of ``d`` over ``[0, pi)``, in order (see the module docstring).
+
+    The same for the radius function (``period`` 2 pi, the pushing jaw only): any function
+    ``chords[k] . (cos theta, -sin theta) + offsets[k]`` on pieces starting at ``breaks``.
 
     The slope of ``d`` is cut into runs of one sign: each piece is split at the zeros of
     its slope inside it; a run whose slope is within the length tolerance of zero is flat.
@@ -780,7 +798,7 @@ def _extrema(
     middle of the flat stretch between them.
     """
     ltol = hull.tol.length_for(hull.size)
-    ends = np.append(breaks[1:], breaks[0] + math.pi)
+    ends = np.append(breaks[1:], breaks[0] + period)
     runs: list[tuple[float, float, int, bool]] = []  # start, end, sign, starts at a break
     for k in range(len(breaks)):
         s, e = float(breaks[k]), float(ends[k])
@@ -808,22 +826,24 @@ def _extrema(
         if runs[i][2] == runs[j][2]:
             continue
         lo = runs[i][1]
-        hi = runs[j][0] if j > i else runs[j][0] + math.pi
+        hi = runs[j][0] if j > i else runs[j][0] + period
         if (j - i) % n == 1:
             at = lo
-            kink = runs[j][3] and _flush(hull, lo, atol) > 0.0
+            kink = runs[j][3] and _flush(hull, lo, atol, jaws) > 0.0
         else:
             at = 0.5 * (lo + hi)
             kink = False
-        at = at % math.pi
-        value = float(_evaluate(breaks, chords, offsets, at))
+        at = at % period
+        value = float(_evaluate(breaks, chords, offsets, at, period))
         out.append(Extremum(at, value, runs[i][2] > 0, kink))
     out.sort(key=lambda e: e.theta)
     return out
 
 
-def _evaluate(breaks: FloatArray, chords: FloatArray, offsets: FloatArray, th: float) -> float:
-    t = (th - breaks[0]) % math.pi
+def _evaluate(
+    breaks: FloatArray, chords: FloatArray, offsets: FloatArray, th: float, period: float
+) -> float:
+    t = (th - breaks[0]) % period
     k = int(np.clip(np.searchsorted(breaks - breaks[0], t, side="right") - 1, 0, len(breaks) - 1))
     th = t + float(breaks[0])  # a half turn swaps the contacts: use the piece's own angle
     return float(chords[k, 0] * math.cos(th) - chords[k, 1] * math.sin(th) + offsets[k])
@@ -849,12 +869,12 @@ def _cancel(ext: list[Extremum], depth: float) -> list[Extremum]:
     return ext
 
 
-def _needs_refining(hull: CurvedHull, e: Extremum) -> bool:
+def _needs_refining(hull: CurvedHull, e: Extremum, jaws: tuple[float, ...]) -> bool:
     """Whether an extremum lies where the model only approximates a curve."""
     if hull.approximate is None or hull.chord_edges is None:
         return False
     tol = hull.tol.angle
-    for phi in (-e.theta, math.pi - e.theta):
+    for phi in (j - e.theta for j in jaws):
         k = int(hull.piece_index(phi + tol))
         at_start = abs(math.remainder(float(hull.starts[k]) - phi, TWO_PI)) <= tol
         if at_start and hull.edges[k] > 0:
@@ -867,32 +887,42 @@ def _needs_refining(hull: CurvedHull, e: Extremum) -> bool:
 
 
 def _refined(
-    hull: CurvedHull, kept: list[Extremum], patches: CurvePatches
+    hull: CurvedHull,
+    kept: list[Extremum],
+    patches: CurvePatches,
+    period: float = math.pi,
+    jaws: tuple[float, ...] = _BOTH,
+    center: FloatArray | None = None,
 ) -> list[Extremum]:
     """The extrema that flattened curves carry, placed on the exact curves.
 
     Each such extremum of the flattened model is searched again on the exact diameter
     ``d(theta) = H(-theta) + H(pi - theta)``, ``H = max(h_flat, h_curves)``, between the
     midpoints to its neighbours (bounded Brent): a smooth extremum of the true curve, to
-    about 1e-8 rad, instead of a kink of a chord.
+    about 1e-8 rad, instead of a kink of a chord. For the radius function (the pushing jaw
+    only, ``center`` the centre of mass): ``r(theta) = H(pi - theta) - center . u``.
     """
     from scipy.optimize import minimize_scalar
 
+    c = np.zeros(2) if center is None else center
+
     def exact(th: float) -> float:
-        return sum(
-            max(float(hull.support(phi)), patches.support(phi)) for phi in (-th, math.pi - th)
-        )
+        total = 0.0
+        for phi in (j - th for j in jaws):
+            h = max(float(hull.support(phi)), patches.support(phi))
+            total += h - (c[0] * math.cos(phi) + c[1] * math.sin(phi) if center is not None else 0)
+        return total
 
     out = list(kept)
     m = len(kept)
     for i, e in enumerate(kept):
-        if not _needs_refining(hull, e):
+        if not _needs_refining(hull, e, jaws):
             continue
         if m > 1:
-            before = (e.theta - kept[i - 1].theta) % math.pi or math.pi
-            after = (kept[(i + 1) % m].theta - e.theta) % math.pi or math.pi
+            before = (e.theta - kept[i - 1].theta) % period or period
+            after = (kept[(i + 1) % m].theta - e.theta) % period or period
         else:
-            before = after = math.pi
+            before = after = period
         sign = -1.0 if e.is_max else 1.0
         res = minimize_scalar(
             lambda t: sign * exact(t),
@@ -900,7 +930,7 @@ def _refined(
             method="bounded",
             options={"xatol": 1e-12},
         )
-        th = float(res.x) % math.pi
+        th = float(res.x) % period
         out[i] = Extremum(th, exact(th), e.is_max, False)
     return out
 
@@ -1192,3 +1222,104 @@ def _no_state_reason(part: CurvedPart, d: CurvedDiameter) -> str:
         f"{spread:.3g}{units}, no more than the error bound allows "
         f"(4 x {d.error:.3g}{units}: flattening and --shape-tol), so no plan can orient it"
     )
+
+
+def mesh_vertices(part: Part, fine: float = 1e-4) -> FloatArray:
+    """Hull vertices for a simulation: a curved part's arcs within ``fine`` times its size.
+
+    A polygon's own hull vertices; for a :class:`CurvedPart` the exact hull sampled so
+    finely that no chord is a facet the part could rest on in the engine.
+    """
+    if isinstance(part, CurvedPart):
+        hull = part.curved_hull
+        return part.curved_hull.polygon(fine * hull.size).vertices
+    return np.asarray(part.hull.vertices, dtype=np.float64)
+
+
+# --------------------------------------------------------------------------------------
+# Pushing: the radius function about the centre of mass
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CurvedRadius:
+    """The exact radius function of a curved part over ``[0, 2 pi)``, and its extrema.
+
+    ``r(theta) = h(pi - theta) - c . u(pi - theta)`` (``c`` the centre of mass; Mason 1986,
+    Goldberg 1993 section 5): on each piece ``chords[k] . (cos theta, -sin theta) +
+    offsets[k]`` with ``chords = c - centre`` of the touching vertex or arc. Minima are
+    stable pushes (an edge flush with the pushing jaw whose foot of the perpendicular from
+    ``c`` lies inside it, or a smooth minimum on an arc: a disc rolls its centre of mass
+    down), maxima the unstable equilibria; pairs shallower than ``2 error`` (``r`` is off by
+    at most ``error``) are cancelled.
+    """
+
+    breaks: FloatArray
+    chords: FloatArray
+    offsets: FloatArray
+    minima: FloatArray
+    maxima: FloatArray
+    center_of_mass: FloatArray
+
+    def __call__(self, theta: ArrayLike) -> FloatArray:
+        """``r(theta)``, vectorised."""
+        th = np.mod(np.asarray(theta, dtype=np.float64) - self.breaks[0], TWO_PI)
+        k = np.clip(np.searchsorted(self.breaks - self.breaks[0], th, side="right") - 1, 0, None)
+        th = th + self.breaks[0]
+        g = self.chords[k]
+        out: FloatArray = g[..., 0] * np.cos(th) - g[..., 1] * np.sin(th) + self.offsets[k]
+        return out
+
+
+def curved_radius(part: CurvedPart) -> CurvedRadius:
+    """The radius function of a curved part about its centre of mass (see CurvedRadius).
+
+    Examples
+    --------
+    >>> slot = curved_part(CurvedRing([(0, -1), (2, -1), (2, 1), (0, 1)], [0, 1, 0, 1]))
+    >>> np.degrees(curved_radius(slot).minima).round(6).tolist()
+    [90.0, 270.0]
+    """
+    if "radius" in part._model:
+        return part._model["radius"]  # type: ignore[return-value]
+    hull = part.curved_hull
+    com = np.asarray(part.center_of_mass, dtype=np.float64)
+    atol = hull.tol.angle
+    b = np.sort(np.mod(math.pi - hull.starts, TWO_PI))
+    wide = np.diff(b, prepend=b[-1] - TWO_PI) > atol
+    breaks = b[wide] if wide.any() else b[:1]
+    ends = np.append(breaks[1:], breaks[0] + TWO_PI)
+    k = hull.piece_index(math.pi - 0.5 * (breaks + ends))
+    chords = com - hull.centers[k]
+    offsets = np.array(hull.radii[k], dtype=np.float64)
+    ext = _extrema(breaks, chords, offsets, hull, atol, TWO_PI, _PUSHER)
+    depth = max(hull.tol.barrier_for(hull.size), 2.0 * part.error)
+    kept = _cancel(ext, depth)
+    patches = part.patches
+    if patches is not None and (len(patches.bezier) or len(patches.ellipses)):
+        kept = _refined(hull, kept, patches, TWO_PI, _PUSHER, com)
+    if not kept:
+        raise PlanningError(
+            f"part {part.name!r} has no stable orientation under a push: its radius about the "
+            "centre of mass varies by no more than the error bound allows"
+        )
+    minima = np.array(sorted(e.theta for e in kept if not e.is_max), dtype=np.float64)
+    maxima = np.array(sorted(e.theta for e in kept if e.is_max), dtype=np.float64)
+    out = CurvedRadius(breaks, chords, offsets, minima, maxima, com)
+    part._model["radius"] = out
+    return out
+
+
+def curved_push(part: CurvedPart) -> TransferFunction:
+    """The push function of a curved part: descend its exact radius function."""
+    r = curved_radius(part)
+    angle = part.hull.tol.angle
+    return transfer_from_extrema("push", r.minima, r.maxima, angle, angle)
+
+
+def curved_push_grasp(part: CurvedPart, squeeze: TransferFunction | None = None) -> TransferFunction:
+    """The push-grasp function ``s o p`` of a curved part (its exact push and squeeze)."""
+    from .push import compose_push_grasp
+
+    s = squeeze if squeeze is not None else squeeze_model(part)[1]
+    r = curved_radius(part)
+    return compose_push_grasp(r.minima, r.maxima, s, part.hull.tol.angle)
