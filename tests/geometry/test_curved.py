@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
@@ -180,6 +180,13 @@ def test_shape_tolerance_removes_minima_it_could_erase() -> None:
         with_shape_tol(part, -1.0)
 
 
+def test_coincident_points_are_refused() -> None:
+    with pytest.raises(PartError, match="coincide"):
+        CurvedRing([(0, 0), (1, 0), (1, 0), (0, 1)], [0, 0, 0, 0])
+    with pytest.raises(PartError, match="across"):
+        CurvedRing([(1.0, 0.0), (1.0, 1e-300)], [1.0, 1.0])
+
+
 def test_polygon_through_the_curved_model_agrees_with_the_polygon_code() -> None:
     part = Part.from_points([(0, 0), (40, 0), (10, 20)])
     curved = with_shape_tol(part, 1e-300)  # the curved code path, no tolerance to speak of
@@ -194,12 +201,18 @@ def test_polygon_through_the_curved_model_agrees_with_the_polygon_code() -> None
 # Brute force: the support and diameter functions of a dense sampling of the outline
 
 
-def dense_outline(ring: CurvedRing, per_turn: int = 200_000) -> np.ndarray:
-    """Points on the true outline: every segment end and arcs sampled very finely."""
+def dense_outline(ring: CurvedRing, per_turn: int = 20_000, sag: float = 2e-11) -> np.ndarray:
+    """Points on the true outline: every segment end and arcs sampled very finely.
+
+    Each arc is sampled at least ``per_turn`` times a turn and so that its sagitta between
+    samples (``r step^2 / 8``) is at most ``sag`` times the part's extent.
+    """
     out = [ring.points]
     centers, radii, starts, sweeps, _ = ring.arcs()
+    extent = float(np.ptp(ring.points)) or 1.0
     for c, r, a, s in zip(centers, radii, starts, sweeps, strict=True):
-        n = max(16, int(per_turn * abs(s) / (2 * math.pi)))
+        step = math.sqrt(8.0 * sag * extent / r)
+        n = max(16, int(per_turn * abs(s) / (2 * math.pi)), min(2_000_000, math.ceil(abs(s) / step)))
         t = a + s * np.linspace(0.0, 1.0, n)
         out.append(c + r * np.column_stack([np.cos(t), np.sin(t)]))
     return np.concatenate(out)
@@ -221,13 +234,11 @@ def arc_outlines(draw: st.DrawFn) -> CurvedRing:
     if n == 2:
         bulges[0] = 1.0
     step = np.roll(pts, -1, axis=0) - pts
-    if np.min(np.hypot(step[:, 0], step[:, 1])) < 1e-2:
-        pts = pts + 0.0
-        bulges = [1.0] * n
+    assume(np.min(np.hypot(step[:, 0], step[:, 1])) > 1e-2)
     return CurvedRing(pts, bulges)
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=30, deadline=None)
 @given(arc_outlines())
 def test_exact_support_and_diameter_match_a_dense_sampling(ring: CurvedRing) -> None:
     try:
@@ -236,11 +247,11 @@ def test_exact_support_and_diameter_match_a_dense_sampling(ring: CurvedRing) -> 
         return
     pts = dense_outline(ring)
     size = float(np.max(np.hypot(*(pts - pts.mean(axis=0)).T)))
-    phi = np.linspace(0.0, 2 * math.pi, 97, endpoint=False) + 0.0123
+    phi = np.linspace(0.0, 2 * math.pi, 61, endpoint=False) + 0.0123
     brute = (np.cos(phi)[:, None] * pts[:, 0] + np.sin(phi)[:, None] * pts[:, 1]).max(axis=1)
     assert_allclose(hull.support(phi), brute, rtol=0, atol=1e-9 * size)
     d = curved_diameter(hull)
-    th = np.linspace(0.0, math.pi, 61) + 0.0071
+    th = np.linspace(0.0, math.pi, 37) + 0.0071
     brute_d = np.array(
         [
             np.ptp(np.cos(t) * pts[:, 0] - np.sin(t) * pts[:, 1])  # width along the squeeze axis
@@ -251,9 +262,12 @@ def test_exact_support_and_diameter_match_a_dense_sampling(ring: CurvedRing) -> 
     # Extrema alternate, and every kept minimum is a local minimum of the sampled width.
     kinds = [e.is_max for e in d.kept]
     assert all(a != b for a, b in zip(kinds, kinds[1:] + kinds[:1], strict=True))
+    others = np.array([x.theta for x in d.extrema])
     for e in d.kept:
+        gap = np.abs(np.remainder(others - e.theta + math.pi / 2, math.pi) - math.pi / 2)
+        step = min(1e-4, 0.25 * float(np.min(gap[gap > 1e-12], initial=1.0)))
         near = np.array(
-            [np.ptp(np.cos(t) * pts[:, 0] - np.sin(t) * pts[:, 1]) for t in (e.theta - 1e-3, e.theta + 1e-3)]
+            [np.ptp(np.cos(t) * pts[:, 0] - np.sin(t) * pts[:, 1]) for t in (e.theta - step, e.theta + step)]
         )
         if e.is_max:
             assert np.all(near <= e.value + 1e-9 * size)

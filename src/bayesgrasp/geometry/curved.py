@@ -147,6 +147,18 @@ class CurvedRing:
             raise PartError("`bulges` must be finite")
         if len(p) < 2 or (len(p) == 2 and not np.any(b != 0)):
             raise PartError(f"a curved outline needs at least 3 points or arcs; got {len(p)}")
+        step = np.roll(p, -1, axis=0) - p
+        gaps = np.hypot(step[:, 0], step[:, 1])
+        extent = float(np.max(np.ptp(p, axis=0)))
+        if not extent > 1e-150 or float(np.max(np.abs(p))) > 1e150:
+            raise PartError(
+                f"the outline is {extent:g} across; it must be between 1e-150 and 1e150 "
+                "(rescale the part's units)"
+            )
+        short = np.flatnonzero(gaps <= 1e-12 * extent)
+        if len(short):
+            i = int(short[0])
+            raise PartError(f"`points` {i} and {(i + 1) % len(p)} of the outline coincide")
         p = p.copy()
         b = b.copy()
         p.setflags(write=False)
