@@ -44,7 +44,10 @@ def cog_dxf(pieces: int, seed: int = 1) -> bytes:
     t = np.linspace(0.0, 2 * math.pi, pieces, endpoint=False)
     r = 50.0 + 1.5 * np.sin(7 * t) + rng.uniform(-0.3, 0.3, pieces)
     bulges = np.where(np.arange(pieces) % 2 == 1, rng.uniform(-0.3, 0.3, pieces), 0.0)
-    pts = [(float(x), float(y), float(b)) for x, y, b in zip(r * np.cos(t), r * np.sin(t), bulges, strict=True)]
+    pts = [
+        (float(x), float(y), float(b))
+        for x, y, b in zip(r * np.cos(t), r * np.sin(t), bulges, strict=True)
+    ]
     doc = ezdxf.new("R2010", units=4)
     doc.modelspace().add_lwpolyline(pts, format="xyb", close=True)
     text = io.StringIO()
@@ -75,12 +78,12 @@ def main() -> None:
 
     t_plan, report = timed(plan, args.repeat)
     best = report.options[report.bayes]
-    print(f"cog.dxf: {part.ring.n_arcs} arcs, {len(part.ring.points) - part.ring.n_arcs} segments")  # noqa: T201
-    print(f"hull pieces {part.curved_hull.n_pieces}, extrema {len(d.extrema)}, states {s.n_states}")  # noqa: T201
-    print(f"read DXF                 {1e3 * t_read:8.1f} ms")  # noqa: T201
-    print(f"squeeze function         {1e3 * t_squeeze:8.1f} ms   (target < 50 ms)")  # noqa: T201
-    print(f"Problem.build + plan     {1e3 * t_plan:8.1f} ms   (target < 200 ms)")  # noqa: T201
-    print(  # noqa: T201
+    print(f"cog.dxf: {part.ring.n_arcs} arcs, {len(part.ring.points) - part.ring.n_arcs} segments")
+    print(f"hull pieces {part.curved_hull.n_pieces}, extrema {len(d.extrema)}, states {s.n_states}")
+    print(f"read DXF                 {1e3 * t_read:8.1f} ms")
+    print(f"squeeze function         {1e3 * t_squeeze:8.1f} ms   (target < 50 ms)")
+    print(f"Problem.build + plan     {1e3 * t_plan:8.1f} ms   (target < 200 ms)")
+    print(
         f"Bayes plan: {best.n_actions} squeezes, p = {best.success_probability:.4f}, "
         f"E[cost] = {best.expected_cost:.3f}"
     )

@@ -63,7 +63,7 @@ def test_disc_has_no_state_and_every_plan_is_refused() -> None:
     d = part.diameter_function
     assert d.minima.size == 0 and d.maxima.size == 0
     assert_allclose(d(np.linspace(0, 7, 50)), 2.0, atol=1e-12)
-    with pytest.raises(PlanningError, match="no stable orientation.*disc"):
+    with pytest.raises(PlanningError, match=r"no stable orientation.*disc"):
         Problem.build(part)
 
 
@@ -212,7 +212,9 @@ def dense_outline(ring: CurvedRing, per_turn: int = 20_000, sag: float = 2e-11) 
     extent = float(np.ptp(ring.points)) or 1.0
     for c, r, a, s in zip(centers, radii, starts, sweeps, strict=True):
         step = math.sqrt(8.0 * sag * extent / r)
-        n = max(16, int(per_turn * abs(s) / (2 * math.pi)), min(2_000_000, math.ceil(abs(s) / step)))
+        n = max(
+            16, int(per_turn * abs(s) / (2 * math.pi)), min(2_000_000, math.ceil(abs(s) / step))
+        )
         t = a + s * np.linspace(0.0, 1.0, n)
         out.append(c + r * np.column_stack([np.cos(t), np.sin(t)]))
     return np.concatenate(out)
@@ -267,7 +269,10 @@ def test_exact_support_and_diameter_match_a_dense_sampling(ring: CurvedRing) -> 
         gap = np.abs(np.remainder(others - e.theta + math.pi / 2, math.pi) - math.pi / 2)
         step = min(1e-4, 0.25 * float(np.min(gap[gap > 1e-12], initial=1.0)))
         near = np.array(
-            [np.ptp(np.cos(t) * pts[:, 0] - np.sin(t) * pts[:, 1]) for t in (e.theta - step, e.theta + step)]
+            [
+                np.ptp(np.cos(t) * pts[:, 0] - np.sin(t) * pts[:, 1])
+                for t in (e.theta - step, e.theta + step)
+            ]
         )
         if e.is_max:
             assert np.all(near <= e.value + 1e-9 * size)

@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+
 from bayesgrasp.cli import main
 from bayesgrasp.errors import PlanningError
 from bayesgrasp.geometry import Part
@@ -120,7 +121,8 @@ def catmull_rom_svg(rng: np.random.Generator, n: int = 6) -> str:
         p0, p1, p2, p3 = p[i - 1], p[i], p[(i + 1) % n], p[(i + 2) % n]
         c1, c2 = p1 + (p2 - p0) / 6, p2 - (p3 - p1) / 6
         d.append(f"C {c1[0]:.6f} {c1[1]:.6f} {c2[0]:.6f} {c2[1]:.6f} {p2[0]:.6f} {p2[1]:.6f}")
-    return f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100"><path d="{" ".join(d)} Z"/></svg>'
+    head = '<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 100 100">'
+    return f'{head}<path d="{" ".join(d)} Z"/></svg>'
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
@@ -132,7 +134,9 @@ def test_states_and_costs_converge_as_the_flattening_tolerance_shrinks(seed: int
         part = read_part_bytes(svg, "svg", "blob.svg", tolerance=rel * size)
         pb = Problem.build(part)
         report = plan_exact(pb)
-        results.append((pb.states.stable, pb.state_distribution(), report.options[-1].expected_cost))
+        results.append(
+            (pb.states.stable, pb.state_distribution(), report.options[-1].expected_cost)
+        )
         # No state has a basin narrower than the error bound could shift it.
         assert np.all(pb.states.widths > 1e-6)
     stable, probs, cost = results[-1]

@@ -58,7 +58,7 @@ class PartSpec:
     shape_tol: float = 0.0
 
     def load(self) -> Part:
-        """Read the part (with ``--shape-tol``, see :func:`~bayesgrasp.geometry.curved.with_shape_tol`)."""
+        """Read the part (``--shape-tol``: :func:`~bayesgrasp.geometry.curved.with_shape_tol`)."""
         from ..geometry.curved import with_shape_tol
         from ..io import resolve_part
 

@@ -55,8 +55,9 @@ takes over for parts with curves or a shape tolerance (:func:`squeeze_model`).
 
 from __future__ import annotations
 
+import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -73,9 +74,9 @@ __all__ = [
     "SHALLOW",
     "CurvePatches",
     "CurvedDiameter",
-    "CurvedRadius",
     "CurvedHull",
     "CurvedPart",
+    "CurvedRadius",
     "CurvedRing",
     "Extremum",
     "RestingState",
@@ -353,7 +354,7 @@ class CurvedHull:
         pts = pts[keep]
         if len(pts) > 1 and math.dist(pts[0], pts[-1]) <= 1e-12 * self.size:
             pts = pts[:-1]
-        return pts
+        return np.asarray(pts, dtype=np.float64)
 
     def polygon(self, tol: float | None = None) -> ConvexPolygon:
         """The hull flattened to a convex polygon (points on the hull, within ``tol``)."""
@@ -415,7 +416,11 @@ def _prune(
     arcs = np.arange(n_points, len(c))
     counts = np.maximum(2, np.ceil(w[arcs] / _STEP).astype(np.intp) + 1)  # (A,)
     owner = np.repeat(arcs, counts)
-    frac = np.concatenate([np.linspace(0.0, 1.0, k) for k in counts.tolist()]) if len(arcs) else np.zeros(0)
+    frac = (
+        np.concatenate([np.linspace(0.0, 1.0, k) for k in counts.tolist()])
+        if len(arcs)
+        else np.zeros(0)
+    )
     t = lo[owner] + w[owner] * frac
     samples = c[owner] + r[owner, None] * np.column_stack([np.cos(t), np.sin(t)])
     pts = np.concatenate([c[:n_points], samples])
@@ -489,7 +494,9 @@ def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedH
 
     # Start: the site of largest support at phi = 0 (ties: the one that continues past 0).
     phi0 = 0.0
-    vals = np.where(valid(np.arange(len(c)), np.zeros(len(c))), value(np.arange(len(c)), 0.0), -np.inf)
+    vals = np.where(
+        valid(np.arange(len(c)), np.zeros(len(c))), value(np.arange(len(c)), 0.0), -np.inf
+    )
     top = float(vals.max())
     tied = np.flatnonzero(vals >= top - ltol)
     along = c[tied, 1] + r[tied] * 0.0  # the tangent at phi = 0 is +y
@@ -583,11 +590,15 @@ def _finish(
     chords = np.asarray(ring.chords, dtype=bool)
     point = orig[site]  # (P,) ring point of each piece (>= n: an arc)
     is_point = point < n
-    approx = is_point & (chords[np.minimum(point, n - 1)] | chords[(np.minimum(point, n - 1) - 1) % n])
+    approx = is_point & (
+        chords[np.minimum(point, n - 1)] | chords[(np.minimum(point, n - 1) - 1) % n]
+    )
     a, b = np.roll(point, 1), point
     forward = is_point & np.roll(is_point, 1) & (b == (a + 1) % n)
     backward = is_point & np.roll(is_point, 1) & (a == (b + 1) % n)
-    chord_edges = (forward & chords[np.minimum(a, n - 1)]) | (backward & chords[np.minimum(b, n - 1)])
+    chord_edges = (forward & chords[np.minimum(a, n - 1)]) | (
+        backward & chords[np.minimum(b, n - 1)]
+    )
     chord_edges &= edges > 0
     # Size: the largest distance of the hull from the middle of its box (the scale of the
     # length tolerance; within a factor of 2 of the distance from the area centroid).
@@ -898,6 +909,10 @@ def _needs_refining(hull: CurvedHull, e: Extremum, jaws: tuple[float, ...]) -> b
     return False
 
 
+def _signed(f: Callable[[float], float], sign: float, t: float) -> float:
+    return sign * f(t)
+
+
 def _refined(
     hull: CurvedHull,
     kept: list[Extremum],
@@ -937,7 +952,7 @@ def _refined(
             before = after = period
         sign = -1.0 if e.is_max else 1.0
         res = minimize_scalar(
-            lambda t: sign * exact(t),
+            functools.partial(_signed, exact, sign),
             bounds=(e.theta - 0.5 * before, e.theta + 0.5 * after),
             method="bounded",
             options={"xatol": 1e-12},
@@ -1328,7 +1343,9 @@ def curved_push(part: CurvedPart) -> TransferFunction:
     return transfer_from_extrema("push", r.minima, r.maxima, angle, angle)
 
 
-def curved_push_grasp(part: CurvedPart, squeeze: TransferFunction | None = None) -> TransferFunction:
+def curved_push_grasp(
+    part: CurvedPart, squeeze: TransferFunction | None = None
+) -> TransferFunction:
     """The push-grasp function ``s o p`` of a curved part (its exact push and squeeze)."""
     from .push import compose_push_grasp
 

@@ -89,7 +89,7 @@ def curved_ring(
     budget = FlattenBudget(max(limit, 4) * 4)
     for c in curves:
         circle = circle_of(c) if isinstance(c, EllipticArc) else None
-        if circle is not None:
+        if circle is not None and isinstance(c, EllipticArc):
             radius, start, sweep = circle
             k = max(1, math.ceil(abs(sweep) / (math.pi / 2) - 1e-9))
             t = start + sweep * np.arange(k) / k
@@ -146,7 +146,9 @@ def patches_of(curves: Sequence[Curve]) -> CurvePatches:
     )
 
 
-def curved_assembly(outer: Ring, holes: Sequence[Ring], name: str, units: str | None, tol: float) -> Part:
+def curved_assembly(
+    outer: Ring, holes: Sequence[Ring], name: str, units: str | None, tol: float
+) -> Part:
     """The part of an outer ring and its holes, with arcs kept exact.
 
     An outline of straight segments stays a polygon :class:`~bayesgrasp.geometry.Part` (as
