@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from .geometry.curved import SHALLOW, CurvedPart, RestingState, resting_states
 
 if TYPE_CHECKING:
@@ -64,8 +66,10 @@ def _edge_text(state: RestingState, units: str) -> str:
     if not state.edges:
         return "smooth (curves touch both jaws)"
     parts = []
-    for a, b in state.edges:
-        length = math.dist(a, b)
+    for a0, b0 in state.edges:
+        length = math.dist(a0, b0)
+        # Coordinates that are rounding noise on a zero (1e-16 of the part) print as 0.
+        a, b = (np.where(np.abs(p) <= 1e-12 * max(length, 1.0), 0.0, p) for p in (a0, b0))
         parts.append(
             f"edge ({a[0]:.4g}, {a[1]:.4g})-({b[0]:.4g}, {b[1]:.4g}), {length:.4g}{units} long"
         )
