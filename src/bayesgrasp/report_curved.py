@@ -56,6 +56,7 @@ def curved_document(part: Part) -> dict[str, Any] | None:
                 "depth": s.depth,
                 "edges": [[a.tolist(), b.tolist()] for a, b in s.edges],
                 "shallow": s.shallow,
+                "flat_rad": list(s.flat),
             }
             for s in _states(part)
         ],
@@ -96,6 +97,9 @@ def curved_lines(part: Part) -> list[str]:
     ]
     for i, s in enumerate(_states(part)):
         mark = "  SHALLOW" if s.shallow else ""
+        if s.is_flat:
+            lo, hi = (math.degrees(x) for x in s.flat)
+            mark += f"  FLAT from {lo:.1f} to {hi:.1f} deg"
         lines.append(
             f"  {i:>3} {math.degrees(s.theta):9.3f}  {_edge_text(s, units)}; depth "
             f"{s.depth:.4g}{units}{mark}"
@@ -116,7 +120,16 @@ def shallow_warnings(problem: Problem, finals: dict[str, float]) -> list[str]:
     out = []
     for label, theta in finals.items():
         for s in states:
-            if s.shallow and abs(math.remainder(theta - s.theta, math.pi)) <= 1e-6:
+            if abs(math.remainder(theta - s.theta, math.pi)) > 1e-6:
+                continue
+            if s.is_flat:
+                lo, hi = (math.degrees(x - s.theta + theta) for x in s.flat)
+                out.append(
+                    f"warning: the {label} ends at {math.degrees(theta):.2f} deg, where the "
+                    f"width stays within {SHALLOW:.0%} of {s.width:.4g}{units} from {lo:.1f} "
+                    f"to {hi:.1f} deg: support friction may stop the part anywhere there"
+                )
+            if s.shallow:
                 out.append(
                     f"warning: the {label} ends at {math.degrees(theta):.2f} deg, a shallow "
                     f"minimum (depth {s.depth:.3g}{units}, under {SHALLOW:.0%} of the jaw "

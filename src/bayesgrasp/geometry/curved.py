@@ -71,6 +71,7 @@ from .polygon import ConvexPolygon, Part, as_points
 from .transfer import TransferFunction, squeeze_function, transfer_from_extrema
 
 __all__ = [
+    "FLAT",
     "SHALLOW",
     "CurvePatches",
     "CurvedDiameter",
@@ -98,6 +99,10 @@ IntArray = NDArray[np.intp]
 #: A state is *shallow* when it lies less than this fraction of its jaw opening below the
 #: lower of its two neighbouring maxima.
 SHALLOW = 0.01
+
+#: A state is *flat* when ``d`` stays within ``SHALLOW`` of its minimum over more than this
+#: angle (radians, 5 degrees) around it.
+FLAT = math.radians(5.0)
 
 # Angles closer than this are the same crossing of two support functions (ties of the march).
 _TIE = 1e-12
@@ -637,6 +642,35 @@ class CurvePatches:
     ellipses: FloatArray
     complete: bool = True
 
+    def points(self, tol: float) -> FloatArray:
+        """Points on the curves, no farther than ``tol`` from them between samples.
+
+        A cubic's chords are within ``h^2 / 8 max |B''|`` of it (``h`` the parameter step,
+        ``|B''| <= 6 max |P_i - 2 P_{i+1} + P_{i+2}|``); an elliptic arc's within
+        ``h^2 / 8`` times its major radius.
+        """
+        out = [np.zeros((0, 2))]
+        for q in self.bezier:
+            second = 6.0 * float(np.max(np.hypot(*(q[:-2] - 2 * q[1:-1] + q[2:]).T)))
+            n = max(2, min(100_000, math.ceil(math.sqrt(second / (8.0 * tol)))))
+            t = np.linspace(0.0, 1.0, n + 1)[:, None]
+            out.append(
+                (1 - t) ** 3 * q[0]
+                + 3 * (1 - t) ** 2 * t * q[1]
+                + 3 * (1 - t) * t**2 * q[2]
+                + t**3 * q[3]
+            )
+        for cx, cy, mx, my, nx, ny, t0, span in self.ellipses:
+            big = max(math.hypot(mx, my), math.hypot(nx, ny))
+            n = max(2, min(100_000, math.ceil(abs(span) / math.sqrt(8.0 * tol / big))))
+            t = t0 + span * np.linspace(0.0, 1.0, n + 1)
+            out.append(
+                np.column_stack(
+                    [cx + mx * np.cos(t) + nx * np.sin(t), cy + my * np.cos(t) + ny * np.sin(t)]
+                )
+            )
+        return np.concatenate(out)
+
     def support(self, phi: float) -> float:
         """``max over the curves of <x, u(phi)>`` (closed forms; -inf without curves)."""
         u = np.array([math.cos(phi), math.sin(phi)])
@@ -1172,6 +1206,11 @@ class RestingState:
         The straight edges flush with a jaw (their two ends), empty for a smooth minimum.
     shallow : bool
         ``depth < SHALLOW * width``.
+    flat : tuple of float
+        ``(lo, hi)``: the stretch of the basin around ``theta`` where ``d`` stays within
+        ``SHALLOW`` of ``width``. A squeeze turns the part there with so little torque that
+        support friction may stop it anywhere in the stretch: when it is wider than
+        :data:`FLAT` the final orientation is only known to lie in it.
     """
 
     theta: float
@@ -1179,6 +1218,12 @@ class RestingState:
     depth: float
     edges: tuple[tuple[FloatArray, FloatArray], ...]
     shallow: bool
+    flat: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def is_flat(self) -> bool:
+        """Whether the flat stretch is wider than :data:`FLAT`."""
+        return self.flat[1] - self.flat[0] > FLAT
 
 
 def resting_states(d: CurvedDiameter) -> list[RestingState]:
@@ -1205,7 +1250,19 @@ def resting_states(d: CurvedDiameter) -> list[RestingState]:
             k = int(hull.piece_index(phi + tol))
             if abs(math.remainder(float(hull.starts[k]) - phi, TWO_PI)) <= tol and hull.edges[k]:
                 edges.append(hull.edge_ends(k))
-        out.append(RestingState(e.theta, e.value, depth, tuple(edges), depth < SHALLOW * e.value))
+        a = kept[i - 1].theta if len(kept) > 1 else e.theta - math.pi / 2
+        b = kept[(i + 1) % len(kept)].theta if len(kept) > 1 else e.theta + math.pi / 2
+        lo = e.theta - ((e.theta - a) % math.pi or math.pi)
+        hi = e.theta + ((b - e.theta) % math.pi or math.pi)
+        grid = np.linspace(lo, hi, 2001)
+        low = d(grid) <= e.value * (1.0 + SHALLOW)
+        at = int(np.argmin(np.abs(grid - e.theta)))
+        left = at - int(np.argmin(low[at::-1])) if not low[at::-1].all() else 0
+        right = at + int(np.argmin(low[at:])) if not low[at:].all() else len(grid) - 1
+        flat = (float(grid[max(left, 0)]), float(grid[min(right, len(grid) - 1)]))
+        out.append(
+            RestingState(e.theta, e.value, depth, tuple(edges), depth < SHALLOW * e.value, flat)
+        )
     return out
 
 
@@ -1259,7 +1316,11 @@ def mesh_vertices(part: Part, fine: float = 1e-4) -> FloatArray:
     """
     if isinstance(part, CurvedPart):
         hull = part.curved_hull
-        return part.curved_hull.polygon(fine * hull.size).vertices
+        tol = fine * hull.size
+        pts = [hull.boundary(tol)]
+        if part.patches is not None:
+            pts.append(part.patches.points(tol))
+        return ConvexPolygon.from_points(np.concatenate(pts), hull.tol).vertices
     return np.asarray(part.hull.vertices, dtype=np.float64)
 
 
