@@ -470,7 +470,7 @@ def curved_hull(ring: CurvedRing, tol: Tolerance = DEFAULT_TOLERANCE) -> CurvedH
     ...                      [0, np.tan(np.pi / 8)] * 4)
     >>> h = curved_hull(rounded)
     >>> h.n_pieces, np.round(h.support([0.0, np.pi / 4]), 12).tolist()
-    (4, [4.0, 4.828427124746])
+    (4, [4.0, 4.535533905933])
     """
     c, r, lo, w, first, last = _sites(ring)
     n_points = len(ring.points)
@@ -1232,7 +1232,7 @@ def resting_states(d: CurvedDiameter) -> list[RestingState]:
     Examples
     --------
     >>> slot = CurvedRing([(0, -1), (2, -1), (2, 1), (0, 1)], [0, 1, 0, 1])
-    >>> [(round(np.degrees(s.theta), 6), len(s.edges)) for s in
+    >>> [(round(float(np.degrees(s.theta)), 6), len(s.edges)) for s in
     ...  resting_states(curved_diameter(curved_hull(slot)))]
     [(90.0, 2)]
     """
