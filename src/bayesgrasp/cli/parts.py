@@ -37,17 +37,12 @@ def push(part: PartSpec, prior: PriorOpt = "uniform", as_json: JsonOpt = False) 
     lies flat against the pushing jaw (on the gripper's -x side); the table names that edge.
     """
     from .. import report
-    from ..geometry.curved import CurvedPart, curved_push, curved_push_grasp
-    from ..geometry.push import push_function, push_grasp_function, radius_function
+    from ..geometry.curved import push_model
     from ..model.prior import parse_prior
 
     p = part.load()
     pr = parse_prior(prior)
-    r = radius_function(p)
-    if isinstance(p, CurvedPart):  # exact pushes; r names the nearest edges of the polygon
-        f, g = curved_push(p), curved_push_grasp(p)
-    else:
-        f, g = push_function(r), push_grasp_function(p)
+    r, f, g = push_model(p)  # a curved part's exact pushes
     if as_json:
         emit_json(report.push_json(p, r, f, g, pr))
     else:

@@ -68,6 +68,7 @@ from ..errors import PartError, PlanningError
 from ..tolerance import DEFAULT_TOLERANCE, Tolerance
 from .diameter import DiameterFunction, diameter_function
 from .polygon import ConvexPolygon, Part, as_points
+from .push import RadiusFunction
 from .transfer import TransferFunction, squeeze_function, transfer_from_extrema
 
 __all__ = [
@@ -88,6 +89,7 @@ __all__ = [
     "curved_push_grasp",
     "curved_radius",
     "mesh_vertices",
+    "push_model",
     "resting_states",
     "squeeze_model",
     "with_shape_tol",
@@ -1413,3 +1415,18 @@ def curved_push_grasp(
     s = squeeze if squeeze is not None else squeeze_model(part)[1]
     r = curved_radius(part)
     return compose_push_grasp(r.minima, r.maxima, s, part.hull.tol.angle)
+
+
+def push_model(part: Part) -> tuple[RadiusFunction, TransferFunction, TransferFunction]:
+    """The radius function of the hull polygon, the push and the push-grasp function.
+
+    A polygon's as :mod:`.push` builds them; a :class:`CurvedPart`'s push and push-grasp
+    functions are the exact curved ones (the polygon's radius function then only names the
+    nearest hull edges in reports).
+    """
+    from .push import push_function, push_grasp_function, radius_function
+
+    r = radius_function(part)
+    if isinstance(part, CurvedPart):
+        return r, curved_push(part), curved_push_grasp(part)
+    return r, push_function(r), push_grasp_function(part)
