@@ -145,3 +145,27 @@ def test_states_and_costs_converge_as_the_flattening_tolerance_shrinks(seed: int
         assert_allclose(s, stable, atol=1e-6)
         assert_allclose(p, probs, atol=1e-6)
         assert_allclose(c, cost, rtol=1e-6)
+
+
+def test_exact_arcs_are_the_limit_of_ever_finer_flattenings() -> None:
+    # The bracket's arcs flattened at 1e-4 .. 1e-6 of its size (every chord marked as such,
+    # with its error bound): the same states (flush edges: exact), and probabilities that
+    # approach the exact ones as the chords' angle, about the square root of the tolerance.
+    from pathlib import Path
+
+    from bayesgrasp.geometry.curved import CurvedRing, curved_part
+    from bayesgrasp.io import read_part
+
+    part = read_part(Path(__file__).resolve().parents[2] / "examples" / "bracket.dxf")
+    assert isinstance(part, CurvedPart) and part.ring is not None
+    _, exact = squeeze_model(part)
+    probs = Problem.build(part).state_distribution()
+    size = part.curved_hull.size
+    for rel in (1e-4, 1e-5, 1e-6):
+        pts = part.ring.flattened(rel * size)
+        ring = CurvedRing(pts, np.zeros(len(pts)), np.ones(len(pts), dtype=bool))
+        flat = curved_part(ring, curve_error=rel * size)
+        _, s = squeeze_model(flat)
+        assert_allclose(s.stable, exact.stable, atol=1e-12)
+        gap = np.abs(Problem.build(flat).state_distribution() - probs).max()
+        assert gap <= 0.3 * math.sqrt(rel)
