@@ -88,6 +88,9 @@ def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -
     for i, (s, lo, hi, p) in enumerate(zip(f.stable, f.basin_lo, f.basin_hi, probs, strict=True)):
         basin = f"({math.degrees(lo):9.3f}, {math.degrees(hi):9.3f})"
         lines.append(f"{i:>5}  {math.degrees(s):12.3f}  {basin:>23}  {p:11.4f}")
+    from .report_curved import curved_lines
+
+    lines += curved_lines(part) if f.kind == "squeeze" else []
     return "\n".join(lines)
 
 
@@ -216,9 +219,20 @@ def plan_table(report: PlanReport, max_actions: int | None = None) -> str:
     else:
         what = "most certain plan"
     lines.append(f"B = Bayes plan (least expected cost), C = {what}")
+    from .report_curved import shallow_warnings
+
+    lines += shallow_warnings(pb, _finals(report))
     if report.nodes is not None:
         lines.append(f"breadth-first nodes generated: {report.nodes}")
     return "\n".join(lines)
+
+
+def _finals(report: PlanReport) -> dict[str, float]:
+    """The final orientations of the Bayes and the most certain plan, by label."""
+    out = {"Bayes plan": report.options[report.bayes].final_orientation}
+    if report.most_certain != report.bayes:
+        out["most certain plan"] = report.options[report.most_certain].final_orientation
+    return out
 
 
 def _simulated_rows(res: SimulationResult) -> list[int]:

@@ -59,6 +59,10 @@ COM_HELP = (
     "the outline; a CSV or JSON point list that crosses itself is a point cloud, whose part "
     "is its convex hull, so its default is the hull's centroid)."
 )
+SHAPE_HELP = (
+    "Manufacturing tolerance of the part, in its units: minima of the diameter function that "
+    "a shape error this large could remove are not stable orientations (default 0)."
+)
 PRIOR_HELP = (
     "Prior on the initial orientation: uniform | vonmises:MEAN_DEG,KAPPA | histogram:FILE "
     "(bin weights over [0, 360) deg) | sample:FILE (observed angles, deg)."
@@ -129,6 +133,7 @@ def _part_params(optional: bool = False) -> list[inspect.Parameter]:
         _opt("layer", str | None, None, help="DXF: read only this layer."),
         _opt("flatten_tol", float | None, None, help=FLATTEN_HELP),
         _opt("com", str | None, None, "--com", metavar="X,Y", help=COM_HELP),
+        _opt("shape_tol", float, 0.0, min=0, help=SHAPE_HELP),
     ]
 
 

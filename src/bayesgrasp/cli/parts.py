@@ -16,12 +16,12 @@ app = command_app()
 def squeeze(part: PartSpec, prior: PriorOpt = "uniform", as_json: JsonOpt = False) -> None:
     """Stable orientations of a squeeze, their basins and probabilities after one squeeze."""
     from .. import report
-    from ..geometry.transfer import squeeze_function
+    from ..geometry.curved import squeeze_model
     from ..model.prior import parse_prior
 
     p = part.load()
     pr = parse_prior(prior)
-    f = squeeze_function(p.hull)
+    f = squeeze_model(p)[1]
     if as_json:
         emit_json(report.squeeze_json(p, f, pr))
     else:
@@ -37,13 +37,12 @@ def push(part: PartSpec, prior: PriorOpt = "uniform", as_json: JsonOpt = False) 
     lies flat against the pushing jaw (on the gripper's -x side); the table names that edge.
     """
     from .. import report
-    from ..geometry.push import push_function, push_grasp_function, radius_function
+    from ..geometry.curved import push_model
     from ..model.prior import parse_prior
 
     p = part.load()
     pr = parse_prior(prior)
-    r = radius_function(p)
-    f, g = push_function(r), push_grasp_function(p)
+    r, f, g = push_model(p)  # a curved part's exact pushes
     if as_json:
         emit_json(report.push_json(p, r, f, g, pr))
     else:

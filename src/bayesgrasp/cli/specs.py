@@ -57,12 +57,17 @@ class PartSpec:
     layer: str | None = None
     flatten_tol: float | None = None
     com: str | None = None
+    shape_tol: float = 0.0
 
     def load(self) -> Part:
-        """Read the part (with the centre of mass ``--com X,Y``, when given)."""
+        """Read the part: ``--shape-tol`` applied, then ``--com X,Y`` when given.
+
+        See :func:`~bayesgrasp.geometry.curved.with_shape_tol`.
+        """
         import dataclasses
 
         from ..errors import PartError
+        from ..geometry.curved import with_shape_tol
         from ..geometry.polygon import Part
         from ..io import resolve_part
 
@@ -80,6 +85,7 @@ class PartSpec:
                 + ("" if self.com else " (centre of mass its centroid; --com X,Y to set it)"),
                 err=True,
             )
+        part = with_shape_tol(part, self.shape_tol)
         if self.com is None:
             return part
         try:

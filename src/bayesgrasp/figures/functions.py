@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..angles import TWO_PI, circle_distance
+from ..geometry.curved import CurvedDiameter
 from ..geometry.diameter import DiameterFunction
 from ..geometry.polygon import Part
 from ..geometry.transfer import TransferFunction
@@ -70,7 +71,9 @@ def first_action_histogram(
     return np.degrees(d.minima), heights
 
 
-def diameter_samples(d: DiameterFunction, n: int = 1441) -> tuple[FloatArray, FloatArray]:
+def diameter_samples(
+    d: DiameterFunction | CurvedDiameter, n: int = 1441
+) -> tuple[FloatArray, FloatArray]:
     """Angles over [0, pi] (the breakpoints and extrema included) and ``d`` at them."""
     th = np.unique(
         np.concatenate([np.linspace(0.0, math.pi, n), d.breaks, d.minima, d.maxima, [math.pi]])

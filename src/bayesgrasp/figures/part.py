@@ -103,7 +103,11 @@ def draw_part(ax: Axes, problem: Problem, theta: float) -> None:
 
     part = problem.part
     placed = place_part(part, theta)
-    i_plus, i_minus = problem.diameter.pairs[int(problem.diameter.piece_index(theta))]
+    pairs = getattr(problem.diameter, "pairs", None)  # a curved part's d has no vertex pairs
+    if pairs is not None:
+        i_plus, i_minus = pairs[int(problem.diameter.piece_index(theta))]
+    else:
+        i_plus, i_minus = int(np.argmax(placed.hull[:, 0])), int(np.argmin(placed.hull[:, 0]))
     ax.add_patch(
         part_patch(placed, facecolor=PART_COLOR, edgecolor=PART_EDGE, lw=1.2, label="part")
     )

@@ -64,7 +64,13 @@ from ..errors import BayesGraspError
 from .polygon import ConvexPolygon, Part
 from .transfer import TransferFunction, detect_period, squeeze_function, transfer_from_extrema
 
-__all__ = ["RadiusFunction", "push_function", "push_grasp_function", "radius_function"]
+__all__ = [
+    "RadiusFunction",
+    "compose_push_grasp",
+    "push_function",
+    "push_grasp_function",
+    "radius_function",
+]
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
@@ -350,8 +356,18 @@ def push_grasp_function(
     """
     poly, _ = _hull_and_com(part)
     r = radius_function(part)
-    p_stable, p_lo, p_hi = _basins(r.minima, r.maxima)
     s = squeeze if squeeze is not None else squeeze_function(poly)
+    return compose_push_grasp(r.minima, r.maxima, s, poly.tol.angle)
+
+
+def compose_push_grasp(
+    push_minima: FloatArray, push_maxima: FloatArray, s: TransferFunction, angle_tol: float
+) -> TransferFunction:
+    """``g = s o p`` from the push function's extrema (sorted in ``[0, 2 pi)``) and ``s``.
+
+    See :func:`push_grasp_function`; also used by curved parts (geometry/curved.py).
+    """
+    p_stable, p_lo, p_hi = _basins(push_minima, push_maxima)
     idx = s.state_index(p_stable)  # squeeze basin holding each push-stable orientation
     image = s.stable[idx]  # (K,) in [0, 2 pi)
     # Lift the images next to their push orientations: a non-decreasing sequence whose
@@ -377,5 +393,5 @@ def push_grasp_function(
         raise BayesGraspError("internal error: push-grasp basins do not tile the circle")
     for arr in (stable, lo, hi):
         arr.setflags(write=False)
-    period = detect_period(stable, np.sort(np.mod(hi, TWO_PI)), poly.tol.angle)
-    return TransferFunction("push-grasp", stable, lo, hi, period, poly.tol.angle)
+    period = detect_period(stable, np.sort(np.mod(hi, TWO_PI)), angle_tol)
+    return TransferFunction("push-grasp", stable, lo, hi, period, angle_tol)

@@ -28,7 +28,10 @@ GeoJSON).
 
 Curves (Bezier curves, arcs, circles, ellipses, splines) are flattened to a chordal
 tolerance: no point of the curve is farther than ``tolerance`` from the polyline (default
-0.1% of the drawing's diagonal). A file whose outlines flatten to more than ``max_points``
+0.1% of the drawing's diagonal). An SVG or DXF outline with curves is a
+:class:`~bayesgrasp.geometry.curved.CurvedPart`: its circular arcs stay exact, its other
+curves keep that error bound and their exact form (:mod:`bayesgrasp.geometry.curved`).
+A file whose outlines flatten to more than ``max_points``
 points (default :data:`MAX_POINTS` = 100 000) is refused, before the points are made.
 
 Parts can also be read from memory (:func:`read_part_bytes`: an upload, a pipe; nothing is

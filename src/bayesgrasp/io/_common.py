@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from ..errors import MissingExtraError, PartError, PartFileError
 from ..geometry import Part, find_crossing
-from ._flatten import Curve, FlattenBudget, TooManyPoints, join, predicted_points
+from ._flatten import Curve, FlattenBudget, Polyline, TooManyPoints, join, predicted_points
 
 __all__ = [
     "DEFAULT_RELATIVE_TOLERANCE",
@@ -428,12 +428,14 @@ def assemble_part(
     name: str,
     units: str | None,
     choose: str,
+    tol: float | None = None,
 ) -> Part:
     """The part of a set of flattened rings: one outer ring, the rings inside it are holes.
 
     Rings inside holes (an island in a hole, a drawn thread) are ignored and logged. More
     than one outer ring is an error that names the candidates and says how to choose
-    (``choose``).
+    (``choose``). With the chordal tolerance ``tol``, an outline with arcs or curves is a
+    :class:`~bayesgrasp.geometry.curved.CurvedPart` (arcs exact; see :mod:`._curves`).
     """
     usable = [r for r in rings if len(r.points) >= 3]
     if not usable:
@@ -452,6 +454,12 @@ def assemble_part(
     if ignored:
         log.info("%s: ignored %d outline(s) nested inside holes", path, ignored)
     try:
+        if tol is not None and any(
+            not isinstance(c, Polyline) for r in (outer[0], *holes) for c in r.curves
+        ):
+            from ._curves import curved_assembly
+
+            return curved_assembly(outer[0], holes, name, units, tol)
         return Part.from_outline(outer[0].points, [h.points for h in holes], name=name, units=units)
     except PartError as exc:
         raise fail(path, str(exc)) from None

@@ -613,7 +613,7 @@ def parse_dxf(data: bytes, path: Path, options: ReadOptions) -> Part:
     else:
         choose = "keep one part per layer (or per file) and choose it with --layer"
     name = path.stem if options.layer is None else f"{path.stem}:{options.layer}"
-    return assemble_part(path, flat, name, units, choose)
+    return assemble_part(path, flat, name, units, choose, tol)
 
 
 def read_dxf(path: Path, options: ReadOptions) -> Part:

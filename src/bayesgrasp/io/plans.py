@@ -175,6 +175,11 @@ def part_document(part: Part) -> dict[str, Any]:
         out["units"] = part.units
     out["center_of_mass"] = part.center_of_mass.tolist()
     out["id"] = part_id(part)
+    from ..report_curved import curved_document
+
+    curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts only)
+    if curved is not None:
+        out["curved"] = curved
     return out
 
 

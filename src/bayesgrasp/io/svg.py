@@ -458,6 +458,7 @@ def parse_svg(data: bytes, path: Path, options: ReadOptions) -> Part:
         units,
         "an element's outline must be one ring with holes inside it; split it or choose "
         "another element with --element ID",
+        tol,
     )
 
 

@@ -102,8 +102,11 @@ def _squeeze(part: Part, squeeze: TransferFunction) -> TransferFunction:
 
 def _push_grasp(part: Part, squeeze: TransferFunction) -> TransferFunction:
     """The push-grasp function of the part (imported on use: it needs the radius function)."""
+    from ..geometry.curved import CurvedPart, curved_push_grasp
     from ..geometry.push import push_grasp_function
 
+    if isinstance(part, CurvedPart):  # the exact radius function of its arcs and curves
+        return curved_push_grasp(part, squeeze)
     return push_grasp_function(part, squeeze)
 
 

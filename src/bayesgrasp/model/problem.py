@@ -37,9 +37,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import PlanningError
-from ..geometry.diameter import DiameterFunction, diameter_function
+from ..geometry.curved import CurvedDiameter, squeeze_model
+from ..geometry.diameter import DiameterFunction
 from ..geometry.polygon import Part
-from ..geometry.transfer import TransferFunction, squeeze_function
+from ..geometry.transfer import TransferFunction
 from .actions import SQUEEZE, Action, get_action, parse_actions
 from .cost import CostModel
 from .goal import Goal
@@ -157,7 +158,7 @@ class Problem:
 
     part: Part
     states: TransferFunction
-    diameter: DiameterFunction
+    diameter: DiameterFunction | CurvedDiameter
     prior: Prior
     actions: tuple[Action, ...]
     transfers: Mapping[str, TransferFunction]
@@ -228,8 +229,7 @@ class Problem:
             raise PlanningError(f"`cost` must be a CostModel; got {type(cost).__name__}")
         if goal is not None and not isinstance(goal, Goal):
             raise PlanningError(f"`goal` must be a Goal; got {type(goal).__name__}")
-        d = diameter_function(part.hull)
-        states = squeeze_function(d)
+        d, states = squeeze_model(part)  # a curved part: its exact model (geometry/curved.py)
         transfers = {SQUEEZE.name: states}
         for a in acts:
             f = a.build(part, states)

@@ -148,7 +148,9 @@ def prism(part: Part, scale: float, params: SimParams | None = None) -> Prism:
         raise PartError(f"`scale` must be a finite number > 0 (metres per unit); got {scale!r}")
     sp = params or SimParams()
     com = np.asarray(part.center_of_mass, dtype=np.float64) * scale
-    rel = part.hull.vertices * scale - com  # (N, 2) body frame
+    from ..geometry.curved import mesh_vertices
+
+    rel = mesh_vertices(part) * scale - com  # (N, 2) body frame (arcs finely sampled)
     # Least width of the hull: the smallest extent over its edge normals.
     e = np.roll(rel, -1, axis=0) - rel
     nrm = np.column_stack([e[:, 1], -e[:, 0]]) / np.hypot(e[:, 0], e[:, 1])[:, None]

@@ -370,24 +370,23 @@ def _chosen(
 def squeeze_document(service: Service, req: PartRequest) -> dict[str, Any]:
     """``bayesgrasp squeeze PART --prior P --json``."""
     from .. import report
-    from ..geometry.transfer import squeeze_function
+    from ..geometry.curved import squeeze_model
     from ..model.prior import parse_prior
 
     p = service.part(req.part)
     pr = parse_prior(_prior_string(req))
-    return report.squeeze_json(p, squeeze_function(p.hull), pr)
+    return report.squeeze_json(p, squeeze_model(p)[1], pr)  # a curved part's exact model
 
 
 def push_document(service: Service, req: PartRequest) -> dict[str, Any]:
     """``bayesgrasp push PART --prior P --json``."""
     from .. import report
-    from ..geometry.push import push_function, push_grasp_function, radius_function
+    from ..geometry.curved import push_model
     from ..model.prior import parse_prior
 
     p = service.part(req.part)
     pr = parse_prior(_prior_string(req))
-    r = radius_function(p)
-    return report.push_json(p, r, push_function(r), push_grasp_function(p), pr)
+    return report.push_json(p, *push_model(p), pr)
 
 
 def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
