@@ -107,8 +107,8 @@ class SimParams:
         Contact asynchrony (README, "Noisy actions and payoffs"): in a squeeze one jaw's
         target starts closing this many seconds before the other's. The leading jaw touches
         first and pushes the part ``jaw_speed * jaw_lag / 2`` before the other meets it,
-        while that is under ``2 * clearance``; beyond, the pushed part reaches the lagging
-        jaw before that jaw starts, and the push saturates at ``2 * clearance``. 0 (the
+        while that is under ``clearance``; beyond, the pushed part reaches the lagging jaw
+        before that jaw starts, and the push saturates at ``clearance``. 0 (the
         default): both jaws close together, the seed's pure squeeze. A push-grasp, which
         leads with one jaw on purpose, ignores it. The lag stands for any cause of one
         jaw touching first (an off-centre part is another, physics notes).
