@@ -118,8 +118,18 @@ def simulate(
         )
 
     res = with_progress(f"{engine.value} trials", n, run)
+    if turn_noise is not None:  # predicted exactly under the noise (--noise: without it)
+        import dataclasses
+
+        from ..model.noise import NoiseModel
+        from ..planning.noisy import evaluate_plan
+
+        ev = evaluate_plan(pb, NoiseModel(t), option.steps)
+        res = dataclasses.replace(res, predicted=ev.distribution)
     if as_json:
         emit_json(report.simulate_json(res, p))
     else:
         title = f"{p.name}: {label} plan, prior {pb.prior.name}; "
+        if turn_noise is not None:
+            title += f"predicted under turn error {t.spec()} deg; "
         typer.echo(report.simulate_table(res, title))
