@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from bayesgrasp.angles import TWO_PI, circle_distance
+from bayesgrasp.errors import SimulationError
 from bayesgrasp.geometry.push import push_grasp_function
 from bayesgrasp.geometry.transfer import squeeze_function
 from bayesgrasp.shapes import load
@@ -62,6 +63,8 @@ def test_a_lag_of_zero_ignores_the_lead() -> None:
     # fresh squeezers: MuJoCo's warm start makes a second run on one model differ in 1e-15
     a, b = Squeezer(TRIANGLE, 0.001).act(1.0), Squeezer(TRIANGLE, 0.001).act(1.0, lead=1)
     assert a.end == b.end and a.sim_time == b.sim_time
+    with pytest.raises(SimulationError, match="lead"):
+        Squeezer(TRIANGLE, 0.001, SimParams(jaw_lag=0.1)).act(1.0, lead=0)
 
 
 @pytest.mark.physics
@@ -74,3 +77,21 @@ def test_a_large_jaw_lag_acts_as_a_push_grasp_more_often() -> None:
     assert big.push >= zero.push + 5, (zero, big)
     # both leading sides are classified right, else q could not pass one half
     assert big.q >= 0.6, big
+
+
+@pytest.mark.physics
+@needs_mujoco
+def test_simulate_mujoco_draws_the_leading_jaws_up_front() -> None:
+    """With a jaw lag the results do not depend on the workers, and the lag acts."""
+    from bayesgrasp.model.problem import Problem
+    from bayesgrasp.planning import plan_exact
+    from bayesgrasp.sim import simulate_mujoco
+
+    pb = Problem.build(TRIANGLE)
+    plan = plan_exact(pb).options[0]
+    lagged = SimParams(jaw_lag=8.0, clearance=0.045)
+    one = simulate_mujoco(pb, plan, 6, params=lagged, rng=3)
+    two = simulate_mujoco(pb, plan, 6, params=lagged, rng=3, workers=2)
+    np.testing.assert_allclose(one.final, two.final, atol=0.0)
+    plain = simulate_mujoco(pb, plan, 6, params=SimParams(clearance=0.045), rng=3)
+    assert np.any(circle_distance(one.final, plain.final) > math.radians(1.0))
