@@ -77,3 +77,25 @@ def test_simulate_takes_the_turn_noise(capsys: pytest.CaptureFixture[str]) -> No
     assert doc["trials"] == 20000
     assert main(["simulate", "key", "--turn-noise", "uniform:2", "--noise", "1"]) == 2
     assert "not both" in capsys.readouterr().err
+
+
+def test_simulate_turn_noise_predicts_under_the_noise(capsys: pytest.CaptureFixture[str]) -> None:
+    """The predicted column is the exact evaluation under the noise, which sampling agrees with."""
+    from bayesgrasp.planning import plan_exact
+    from bayesgrasp.planning.noisy import evaluate_plan
+    from bayesgrasp.sim.stats import wilson_interval
+
+    argv = ["simulate", "key", "--turn-noise", "uniform:2", "--trials", "40000", "--json"]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    plan = plan_exact(Problem.build(load("key"))).bayes_plan
+    ev = evaluate_plan(
+        Problem.build(load("key")), NoiseModel(TurnNoise("uniform", math.radians(2))), plan.steps
+    )
+    assert_allclose(doc["predicted_success"], ev.success_probability, atol=1e-12)
+    assert abs(ev.success_probability - plan.success_probability) > 0.05  # not noise-free
+    lo, hi = wilson_interval(round(doc["observed_success"] * 40000), 40000, confidence=0.999)
+    assert lo <= doc["predicted_success"] <= hi
+    assert_allclose(sum(r["predicted"] for r in doc["per_orientation"]), 1.0, atol=1e-9)
+    assert main(["simulate", "key", "--turn-noise", "uniform:2", "--trials", "1000"]) == 0
+    assert "predicted under turn error uniform:2 deg" in capsys.readouterr().out

@@ -157,6 +157,14 @@ def simulate(
         )
 
     res = with_progress(f"{engine.value} trials", n, run)
+    if turn_noise is not None:  # predicted exactly under the noise (--noise: without it)
+        import dataclasses
+
+        from ..model.noise import NoiseModel
+        from ..planning.noisy import evaluate_plan
+
+        ev = evaluate_plan(pb, NoiseModel(t), option.steps)
+        res = dataclasses.replace(res, predicted=ev.distribution)
     if as_json:
         doc = report.simulate_json(res, p)
         mujoco = engine is Engine.mujoco
@@ -168,6 +176,8 @@ def simulate(
         emit_json(doc)
     else:
         title = f"{p.name}: {label} plan, prior {pb.prior.name}; "
+        if turn_noise is not None:
+            title += f"predicted under turn error {t.spec()} deg; "
         typer.echo(report.simulate_table(res, title))
 
 

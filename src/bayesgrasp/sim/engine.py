@@ -32,7 +32,7 @@ import math
 import multiprocessing
 import time
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -152,6 +152,9 @@ class Squeezer:
         ]
         self._act = [mj.mj_name2id(m, mj.mjtObj.mjOBJ_ACTUATOR, n) for n in ("jaw_neg", "jaw_pos")]
         self._z = self._rest_height()
+        #: Draws the leading jaw of a squeeze when ``params.jaw_lag > 0`` and ``lead_jaw``
+        #: is ``random`` and :meth:`act` is given no ``lead``; replace it to reseed.
+        self.rng = np.random.default_rng(0)
 
     def _rest_height(self) -> float:
         """Height of the part's body frame when it rests on the table (one short settle)."""
@@ -182,7 +185,9 @@ class Squeezer:
         d.qvel[self._part_v : self._part_v + 6] = 0.0
         return lo - mid + offset, hi - mid + offset
 
-    def act(self, theta: float, offset: float = 0.0, push: bool = False) -> ActionOutcome:
+    def act(
+        self, theta: float, offset: float = 0.0, push: bool = False, lead: int | None = None
+    ) -> ActionOutcome:
         """One squeeze (or push-grasp when ``push``) from yaw ``theta`` in the gripper frame.
 
         Parameters
@@ -193,6 +198,10 @@ class Squeezer:
             Shift (metres) along x of the part's x-extent from the gripper's centre.
         push : bool
             Close the -x jaw first (an action that ``pushes_first``, the push-grasp).
+        lead : int, optional
+            For a squeeze with ``params.jaw_lag > 0``: ``-1`` or ``+1``, the side (-x or
+            +x) of the jaw that starts ``jaw_lag`` seconds early. Default from
+            ``params.lead_jaw`` (``random``: drawn from :attr:`rng`).
 
         Returns
         -------
@@ -220,17 +229,23 @@ class Squeezer:
         # The +x jaw of a push-grasp waits until the -x jaw has pushed push_len past contact;
         # no settling test before the (last) jaw can have reached the part.
         wait = (push_len + sp.clearance) / sp.jaw_speed if push else 0.0
-        earliest = wait + sp.clearance / sp.jaw_speed
+        wait_neg = 0.0
+        if not push and sp.jaw_lag > 0:  # contact asynchrony: the lagging jaw starts late
+            if lead is None:
+                lead = {"-x": -1, "+x": 1}.get(sp.lead_jaw) or int(self.rng.choice((-1, 1)))
+            if lead not in (-1, 1):
+                raise SimulationError(f"`lead` must be -1 or +1 (the leading jaw); got {lead!r}")
+            wait, wait_neg = (sp.jaw_lag, 0.0) if lead < 0 else (0.0, sp.jaw_lag)
+        earliest = max(wait, wait_neg) + sp.clearance / sp.jaw_speed
         # Time for the last jaw to cross the whole opening, plus max_time to settle.
-        travel_time = wait + (start[1] - start[0]) / sp.jaw_speed
+        travel_time = max(wait, wait_neg) + (start[1] - start[0]) / sp.jaw_speed
         steps_max = math.ceil((travel_time + sp.max_time) / dt)
         force = 0.999 * self.force
         calm = 0
         t = 0.0
         for _ in range(steps_max):
             t += dt
-            travel = sp.jaw_speed * t
-            d.ctrl[an] = start[0] + travel
+            d.ctrl[an] = start[0] + sp.jaw_speed * max(0.0, t - wait_neg)
             d.ctrl[ap] = start[1] - sp.jaw_speed * max(0.0, t - wait)
             mj.mj_step(m, d, n)
             slow = max(abs(d.qvel[vn]), abs(d.qvel[vp])) < sp.settle_speed
@@ -262,6 +277,7 @@ class _Trial:
     angles: tuple[float, ...]  # commanded (perturbed) angle of each action
     offsets: tuple[float, ...]  # signed offset of each action (metres)
     pushes: tuple[bool, ...]
+    leads: tuple[int | None, ...] = ()  # leading jaw of each lagged squeeze (jaw_lag > 0)
 
 
 def _run_trial(trial: _Trial) -> list[ActionOutcome]:
@@ -270,8 +286,10 @@ def _run_trial(trial: _Trial) -> list[ActionOutcome]:
         raise RuntimeError("worker not initialised")
     yaw = trial.theta0
     out = []
-    for angle, off, push in zip(trial.angles, trial.offsets, trial.pushes, strict=True):
-        res = sq.act(float(np.mod(yaw - angle, TWO_PI)), off, push)
+    leads = trial.leads or (None,) * len(trial.angles)
+    steps = zip(trial.angles, trial.offsets, trial.pushes, leads, strict=True)
+    for angle, off, push, lead in steps:
+        res = sq.act(float(np.mod(yaw - angle, TWO_PI)), off, push, lead)
         out.append(res)
         yaw = res.end
     return out
@@ -386,6 +404,9 @@ def simulate_mujoco(
                pushes)
         for i in range(trials)
     ]  # fmt: skip
+    if params.jaw_lag > 0 and params.lead_jaw == "random":  # drawn here: workers don't matter
+        leads = np.where(gen.random((trials, k)) < 0.5, -1, 1)
+        tasks = [replace(t, leads=tuple(leads[i].tolist())) for i, t in enumerate(tasks)]
     t0 = time.perf_counter()
     outcomes: list[list[ActionOutcome]] = []
     for res in _map_trials(problem.part, sc, params, tasks, workers):

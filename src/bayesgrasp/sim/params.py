@@ -103,6 +103,18 @@ class SimParams:
         For a push-grasp, the pushing (-x) jaw travels this far beyond first contact before
         the other jaw closes; 0 means twice the part's size (enough for the part to turn
         to a stable push orientation, which needs a travel of the order of its size).
+    jaw_lag : float
+        Contact asynchrony (README, "Noisy actions and payoffs"): in a squeeze one jaw's
+        target starts closing this many seconds before the other's. The leading jaw touches
+        first and pushes the part ``jaw_speed * jaw_lag / 2`` before the other meets it,
+        while that is under ``clearance``; beyond, the pushed part reaches the lagging jaw
+        before that jaw starts, and the push saturates at ``clearance``. 0 (the
+        default): both jaws close together, the seed's pure squeeze. A push-grasp, which
+        leads with one jaw on purpose, ignores it. The lag stands for any cause of one
+        jaw touching first (an off-centre part is another, physics notes).
+    lead_jaw : str
+        Which jaw leads when ``jaw_lag > 0``: ``random`` (either, equally likely, drawn per
+        squeeze: the model's contact asynchrony), ``-x`` or ``+x``.
 
     Examples
     --------
@@ -136,6 +148,8 @@ class SimParams:
     check_every: int = 10
     jam_tol: float = math.radians(1.0)
     push_distance: float = 0.0
+    jaw_lag: float = 0.0
+    lead_jaw: str = "random"
 
     def squeeze_force(self, mass: float) -> float:
         """Force limit of each jaw for a part of the given mass (kg): ``force_ratio`` weights.
@@ -164,7 +178,7 @@ class SimParams:
             value = getattr(self, f.name)
             if isinstance(value, str):
                 continue
-            nonneg = f.name in ("push_distance", "table_friction")
+            nonneg = f.name in ("push_distance", "table_friction", "jaw_lag")
             if not math.isfinite(value) or value < 0 or (value == 0 and not nonneg):
                 want = ">= 0" if nonneg else "> 0"
                 raise SimParamsError(
@@ -179,3 +193,5 @@ class SimParams:
             raise SimParamsError(f"`solver` must be PGS, CG or Newton; got {self.solver!r}")
         if self.cone not in ("pyramidal", "elliptic"):
             raise SimParamsError(f"`cone` must be pyramidal or elliptic; got {self.cone!r}")
+        if self.lead_jaw not in ("random", "-x", "+x"):
+            raise SimParamsError(f"`lead_jaw` must be random, -x or +x; got {self.lead_jaw!r}")
