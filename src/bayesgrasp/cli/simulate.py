@@ -10,6 +10,7 @@ import typer
 
 from .common import chosen_plan, emit_json, with_progress
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
 from .specs import Engine, PartSpec, ProblemSpec
 
 app = command_app()
@@ -49,6 +50,14 @@ UnitsOpt = Annotated[
     str | None,
     typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
 ]
+SensorErrorOpt = Annotated[
+    bool,
+    typer.Option(
+        "--sensor-error",
+        help="With --sense and --engine mujoco: add the sensor model's normal error to the "
+        "jaw separation MuJoCo reads (default: the physics' own error only).",
+    ),
+]
 
 
 @app.command()
@@ -67,8 +76,19 @@ def simulate(
     seed: SeedOpt = 0,
     units: UnitsOpt = None,
     as_json: JsonOpt = False,
+    sense: SenseOpt = None,
+    also: AlsoOpt = None,
+    part_prior: PartPriorOpt = None,
+    max_actions: MaxActionsOpt = 3,
+    sensor_error: SensorErrorOpt = False,
 ) -> None:
-    """Execute a plan many times and compare the final orientations with the prediction."""
+    """Execute a plan many times and compare the final orientations with the prediction.
+
+    With --sense: plan the Bayes sensing policy, run it cycle after cycle (readings drawn
+    from the sensor model, or MuJoCo's jaw separation with --engine mujoco: --sense width
+    then means MuJoCo's default error, width:0.2,0.1 mm) and compare its success, cost a
+    cycle, actions and cost per oriented part with the prediction.
+    """
     from .. import report
     from ..sim.kinematic import GripperNoise, simulate_kinematic
 
@@ -77,10 +97,20 @@ def simulate(
             "applies to --engine mujoco only (the kinematic model has no positions)",
             param_hint="--offset",
         )
+    err = GripperNoise(noise_kind.value, math.radians(noise))
+    if sense is not None:
+        from .sensing import simulate_policy_command
+
+        simulate_policy_command(
+            part, spec, sense, also or [], part_prior, max_actions, engine, trials, workers,
+            offset, err, seed, units, sensor_error, as_json,
+        )  # fmt: skip
+        return
+    if also or part_prior is not None or sensor_error:
+        raise typer.BadParameter("--also, --part-prior and --sensor-error need --sense")
     p = part.load()
     pb, option, label = chosen_plan(which, spec, p)
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
-    err = GripperNoise(noise_kind.value, math.radians(noise))
 
     def run(progress: Any) -> Any:
         if engine is Engine.kinematic:
