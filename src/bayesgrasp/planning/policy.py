@@ -591,24 +591,73 @@ class _Builder:
         level: int,
         first: bool,
     ) -> PolicyNode:
-        """An action node whose action leaves the (normalised) belief ``img``."""
+        """An action node whose action leaves the (normalised) belief ``img``.
+
+        The readings after which the programme stops (a leaf is no worse than the bound on
+        acting again, as :meth:`_Solver.best_act` settles them, or no actions are left) are
+        handled together: their leaves, figures and entropies are computed for all bins at
+        once, and neighbouring bins with the same leaf are one branch.
+        """
+        s = self.solver
         t = self.tally
         t.actions += mass
         t.action_cost += mass * (kind.first_cost if first else kind.cost)
         turn, carry = self.turn(kind, alpha, carry)
-        lik = self.solver.bins.likelihood
-        joint = img[:, None] * lik  # (N, B)
+        joint = img[:, None] * s.bins.likelihood  # (N, B)
         p = joint.sum(axis=0)
         kept = np.flatnonzero(p > 0)
-        raw: list[tuple[float, PolicyNode | Declare | Reject]] = []
-        for b in kept:
-            pb = float(p[b])
-            q = joint[:, b] / pb
-            raw.append((pb, self.after(q, mass * pb, r_after, carry, level)))
-        lo = [-math.inf, *(float(self.solver.bins.lo[b]) for b in kept[1:])]
-        hi = [*lo[1:], math.inf]
-        branches = _merge_leaves([Branch(lo[i], hi[i], pb, nxt) for i, (pb, nxt) in enumerate(raw)])
-        return PolicyNode(PlanStep(kind.name, turn), tuple(branches), margin)
+        pm = p[kept]
+        q = joint[:, kept].T / pm[:, None]  # (M, N) belief after each reading
+        if r_after > 0:
+            settled = s.leaf_value(q) <= s.act_bound(q) + _EPS
+        else:
+            settled = np.ones(len(kept), dtype=bool)
+        succ, state = s.success(q)
+        declare = (s.verify + s.retry) - (s.lam + s.retry) * succ <= s.retry + _EPS
+        # Leaf key of each bin: the declared state, or -1 to reject, or -2 to act on.
+        leaf_key = np.where(settled, np.where(declare, state, -1), -2)
+        w = mass * pm
+        lw = np.where(settled, w, 0.0)
+        dw = np.where(settled & declare, w, 0.0)
+        t.success += float((dw * succ).sum())
+        t.verify_cost += float(dw.sum()) * s.verify
+        t.reject += float(np.where(settled & ~declare, w, 0.0).sum())
+        if settled.any():
+            h = _entropies(q[settled])
+            mean_h = float((w[settled] * h).sum() / lw.sum())
+            self.leaves_at.append((level, float(lw.sum()), mean_h))
+        lo_all = s.bins.lo
+        branches: list[Branch] = []
+        i, m = 0, len(kept)
+        while i < m:
+            key = int(leaf_key[i])
+            lo = -math.inf if i == 0 else float(lo_all[kept[i]])
+            if key == -2:
+                nxt = self.after(q[i], float(w[i]), r_after, carry, level)
+                j = i + 1
+                prob = float(pm[i])
+            else:
+                j = i + 1
+                while j < m and leaf_key[j] == key:
+                    j += 1
+                prob = float(pm[i:j].sum())
+                if key == -1:
+                    nxt = Reject()
+                else:
+                    q_succ = float((pm[i:j] * succ[i:j]).sum()) / prob
+                    nxt = self.declare(key, q_succ, carry)
+            hi = math.inf if j == m else float(lo_all[kept[j]])
+            branches.append(Branch(lo, hi, prob, nxt))
+            i = j
+        return PolicyNode(PlanStep(kind.name, turn), tuple(_merge_leaves(branches)), margin)
+
+    def declare(self, state: int, success: float, carry: float) -> Declare:
+        """The leaf declaring joint state ``state`` (its orientation turned by ``carry``)."""
+        part, theta = self.solver.space.stable(state)
+        orientation = float(np.mod(theta + carry, TWO_PI))
+        if orientation >= TWO_PI:  # pragma: no cover - rounding
+            orientation = 0.0
+        return Declare(part, self.solver.space.names[part], orientation, success)
 
     def after(
         self, q: FloatArray, mass: float, r: int, carry: float, level: int
@@ -642,11 +691,14 @@ class _Builder:
         succ = float(q[s.goal[o]].sum())
         t.success += mass * succ
         t.verify_cost += mass * s.verify
-        part, theta = s.space.stable(o)
-        orientation = float(np.mod(theta + carry, TWO_PI))
-        if orientation >= TWO_PI:  # pragma: no cover - rounding
-            orientation = 0.0
-        return Declare(part, s.space.names[part], orientation, succ)
+        return self.declare(o, succ, carry)
+
+
+def _entropies(q: FloatArray) -> FloatArray:
+    """Shannon entropy (bits) of each row of normalised beliefs ``q`` (M, N)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        terms = np.where(q > 0, q * np.log2(np.where(q > 0, q, 1.0)), 0.0)
+    return np.asarray(-terms.sum(axis=1), dtype=np.float64)
 
 
 def _merge_leaves(branches: list[Branch]) -> list[Branch]:
