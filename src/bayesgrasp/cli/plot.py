@@ -9,6 +9,7 @@ import typer
 
 from .common import IMAGE_FORMATS, chosen_plan, emit_json
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
 from .specs import PartSpec, ProblemSpec
 
 app = command_app()
@@ -36,8 +37,15 @@ def plot(
     animation: AnimationOpt = True,
     frames: FramesOpt = 20,
     as_json: JsonOpt = False,
+    sense: SenseOpt = None,
+    also: AlsoOpt = None,
+    part_prior: PartPriorOpt = None,
+    max_actions: MaxActionsOpt = 3,
 ) -> None:
-    """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif."""
+    """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif.
+
+    With --sense: the Bayes sensing policy's tree with the part at each node (policy.*).
+    """
     from ..figures.plots import write_figures
     from ..model.actions import PUSH_GRASP
 
@@ -47,6 +55,15 @@ def plot(
             f"expected a comma-separated list of png, svg, pdf; got {image_formats!r}",
             param_hint="--image-formats",
         )
+    if sense is not None:
+        from .sensing import plot_policy_command
+
+        plot_policy_command(
+            part, spec, sense, also or [], part_prior, max_actions, out, formats, as_json
+        )
+        return
+    if also or part_prior is not None:
+        raise typer.BadParameter("--also and --part-prior need --sense")
     pb, option, label = chosen_plan(which, spec, part.load())
     try:
         files = write_figures(

@@ -1,8 +1,9 @@
-"""``simulate --sense``: plan a sensing policy and run its cycles (kinematic or MuJoCo)."""
+"""``simulate --sense`` and ``plot --sense``: run a sensing policy's cycles, draw its tree."""
 
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 from typing import Any
 
 import typer
@@ -77,3 +78,39 @@ def simulate_policy_command(
     typer.echo(
         policy_simulation_text(res, f"{names}: Bayes policy of at most {max_actions} actions; ")
     )
+
+
+def plot_policy_command(
+    part: PartSpec,
+    spec: ProblemSpec,
+    sense: str,
+    also: list[str],
+    part_prior: str | None,
+    max_actions: int,
+    out: Path,
+    formats: list[str],
+    as_json: bool,
+) -> None:
+    """Plan the Bayes policy and draw its tree into ``out/policy.FORMAT``."""
+    from ..figures.policy import policy_figure
+    from ..planning.policy import plan_policy
+
+    parts = [part.load(), *(dataclasses.replace(part, part=p).load() for p in also)]
+    problems = [spec.build(p) for p in parts]
+    pol = plan_policy(problems, sensor=sense, max_actions=max_actions, part_prior=part_prior)
+    fig = policy_figure(problems, pol)
+    files = []
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        for fmt in formats:
+            path = out / f"policy.{fmt}"
+            fig.savefig(path, dpi=110)
+            files.append(path)
+    except OSError as exc:
+        reason = exc.strerror or exc
+        raise typer.BadParameter(f"cannot write into {out}: {reason}", param_hint="--out") from None
+    if as_json:
+        emit_json({"schema": "bayesgrasp.plot/1", "files": [str(f) for f in files]})
+    else:
+        for f in files:
+            typer.echo(str(f))

@@ -716,7 +716,8 @@ class _Builder:
             hi = math.inf if j == m else float(lo_all[kept[j]])
             branches.append(Branch(lo, hi, prob, nxt))
             i = j
-        return PolicyNode(PlanStep(kind.name, turn), tuple(_merge_leaves(branches)), margin)
+        merged = _merge_subtrees(_merge_leaves(branches))
+        return PolicyNode(PlanStep(kind.name, turn), tuple(merged), margin)
 
     def declare(self, state: int, success: float, carry: float) -> Declare:
         """The leaf declaring joint state ``state`` (its orientation turned by ``carry``)."""
@@ -786,6 +787,59 @@ def _merge_leaves(branches: list[Branch]) -> list[Branch]:
         else:
             out.append(b)
     return out
+
+
+def _merge_subtrees(branches: list[Branch]) -> list[Branch]:
+    """Join neighbouring branches that lead to the same policy (:func:`_same_next`).
+
+    The joined branch's subtree is the same tree with its probabilities mixed by the weight
+    of each reading, so the policy (and every figure of it) is unchanged; it is only told
+    once.
+    """
+    out: list[Branch] = []
+    for b in branches:
+        if out and _same_next(out[-1].next, b.next):
+            prev = out[-1]
+            p = prev.probability + b.probability
+            out[-1] = Branch(
+                prev.lo, b.hi, p, _mix(prev.next, prev.probability, b.next, b.probability)
+            )
+        else:
+            out.append(b)
+    return out
+
+
+def _same_next(a: object, b: object) -> bool:
+    """The same leaf, or the same actions with the same branches down to the same leaves."""
+    if isinstance(a, PolicyNode) and isinstance(b, PolicyNode):
+        return (
+            a.step.kind == b.step.kind
+            and abs(a.step.alpha - b.step.alpha) < 1e-12
+            and len(a.branches) == len(b.branches)
+            and all(
+                x.lo == y.lo and x.hi == y.hi and _same_next(x.next, y.next)
+                for x, y in zip(a.branches, b.branches, strict=True)
+            )
+        )
+    return _same_leaf(a, b)
+
+
+def _mix(
+    a: PolicyNode | Declare | Reject, wa: float, b: PolicyNode | Declare | Reject, wb: float
+) -> PolicyNode | Declare | Reject:
+    """The tree ``a`` (= ``b``) reached with weight ``wa + wb``, its probabilities mixed."""
+    w = wa + wb
+    if isinstance(a, Declare) and isinstance(b, Declare):
+        q = (wa * a.success_probability + wb * b.success_probability) / w if w > 0 else 0.0
+        return Declare(a.part, a.part_name, a.orientation, q)
+    if isinstance(a, PolicyNode) and isinstance(b, PolicyNode):
+        branches = []
+        for x, y in zip(a.branches, b.branches, strict=True):
+            px, py = wa * x.probability, wb * y.probability
+            prob = (px + py) / w if w > 0 else 0.0
+            branches.append(Branch(x.lo, x.hi, prob, _mix(x.next, px, y.next, py)))
+        return PolicyNode(a.step, tuple(branches), min(a.margin, b.margin))
+    return a
 
 
 def _same_leaf(a: object, b: object) -> bool:
