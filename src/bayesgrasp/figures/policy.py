@@ -204,15 +204,13 @@ def policy_figure(
         for edge, c in b.children:
             ax.plot([b.x, c.x], [y(b) - 0.45, y(c) + 0.45], color="#999999", lw=0.8, zorder=0)
             ax.text(
-                0.3 * b.x + 0.7 * c.x, 0.35 * y(b) + 0.65 * y(c), edge, ha="center", va="center",
+                0.5 * (b.x + c.x), 0.5 * (y(b) + y(c)), edge, ha="center", va="center",
                 fontsize=6.5, bbox={"fc": "white", "ec": "none", "pad": 0.5}, gid="policy-edge",
             )  # fmt: skip
         if isinstance(b.item, PolicyNode):
             j, theta, _ = where.get(id(b.item), (0, 0.0, 0.0))
             _draw_part(ax, pbs, j, theta, b.x, y(b), True)
-            ax.text(
-                b.x, y(b) + 0.5, b.label, ha="center", va="bottom", fontsize=7, gid="policy-node"
-            )
+            ax.text(b.x + 0.3, y(b), b.label, ha="left", va="center", fontsize=7, gid="policy-node")
         elif isinstance(b.item, Declare):
             _draw_part(ax, pbs, b.item.part, b.item.orientation, b.x, y(b), False)
             text = b.label if not several else f"{b.item.part_name}\n{b.label}"
