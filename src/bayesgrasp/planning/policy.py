@@ -75,6 +75,18 @@ far plus the bounds of the rest cannot. Classes with the same effect on the beli
 are one (the widest is kept: the most margin for the turn). Ties go to fewer actions and to
 declaring over rejecting.
 
+Where the search grows: every reading bin of positive probability leads to its own belief,
+and with noisy readings almost every such belief is new (the memo only helps where readings
+are deterministic), so the programme visits up to ``(A B)^(K - 1)`` beliefs for ``A``
+distinct class images and ``B`` bins a node. The last action's children are settled in one
+vectorised step, the bounds prune the rest, and the per-belief work that does not depend on
+``lambda`` (the images of each class, their reading masses and success masses, the bound's
+``U`` and ``r``, computed by a matrix product over the pi pairs' common likelihoods) is kept
+across the parametric steps. Noisy readings with push-grasps (no pi-pair bound) or with
+SIGMA large against the width differences (many ambiguous bins) are the slow cases: see
+the README's figures. Neighbouring readings that lead to the same subtree are joined into
+one branch of the returned tree (the policy is the same).
+
 First gripper angle: under the uniform prior it does not matter (0). Otherwise the root
 belief is linear in the angle between the angles where a basin boundary meets a breakpoint
 of the prior, and ``h`` is concave in the root belief, so the best angle is one of those (or,
