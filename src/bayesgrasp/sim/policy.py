@@ -34,8 +34,9 @@ without failures still has an honest interval).
 
 How far MuJoCo's readings stray from ``d(sigma)``: with the default
 :class:`~bayesgrasp.sim.params.SimParams`, settled squeezes of the catalogue parts (mm,
-3-7 cm across) read 0.07-0.11 mm *below* the width at the stable orientation reached, with a
-spread under 0.03 mm; the jaws' force presses the soft contacts in (``solref`` 4 ms).
+3-7 cm across) read 0.07-0.12 mm *below* the width at the stable orientation reached, with a
+spread of 0.02-0.03 mm and at most 0.16 mm (house, rectangle, key, triangle, tuning fork,
+IC chip); the jaws' force presses the soft contacts in (``solref`` 4 ms).
 :data:`MUJOCO_SIGMA` = 0.2 mm, about twice that bias, is the default SIGMA of a policy
 executed in MuJoCo (:func:`mujoco_sensor`), with RES = 0.1 mm.
 """
