@@ -62,6 +62,9 @@ classes) and ``post`` Bayes' rule with the reading bins of the sensor. The root 
 ``h = min over first kinds t (and first gripper angles) of c^first_t + sum_b P(b) V(q_b,
 K - 1)``. Beliefs are memoised after rounding to multiples of ``2^-40`` (so values may carry
 errors of about ``1e-12``; the reported figures are recomputed exactly on the returned tree).
+A reading of probability ``p`` (given its node) whose leaf value exceeds the bound on acting
+again by ``g`` ends in a leaf when ``p g < 1e-13``: the search gives up at most that much per
+such reading.
 
 The search is bounded by the depth and by branch and bound with an upper bound ``U(q)`` on
 the success probability any continuation can reach: when every action is symmetric under a
@@ -150,6 +153,7 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 _QUANT = float(2**40)  # beliefs are memoised after rounding to multiples of 2**-40
 _EPS = 1e-12  # value comparisons (ties go to fewer actions)
+_TINY = 1e-13  # a reading this unlikely times its most to gain by acting again ends in a leaf
 _DEFAULT_MAX_ACTIONS = 3
 
 
@@ -549,7 +553,7 @@ class _Solver:
         lb_child = np.minimum(leaf, act)
         lb = cost + lb_child.sum(axis=1)
         # A child whose leaf is no worse than acting's bound is a leaf (as `value` decides).
-        settled = leaf <= act + _EPS * pm
+        settled = (leaf <= act + _EPS * pm) | (leaf - act < _TINY)
         lik_t = self.bins.likelihood.T  # (B, N)
         for i in np.argsort(ub, kind="stable"):
             if lb[i] >= best - _EPS:
@@ -688,7 +692,8 @@ class _Builder:
         pm = p[kept]
         q = joint[:, kept].T / pm[:, None]  # (M, N) belief after each reading
         if r_after > 0:
-            settled = s.leaf_value(q) <= s.act_bound(q) + _EPS
+            leaf_q, act_q = s.leaf_value(q), s.act_bound(q)
+            settled = (leaf_q <= act_q + _EPS) | (pm * (leaf_q - act_q) < _TINY)
         else:
             settled = np.ones(len(kept), dtype=bool)
         succ, state = s.success(q)
