@@ -15,6 +15,19 @@ app = command_app()
 PolygonsOpt = Annotated[int, typer.Option(min=1, help="How many random polygons (the seed: 2000).")]
 SeedOpt = Annotated[int, typer.Option(min=0, help="Seed of the random generator (>= 0).")]
 MethodOpt = Annotated[Method, typer.Option(help="Planner whose plans give the figures.")]
+StudySenseOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--sense",
+        metavar="width[:SIGMA,RES]",
+        help="The sensing study instead: mean cost without sensing, with exact readings and "
+        "with SIGMA 1% and 5% (or the SIGMA,RES given) of each part's largest diameter, "
+        "squeezes only and with push-grasps, on the polygons and the Table 1 parts.",
+    ),
+]
+StudyDepthOpt = Annotated[
+    int, typer.Option("--max-actions", min=1, max=6, help="With --sense: deepest policy.")
+]
 BfsStatsOpt = Annotated[
     bool,
     typer.Option(
@@ -43,8 +56,22 @@ def study(
     method: MethodOpt = Method.exact,
     bfs_stats: BfsStatsOpt = True,
     as_json: JsonOpt = False,
+    sense: StudySenseOpt = None,
+    max_actions: StudyDepthOpt = 2,
 ) -> None:
     """The seed's study: hulls of 10 random points in the unit square, planned and counted."""
+    if sense is not None:
+        from ..paper.sensing import run_sensing_study, sensing_json, sensing_table
+
+        res = with_progress(
+            "planning polygons",
+            polygons,
+            lambda progress: run_sensing_study(
+                polygons, seed, max_actions, sense, progress=progress
+            ),
+        )
+        emit_json(sensing_json(res)) if as_json else typer.echo(sensing_table(res))
+        return
     from ..paper.study import run_study, study_json, study_table
 
     bfs = bfs_stats or method is Method.bfs

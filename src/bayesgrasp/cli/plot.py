@@ -9,6 +9,7 @@ import typer
 
 from .common import IMAGE_FORMATS, check_outputs, chosen_plan, emit_json, input_files
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
+from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
 from .specs import PartSpec, ProblemSpec
 
 app = command_app()
@@ -56,9 +57,14 @@ def plot(
     frames: FramesOpt = 20,
     as_json: JsonOpt = False,
     force: ForceOpt = False,
+    sense: SenseOpt = None,
+    also: AlsoOpt = None,
+    part_prior: PartPriorOpt = None,
+    max_actions: MaxActionsOpt = 3,
 ) -> None:
     """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif.
 
+    With --sense: the Bayes sensing policy's tree with the part at each node (policy.*).
     Files that exist in the folder are replaced only with --force; an input (the part, the
     prior or the plan file) never is.
     """
@@ -74,6 +80,16 @@ def plot(
     if out.exists() and not out.is_dir():
         raise typer.BadParameter(f"{str(out)!r} is a file, not a folder", param_hint="--out")
     inputs = input_files(part.part, spec.prior, which)
+    if sense is not None:
+        from .sensing import plot_policy_command
+
+        check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
+        plot_policy_command(
+            part, spec, sense, also or [], part_prior, max_actions, out, formats, as_json
+        )
+        return
+    if also or part_prior is not None:
+        raise typer.BadParameter("--also and --part-prior need --sense")
     check_outputs(figure_files(out, formats, animation), inputs, force, "--out")
     pb, option, label = chosen_plan(which, spec, part.load(), force)
     try:

@@ -17,6 +17,7 @@ from .options import (
     part_options,
     problem_options,
 )
+from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
 from .specs import Engine, PartSpec, ProblemSpec
 
 app = command_app()
@@ -70,6 +71,14 @@ UnitsOpt = Annotated[
     str | None,
     typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
 ]
+SensorErrorOpt = Annotated[
+    bool,
+    typer.Option(
+        "--sensor-error",
+        help="With --sense and --engine mujoco: add the sensor model's normal error to the "
+        "jaw separation MuJoCo reads (default: the physics' own error only).",
+    ),
+]
 
 
 @app.command()
@@ -90,11 +99,21 @@ def simulate(
     as_json: JsonOpt = False,
     turn_noise: TurnNoiseOpt = None,
     force: ForceOpt = False,
+    sense: SenseOpt = None,
+    also: AlsoOpt = None,
+    part_prior: PartPriorOpt = None,
+    max_actions: MaxActionsOpt = 3,
+    sensor_error: SensorErrorOpt = False,
 ) -> None:
     """Execute a plan many times and compare the final orientations with the prediction.
 
     With --plan FILE the plan must be for PART (else exit 2, unless --force) and runs under
     the prior and goal it was made for, unless --prior or --goal says otherwise.
+
+    With --sense: plan the Bayes sensing policy, run it cycle after cycle (readings drawn
+    from the sensor model, or MuJoCo's jaw separation with --engine mujoco: --sense width
+    then means MuJoCo's default error, width:0.2,0.1 mm) and compare its success, cost a
+    cycle, actions and cost per oriented part with the prediction.
     """
     from .. import report
     from ..io.plans import provenance
@@ -118,8 +137,22 @@ def simulate(
             "within +-3.1e-5 and take about half an hour; more would run for hours)",
             param_hint="--trials",
         )
+    err = GripperNoise(noise_kind.value, math.radians(noise))
+    if sense is not None:
+        from .sensing import simulate_policy_command
+
+        if turn_noise is not None:
+            raise typer.BadParameter("does not apply to --sense yet", param_hint="--turn-noise")
+        simulate_policy_command(
+            part, spec, sense, also or [], part_prior, max_actions, engine, trials, workers,
+            offset, err, seed, units, sensor_error, as_json,
+        )  # fmt: skip
+        return
+    if also or part_prior is not None or sensor_error:
+        raise typer.BadParameter("--also, --part-prior and --sensor-error need --sense")
     p = part.load()
-    scale = units_scale(units if units is not None else p.units) if offset > 0 else 1.0
+    given = units is not None
+    scale = units_scale(units if given else p.units) if offset > 0 or given else 1.0
     if offset > 0 and offset / 1000.0 >= p.hull.size * scale:
         size_mm = p.hull.size * scale * 1000.0
         raise typer.BadParameter(
@@ -129,7 +162,6 @@ def simulate(
         )
     pb, option, label = chosen_plan(which, spec, p, force)
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
-    err = GripperNoise(noise_kind.value, math.radians(noise))
     if turn_noise is not None:  # the spelling of plan --turn-noise
         from .noisy import turn_noise as parse
 

@@ -62,6 +62,9 @@ classes) and ``post`` Bayes' rule with the reading bins of the sensor. The root 
 ``h = min over first kinds t (and first gripper angles) of c^first_t + sum_b P(b) V(q_b,
 K - 1)``. Beliefs are memoised after rounding to multiples of ``2^-40`` (so values may carry
 errors of about ``1e-12``; the reported figures are recomputed exactly on the returned tree).
+A reading of probability ``p`` (given its node) whose leaf value exceeds the bound on acting
+again by ``g`` ends in a leaf when ``p g < 1e-13``: the search gives up at most that much per
+such reading.
 
 The search is bounded by the depth and by branch and bound with an upper bound ``U(q)`` on
 the success probability any continuation can reach: when every action is symmetric under a
@@ -74,6 +77,18 @@ cannot beat the best found is skipped, and one is abandoned as soon as its exact
 far plus the bounds of the rest cannot. Classes with the same effect on the belief's support
 are one (the widest is kept: the most margin for the turn). Ties go to fewer actions and to
 declaring over rejecting.
+
+Where the search grows: every reading bin of positive probability leads to its own belief,
+and with noisy readings almost every such belief is new (the memo only helps where readings
+are deterministic), so the programme visits up to ``(A B)^(K - 1)`` beliefs for ``A``
+distinct class images and ``B`` bins a node. The last action's children are settled in one
+vectorised step, the bounds prune the rest, and the per-belief work that does not depend on
+``lambda`` (the images of each class, their reading masses and success masses, the bound's
+``U`` and ``r``, computed by a matrix product over the pi pairs' common likelihoods) is kept
+across the parametric steps. Noisy readings with push-grasps (no pi-pair bound) or with
+SIGMA large against the width differences (many ambiguous bins) are the slow cases: see
+the README's figures. Neighbouring readings that lead to the same subtree are joined into
+one branch of the returned tree (the policy is the same).
 
 First gripper angle: under the uniform prior it does not matter (0). Otherwise the root
 belief is linear in the angle between the angles where a basin boundary meets a breakpoint
@@ -107,8 +122,9 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
-from ..angles import TWO_PI, circle_distance, wrap, wrap_period
+from ..angles import TWO_PI, circle_distance, wrap
 from ..errors import PlanningError
+from ..model.actions import Action
 from ..model.prior import SamplePrior, UniformPrior
 from ..model.problem import ActionClasses, Problem, nearest_state
 from ..model.sensing import (
@@ -118,7 +134,7 @@ from ..model.sensing import (
     entropy_bits,
     parse_sensor,
 )
-from .result import PlanStep
+from .result import PlanStep, short_turns
 
 __all__ = [
     "Branch",
@@ -137,6 +153,7 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 _QUANT = float(2**40)  # beliefs are memoised after rounding to multiples of 2**-40
 _EPS = 1e-12  # value comparisons (ties go to fewer actions)
+_TINY = 1e-13  # a reading this unlikely times its most to gain by acting again ends in a leaf
 _DEFAULT_MAX_ACTIONS = 3
 
 
@@ -345,6 +362,7 @@ def _joint(space: StateSpace, kind: str) -> ActionClasses:
 
 @dataclass(slots=True)
 class _Kind:
+    action: Action
     name: str
     cost: float
     first_cost: float
@@ -353,6 +371,21 @@ class _Kind:
     mid: FloatArray  # (A,)
     half_width: FloatArray  # (A,)
     pi_symmetric: bool
+
+
+@dataclass(slots=True)
+class _Prepared:
+    """Images of a belief under one kind's classes and what does not depend on ``lambda``.
+
+    ``mass[i, b]`` is the probability of reading bin ``b`` after image ``i``; ``success`` the
+    best declaration's success mass there; ``bound`` the bound's ``U`` and ``r``
+    (:meth:`_Solver.bound_of`) of those (image, reading) pairs, once asked for.
+    """
+
+    images: FloatArray  # (M, N)
+    mass: FloatArray  # (M, B)
+    success: FloatArray  # (M, B)
+    bound: tuple[FloatArray, FloatArray] | None = None
 
 
 @dataclass(slots=True)
@@ -368,10 +401,12 @@ class _Solver:
     pair_b: IntArray
     pair_both: NDArray[np.bool_]
     use_pairs: bool
+    pair_likelihood: FloatArray  # (P, B): a reading's likelihood in either state of a pair
     lam: float = 0.0
     memo: dict[tuple[bytes, int], tuple[float, tuple[Any, ...], float, float]] = field(
         default_factory=dict
     )
+    prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
     @property
     def c_min(self) -> float:
@@ -425,9 +460,16 @@ class _Solver:
         """Distinct beliefs after each class of ``kind`` (M, N) and the row of each."""
         supp = np.flatnonzero(q > 0)
         t = kind.transfer[:, supp]  # (A, S)
-        _, first = np.unique(t, axis=0, return_index=True)
-        first = np.sort(first)  # widest class of each distinct effect, widest first
         n = self.space.n_states
+        if len(supp) * math.log2(max(n, 2)) < 62:  # each row as one integer in base n
+            code = t @ (n ** np.arange(len(supp), dtype=np.int64))
+            _, first = np.unique(code, return_index=True)
+            first = np.sort(first)  # the widest class of each distinct effect, widest first
+        else:
+            seen: dict[bytes, int] = {}
+            for ai, row in enumerate(t):
+                seen.setdefault(row.tobytes(), ai)
+            first = np.fromiter(seen.values(), dtype=np.intp, count=len(seen))
         rows = t[first]
         m = len(first)
         idx = (rows + n * np.arange(m)[:, None]).ravel()
@@ -444,42 +486,75 @@ class _Solver:
         return np.rint(q * _QUANT).astype(np.int64).tobytes()
 
     # -- the programme -----------------------------------------------------------------
-    def leaf_figures(self, m: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """Cycle cost and success mass of the leaf chosen for beliefs ``m`` (..., N).
+    def prepare(self, imgs: FloatArray) -> _Prepared:
+        """What :meth:`best_act` needs of images ``imgs`` (M, N) at any price ``lambda``."""
+        j = self.joint(imgs)  # (M, B, N)
+        s, _ = self.success(j)
+        return _Prepared(imgs, j.sum(axis=-1), s)
 
-        Declares unless rejecting is strictly better (as :meth:`value` decides).
+    def bound_of(self, prep: _Prepared) -> tuple[FloatArray, FloatArray]:
+        """The bound's ``U`` and ``r`` (:meth:`bound`) of every (image, reading) pair: (M, B).
+
+        The two states of a pi pair have the same width, so a reading scales both by the
+        same likelihood ``L_p(b)``: the pair's split (``share``) is the image's, and ``U`` is
+        a matrix product. ``L_p`` is the larger of the pair's two likelihoods (equal up to
+        rounding), so ``U`` stays an upper bound. Computed once per prepared images.
         """
-        total = m.sum(axis=-1)
-        s, _ = self.success(m)
+        if prep.bound is not None:
+            return prep.bound
+        if not self.use_pairs:
+            out = (prep.mass, np.ones_like(prep.mass))
+        else:
+            imgs, lik = prep.images, self.pair_likelihood
+            a, b = imgs[:, self.pair_a], imgs[:, self.pair_b]  # (M, P)
+            pair = a + b
+            top = np.where(self.pair_both, pair, np.maximum(a, b))
+            share = top / np.maximum(pair, 1e-300)
+            reach = (pair[:, :, None] > 0) & (lik[None, :, :] > 0)  # (M, P, B)
+            r = np.max(np.where(reach, share[:, :, None], 0.0), axis=1)  # (M, B)
+            out = (np.asarray(top @ lik), np.asarray(r))
+        prep.bound = out
+        return out
+
+    def leaf_figures_of(self, total: FloatArray, s: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Cycle cost and success mass of the leaf chosen for masses ``total`` (best ``s``).
+
+        ``s`` is the success mass of the best declaration. Declares unless rejecting is
+        strictly better (as :meth:`value` decides).
+        """
         lam, v, rho = self.lam, self.verify, self.retry
         declare = (v + rho) * total - (lam + rho) * s <= rho * total + _EPS * total
         c = np.where(declare, v * total + rho * (total - s), rho * total)
         return np.asarray(c), np.asarray(np.where(declare, s, 0.0))
 
     def best_act(
-        self, imgs: FloatArray, cost: float, r_after: int, best: float
+        self, prep: _Prepared, cost: float, r_after: int, best: float
     ) -> tuple[float, int, float, float]:
         """Least value of acting into each image (``cost + children``) if below ``best``.
 
         Returns the value, the image index (-1 when none beats ``best``), and the chosen
         continuation's cycle cost and success probability (per unit mass).
         """
-        j = self.joint(imgs)  # (M, B, N)
-        leaf = self.leaf_value(j)  # (M, B): children as leaves
+        lam, v, rho = self.lam, self.verify, self.retry
+        pm, s = prep.mass, prep.success
+        leaf = np.minimum(rho * pm, (v + rho) * pm - (lam + rho) * s)  # (M, B): leaves
         ub = cost + leaf.sum(axis=1)
         if r_after == 0:
             i = int(np.argmin(ub))
             if ub[i] < best - _EPS:
-                c, p = self.leaf_figures(j[i])
+                c, p = self.leaf_figures_of(pm[i], s[i])
                 return float(ub[i]), i, cost + float(c.sum()), float(p.sum())
             return best, -1, math.nan, math.nan
         pick, pick_c, pick_p = -1, math.nan, math.nan
-        pm = j.sum(axis=2)  # (M, B)
-        act = self.act_bound(j)  # (M, B)
+        # The bound on acting again (:meth:`act_bound`) of every (image, reading) pair.
+        top, share = self.bound_of(prep)
+        gain = top * (v / np.maximum(share, 0.5) - lam - rho)
+        act = (self.c_min + rho) * pm + np.minimum(0.0, gain)
         lb_child = np.minimum(leaf, act)
         lb = cost + lb_child.sum(axis=1)
         # A child whose leaf is no worse than acting's bound is a leaf (as `value` decides).
-        settled = leaf <= act + _EPS * pm
+        settled = (leaf <= act + _EPS * pm) | (leaf - act < _TINY)
+        lik_t = self.bins.likelihood.T  # (B, N)
         for i in np.argsort(ub, kind="stable"):
             if lb[i] >= best - _EPS:
                 continue
@@ -488,13 +563,14 @@ class _Solver:
             rest = float(lb_child[i, ~done].sum())
             if total + rest >= best - _EPS:
                 continue
-            lc, lp = self.leaf_figures(j[i, done])
+            lc, lp = self.leaf_figures_of(pm[i, done], s[i, done])
             c_sum, p_sum = cost + float(lc.sum()), float(lp.sum())
             aborted = False
+            img = prep.images[i]
             for b in np.flatnonzero((pm[i] > 0) & ~done):
                 rest -= float(lb_child[i, b])
                 pb = float(pm[i, b])
-                val, cv, pv = self.value(j[i, b] / pb, r_after)
+                val, cv, pv = self.value(img * lik_t[b] / pb, r_after)
                 total += pb * val
                 c_sum += pb * cv
                 p_sum += pb * pv
@@ -505,12 +581,22 @@ class _Solver:
                 best, pick, pick_c, pick_p = total, int(i), c_sum, p_sum
         return best, pick, pick_c, pick_p
 
+    def prepared(self, key: bytes, q: FloatArray, ti: int) -> tuple[_Prepared, IntArray]:
+        """The images of belief ``q`` under kind ``ti``, prepared (kept across prices)."""
+        hit = self.prep_cache.get((key, ti))
+        if hit is None:
+            imgs, rows = self.images(q, self.kinds[ti])
+            hit = (self.prepare(imgs), rows)
+            self.prep_cache[(key, ti)] = hit
+        return hit
+
     def value(self, q: FloatArray, r: int) -> tuple[float, float, float]:
         """``V(q, r)`` per unit mass (``q`` normalised), with its cycle cost and success.
 
         Memoised with the decision that reaches it.
         """
-        k = (self.key(q), r)
+        qk = self.key(q)
+        k = (qk, r)
         hit = self.memo.get(k)
         if hit is not None:
             return hit[0], hit[2], hit[3]
@@ -526,8 +612,8 @@ class _Solver:
             best, decision, c, p = rho, ("reject",), rho, 0.0
         if r > 0 and best > float(self.act_bound(q)) + _EPS:
             for ti, kind in enumerate(self.kinds):
-                imgs, rows = self.images(q, kind)
-                val, i, ci, pi = self.best_act(imgs, kind.cost, r - 1, best)
+                prep, rows = self.prepared(qk, q, ti)
+                val, i, ci, pi = self.best_act(prep, kind.cost, r - 1, best)
                 if i >= 0:
                     best, decision, c, p = val, ("act", ti, int(rows[i])), ci, pi
         self.memo[k] = (best, decision, c, p)
@@ -567,17 +653,14 @@ class _Builder:
     leaves_at: list[tuple[int, float, float]] = field(default_factory=list)
 
     def turn(self, kind: _Kind, alpha: float, carry: float) -> tuple[float, float]:
-        """The turn to command and the carry it leaves (see :func:`.result.short_turns`).
+        """The turn to command and the carry it leaves: :func:`.result.short_turns`.
 
         A gripper with a pi-symmetric action turned by pi is the same gripper; the part then
         lies pi further round in its frame, which later turns and the declared orientation
         absorb.
         """
-        a = wrap(alpha + carry)
-        if kind.pi_symmetric:
-            short = wrap_period(a, math.pi)
-            return short, a - short
-        return a, 0.0
+        steps, rest = short_turns([kind.action], [alpha + carry])
+        return steps[0].alpha, rest
 
     def node(
         self,
@@ -591,24 +674,75 @@ class _Builder:
         level: int,
         first: bool,
     ) -> PolicyNode:
-        """An action node whose action leaves the (normalised) belief ``img``."""
+        """An action node whose action leaves the (normalised) belief ``img``.
+
+        The readings after which the programme stops (a leaf is no worse than the bound on
+        acting again, as :meth:`_Solver.best_act` settles them, or no actions are left) are
+        handled together: their leaves, figures and entropies are computed for all bins at
+        once, and neighbouring bins with the same leaf are one branch.
+        """
+        s = self.solver
         t = self.tally
         t.actions += mass
         t.action_cost += mass * (kind.first_cost if first else kind.cost)
         turn, carry = self.turn(kind, alpha, carry)
-        lik = self.solver.bins.likelihood
-        joint = img[:, None] * lik  # (N, B)
+        joint = img[:, None] * s.bins.likelihood  # (N, B)
         p = joint.sum(axis=0)
         kept = np.flatnonzero(p > 0)
-        raw: list[tuple[float, PolicyNode | Declare | Reject]] = []
-        for b in kept:
-            pb = float(p[b])
-            q = joint[:, b] / pb
-            raw.append((pb, self.after(q, mass * pb, r_after, carry, level)))
-        lo = [-math.inf, *(float(self.solver.bins.lo[b]) for b in kept[1:])]
-        hi = [*lo[1:], math.inf]
-        branches = _merge_leaves([Branch(lo[i], hi[i], pb, nxt) for i, (pb, nxt) in enumerate(raw)])
-        return PolicyNode(PlanStep(kind.name, turn), tuple(branches), margin)
+        pm = p[kept]
+        q = joint[:, kept].T / pm[:, None]  # (M, N) belief after each reading
+        if r_after > 0:
+            leaf_q, act_q = s.leaf_value(q), s.act_bound(q)
+            settled = (leaf_q <= act_q + _EPS) | (pm * (leaf_q - act_q) < _TINY)
+        else:
+            settled = np.ones(len(kept), dtype=bool)
+        succ, state = s.success(q)
+        declare = (s.verify + s.retry) - (s.lam + s.retry) * succ <= s.retry + _EPS
+        # Leaf key of each bin: the declared state, or -1 to reject, or -2 to act on.
+        leaf_key = np.where(settled, np.where(declare, state, -1), -2)
+        w = mass * pm
+        lw = np.where(settled, w, 0.0)
+        dw = np.where(settled & declare, w, 0.0)
+        t.success += float((dw * succ).sum())
+        t.verify_cost += float(dw.sum()) * s.verify
+        t.reject += float(np.where(settled & ~declare, w, 0.0).sum())
+        if settled.any():
+            h = _entropies(q[settled])
+            mean_h = float((w[settled] * h).sum() / lw.sum())
+            self.leaves_at.append((level, float(lw.sum()), mean_h))
+        lo_all = s.bins.lo
+        branches: list[Branch] = []
+        i, m = 0, len(kept)
+        while i < m:
+            key = int(leaf_key[i])
+            lo = -math.inf if i == 0 else float(lo_all[kept[i]])
+            if key == -2:
+                nxt = self.after(q[i], float(w[i]), r_after, carry, level)
+                j = i + 1
+                prob = float(pm[i])
+            else:
+                j = i + 1
+                while j < m and leaf_key[j] == key:
+                    j += 1
+                prob = float(pm[i:j].sum())
+                if key == -1:
+                    nxt = Reject()
+                else:
+                    q_succ = float((pm[i:j] * succ[i:j]).sum()) / prob
+                    nxt = self.declare(key, q_succ, carry)
+            hi = math.inf if j == m else float(lo_all[kept[j]])
+            branches.append(Branch(lo, hi, prob, nxt))
+            i = j
+        merged = _merge_subtrees(_merge_leaves(branches))
+        return PolicyNode(PlanStep(kind.name, turn), tuple(merged), margin)
+
+    def declare(self, state: int, success: float, carry: float) -> Declare:
+        """The leaf declaring joint state ``state`` (its orientation turned by ``carry``)."""
+        part, theta = self.solver.space.stable(state)
+        orientation = float(np.mod(theta + carry, TWO_PI))
+        if orientation >= TWO_PI:  # pragma: no cover - rounding
+            orientation = 0.0
+        return Declare(part, self.solver.space.names[part], orientation, success)
 
     def after(
         self, q: FloatArray, mass: float, r: int, carry: float, level: int
@@ -642,11 +776,14 @@ class _Builder:
         succ = float(q[s.goal[o]].sum())
         t.success += mass * succ
         t.verify_cost += mass * s.verify
-        part, theta = s.space.stable(o)
-        orientation = float(np.mod(theta + carry, TWO_PI))
-        if orientation >= TWO_PI:  # pragma: no cover - rounding
-            orientation = 0.0
-        return Declare(part, s.space.names[part], orientation, succ)
+        return self.declare(o, succ, carry)
+
+
+def _entropies(q: FloatArray) -> FloatArray:
+    """Shannon entropy (bits) of each row of normalised beliefs ``q`` (M, N)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        terms = np.where(q > 0, q * np.log2(np.where(q > 0, q, 1.0)), 0.0)
+    return np.asarray(-terms.sum(axis=1), dtype=np.float64)
 
 
 def _merge_leaves(branches: list[Branch]) -> list[Branch]:
@@ -667,6 +804,59 @@ def _merge_leaves(branches: list[Branch]) -> list[Branch]:
         else:
             out.append(b)
     return out
+
+
+def _merge_subtrees(branches: list[Branch]) -> list[Branch]:
+    """Join neighbouring branches that lead to the same policy (:func:`_same_next`).
+
+    The joined branch's subtree is the same tree with its probabilities mixed by the weight
+    of each reading, so the policy (and every figure of it) is unchanged; it is only told
+    once.
+    """
+    out: list[Branch] = []
+    for b in branches:
+        if out and _same_next(out[-1].next, b.next):
+            prev = out[-1]
+            p = prev.probability + b.probability
+            out[-1] = Branch(
+                prev.lo, b.hi, p, _mix(prev.next, prev.probability, b.next, b.probability)
+            )
+        else:
+            out.append(b)
+    return out
+
+
+def _same_next(a: object, b: object) -> bool:
+    """The same leaf, or the same actions with the same branches down to the same leaves."""
+    if isinstance(a, PolicyNode) and isinstance(b, PolicyNode):
+        return (
+            a.step.kind == b.step.kind
+            and abs(a.step.alpha - b.step.alpha) < 1e-12
+            and len(a.branches) == len(b.branches)
+            and all(
+                x.lo == y.lo and x.hi == y.hi and _same_next(x.next, y.next)
+                for x, y in zip(a.branches, b.branches, strict=True)
+            )
+        )
+    return _same_leaf(a, b)
+
+
+def _mix(
+    a: PolicyNode | Declare | Reject, wa: float, b: PolicyNode | Declare | Reject, wb: float
+) -> PolicyNode | Declare | Reject:
+    """The tree ``a`` (= ``b``) reached with weight ``wa + wb``, its probabilities mixed."""
+    w = wa + wb
+    if isinstance(a, Declare) and isinstance(b, Declare):
+        q = (wa * a.success_probability + wb * b.success_probability) / w if w > 0 else 0.0
+        return Declare(a.part, a.part_name, a.orientation, q)
+    if isinstance(a, PolicyNode) and isinstance(b, PolicyNode):
+        branches = []
+        for x, y in zip(a.branches, b.branches, strict=True):
+            px, py = wa * x.probability, wb * y.probability
+            prob = (px + py) / w if w > 0 else 0.0
+            branches.append(Branch(x.lo, x.hi, prob, _mix(x.next, px, y.next, py)))
+        return PolicyNode(a.step, tuple(branches), min(a.margin, b.margin))
+    return a
 
 
 def _same_leaf(a: object, b: object) -> bool:
@@ -801,6 +991,7 @@ def plan_policy(
         order = np.argsort(-(cl.hi - cl.lo), kind="stable")
         kinds.append(
             _Kind(
+                action,
                 action.name,
                 cost.action_cost(action.name),
                 cost.action_cost(action.name, first=True),
@@ -813,9 +1004,11 @@ def plan_policy(
         )
     goal = space.success_matrix()
     pa, pb, both, paired = _pairs(space)
+    bins = space.bins(sens)
+    pair_lik = np.maximum(bins.likelihood[pa], bins.likelihood[pb]) if paired else np.zeros((0, 1))
     solver = _Solver(
         space,
-        space.bins(sens),
+        bins,
         kinds,
         cost.verify,
         cost.retry,
@@ -825,6 +1018,7 @@ def plan_policy(
         pb,
         both,
         paired and all(k.pi_symmetric for k in kinds),
+        np.ascontiguousarray(pair_lik),
     )
     if first_angles is not None:
         angles = [float(a) for a in first_angles]
@@ -857,6 +1051,8 @@ def plan_policy(
     if sensorless_cost is not None and math.isfinite(sensorless_cost):
         lam = min(lam, sensorless_cost)
 
+    root_preps = [solver.prepare(roots[ri : ri + 1]) for ri in range(len(roots))]
+
     def solve(lam: float) -> tuple[float, int, float]:
         """``h(lambda)``, the best root, and the ratio of the policy that reaches it."""
         solver.lam = lam
@@ -864,7 +1060,7 @@ def plan_policy(
         h, pick, ratio = math.inf, -1, math.inf
         for ri in range(len(roots)):
             k = kinds[root_kind[ri]]
-            val, i, c, p = solver.best_act(roots[ri : ri + 1], k.first_cost, max_actions - 1, h)
+            val, i, c, p = solver.best_act(root_preps[ri], k.first_cost, max_actions - 1, h)
             if i >= 0:
                 h, pick, ratio = val, ri, (c / p if p > 0 else math.inf)
         return h, pick, ratio

@@ -99,12 +99,16 @@ class ActionOutcome:
         Whether the jaws came to rest in time (``SimParams.max_time``).
     sim_time : float
         Simulated seconds.
+    width : float
+        The jaw separation when the action ended, less the vertex capsules' diameter
+        (:meth:`Squeezer.width`), metres: what a gripper's encoder reads.
     """
 
     start: float
     end: float
     settled: bool
     sim_time: float
+    width: float = math.nan
 
 
 class Squeezer:
@@ -155,6 +159,8 @@ class Squeezer:
         #: Draws the leading jaw of a squeeze when ``params.jaw_lag > 0`` and ``lead_jaw``
         #: is ``random`` and :meth:`act` is given no ``lead``; replace it to reseed.
         self.rng = np.random.default_rng(0)
+        # The jaws touch capsules of this radius at the hull's vertices (scene_xml).
+        self._rc = min(self.params.edge_radius, 0.25 * self.body.thickness)
 
     def _rest_height(self) -> float:
         """Height of the part's body frame when it rests on the table (one short settle)."""
@@ -171,6 +177,16 @@ class Squeezer:
         """The part's yaw (radians, ``[0, 2 pi)``) from the free joint's quaternion."""
         w, x, y, z = self.data.qpos[self._part_q + 3 : self._part_q + 7]
         return float(np.mod(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)), TWO_PI))
+
+    def width(self) -> float:
+        """The jaw separation less the capsules' diameter (metres): the part's width read.
+
+        The slide joints' positions are the x of the jaws' inner faces; the capsules at the
+        hull's vertices add ``2 * edge_radius`` to every width (:mod:`bayesgrasp.sim.scene`).
+        """
+        d = self.data
+        sep = float(d.qpos[self._jaw_q[1]] - d.qpos[self._jaw_q[0]])
+        return sep - 2.0 * self._rc
 
     def _place(self, theta: float, offset: float) -> tuple[float, float]:
         """Put the part at yaw ``theta``, x-extent centred at ``offset``; return its extent."""
@@ -255,10 +271,10 @@ class Squeezer:
             if t > earliest and slow and full:
                 calm += 1
                 if calm >= need:
-                    return ActionOutcome(theta, self.yaw(), True, t)
+                    return ActionOutcome(theta, self.yaw(), True, t, self.width())
             else:
                 calm = 0
-        return ActionOutcome(theta, self.yaw(), False, t)
+        return ActionOutcome(theta, self.yaw(), False, t, self.width())
 
 
 # --- parallel trials ---------------------------------------------------------------------

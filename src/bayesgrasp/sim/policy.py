@@ -1,0 +1,652 @@
+"""Executing a sensing policy: cycles on the model or in MuJoCo, against the policy's claims.
+
+A policy (:mod:`bayesgrasp.planning.policy`) claims, per *cycle* (one run of the tree on a
+fresh part), a success probability ``P``, a cycle cost ``c = E[C] + rho (1 - P)`` (actions
+on the path, verification at a declaring leaf, the retry overhead ``rho`` when the cycle
+fails or rejects) and a number of actions; and, over the whole process (cycles repeat until
+one succeeds), the expected cost ``E = c / P``.
+
+A simulation runs ``n`` cycles back to back. Each draws a part from the part prior and a
+world orientation from the orientation prior (:func:`~bayesgrasp.sim.kinematic.sample_prior`),
+then follows the tree: at a node it turns the gripper (plus an optional gripper error,
+:class:`~bayesgrasp.sim.noise.GripperNoise`), acts, reads the jaw width and takes the branch
+the reading falls in; at a leaf it verifies (a declaration is right when the part and the
+final orientation are the declared ones under the goal) or rejects. A failed or rejected
+cycle is followed by the next one, as the cost semantics say, so the parts oriented are the
+cycles that succeed and the observed cost per oriented part is the renewal-reward ratio
+``sum of cycle costs / successes`` (it converges to ``E``).
+
+- :func:`simulate_policy` runs on the model's transfer functions and draws each reading
+  from the sensor model, ``RES round((d(sigma) + e) / RES)``, ``e ~ Normal(0, SIGMA^2)``
+  (:meth:`~bayesgrasp.model.sensing.WidthSensor.read`).
+- :func:`simulate_policy_mujoco` runs every action in MuJoCo
+  (:class:`~bayesgrasp.sim.engine.Squeezer`) and reads the real jaw separation at the end
+  of each squeeze or push-grasp (:attr:`~bayesgrasp.sim.engine.ActionOutcome.width`),
+  quantised at the sensor's resolution. The physics' own error is the sensor error; the
+  model's normal error can be added on top (``add_sensor_error``).
+
+Intervals (:class:`PolicySimulation`): the success count is binomial (Wilson score
+interval); the mean cycle cost and actions are means of independent cycles (central limit
+theorem, ``z`` sample standard errors); the cost per success is a ratio of means, whose
+standard error is the delta method's ``sqrt(Var(C - E S) / n) / mean(S)`` with ``S`` the
+success indicator (at least the relative half-width of the success interval, so that a run
+without failures still has an honest interval).
+
+How far MuJoCo's readings stray from ``d(sigma)``: with the default
+:class:`~bayesgrasp.sim.params.SimParams`, settled squeezes of the catalogue parts (mm,
+3-7 cm across) read 0.07-0.12 mm *below* the width at the stable orientation reached, with a
+spread of 0.02-0.03 mm and at most 0.16 mm (house, rectangle, key, triangle, tuning fork,
+IC chip); the jaws' force presses the soft contacts in (``solref`` 4 ms).
+:data:`MUJOCO_SIGMA` = 0.2 mm, about twice that bias, is the default SIGMA of a policy
+executed in MuJoCo (:func:`mujoco_sensor`), with RES = 0.1 mm.
+"""
+
+from __future__ import annotations
+
+import math
+import multiprocessing
+import time
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..angles import TWO_PI, circle_distance
+from ..errors import SimulationError
+from ..geometry.polygon import Part
+from ..model.actions import get_action
+from ..model.problem import Problem, nearest_state
+from ..model.sensing import WidthSensor
+from ..planning.policy import Declare, Policy, PolicyNode, Reject
+from .kinematic import sample_prior
+from .noise import GripperNoise
+from .params import SimParams
+from .result import Progress, check_trials
+from .stats import wilson_interval
+
+__all__ = [
+    "MUJOCO_RESOLUTION",
+    "MUJOCO_SIGMA",
+    "PolicySimulation",
+    "mujoco_sensor",
+    "policy_simulation_json",
+    "policy_simulation_text",
+    "simulate_policy",
+    "simulate_policy_mujoco",
+]
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
+BoolArray = NDArray[np.bool_]
+
+#: Default reading error of MuJoCo's jaw separation (metres): about twice the largest
+#: stray measured (see the module notes).
+MUJOCO_SIGMA = 2e-4
+#: Default resolution of MuJoCo's readings (metres).
+MUJOCO_RESOLUTION = 1e-4
+_Z = 4.0  # the intervals' half-width in standard errors (about 1 in 16,000 two-sided)
+
+
+def mujoco_sensor(part: Part, scale: float) -> WidthSensor:
+    """The default sensor of a policy run in MuJoCo, in the part's units.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry import Part
+    >>> mujoco_sensor(Part.from_points([(0, 0), (40, 0), (10, 30)]), 0.001).spec
+    'width:0.2,0.1'
+    """
+    return WidthSensor(MUJOCO_SIGMA / scale, MUJOCO_RESOLUTION / scale)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PolicySimulation:
+    """Observed cycles of a policy beside its claims (see the module notes).
+
+    Attributes
+    ----------
+    engine : str
+        ``"kinematic"`` or ``"mujoco"``.
+    policy : Policy
+    cycles, successes, rejects, jams : int
+        Cycles run; those whose declaration was right; those that rejected; those with an
+        action that did not settle or stopped away from every stable orientation (MuJoCo;
+        a jammed cycle fails unless its declaration happens to hold).
+    cycle_costs, actions : ndarray of shape (cycles,)
+        Cost of each cycle (retry overhead included) and its number of actions.
+    success : ndarray of bool, shape (cycles,)
+    reading_errors : ndarray
+        ``reading - d(sigma)`` of every reading (part units), ``sigma`` the stable state
+        nearest to where the part ended (MuJoCo: of the actions that did not jam).
+    seconds : float
+        Wall time.
+    """
+
+    engine: str
+    policy: Policy
+    cycles: int
+    successes: int
+    rejects: int
+    jams: int
+    cycle_costs: FloatArray
+    actions: FloatArray
+    success: BoolArray
+    reading_errors: FloatArray
+    seconds: float
+
+    @property
+    def observed_success(self) -> float:
+        """Share of cycles that succeeded."""
+        return self.successes / self.cycles
+
+    @property
+    def success_interval(self) -> tuple[float, float]:
+        """Wilson score interval of the success probability, ``z = 4``."""
+        from scipy.stats import norm
+
+        return wilson_interval(self.successes, self.cycles, float(1 - 2 * norm.sf(_Z)))
+
+    def _mean_interval(self, x: FloatArray) -> tuple[float, float, float]:
+        m = float(x.mean())
+        se = float(x.std(ddof=1)) / math.sqrt(len(x)) if len(x) > 1 else math.inf
+        return m, m - _Z * se, m + _Z * se
+
+    @property
+    def cycle_cost(self) -> tuple[float, float, float]:
+        """Mean cycle cost and its CLT interval (``z = 4``)."""
+        return self._mean_interval(self.cycle_costs)
+
+    @property
+    def mean_actions(self) -> tuple[float, float, float]:
+        """Mean number of actions a cycle and its CLT interval."""
+        return self._mean_interval(self.actions)
+
+    @property
+    def cost_per_success(self) -> tuple[float, float, float]:
+        """Total cost over the parts oriented, with the delta method's interval.
+
+        ``inf`` (and an unbounded interval) when no cycle succeeded.
+        """
+        if self.successes == 0:
+            return math.inf, math.inf, math.inf
+        s = self.success.astype(np.float64)
+        ratio = float(self.cycle_costs.sum() / s.sum())
+        resid = self.cycle_costs - ratio * s
+        n = self.cycles
+        se = float(resid.std(ddof=1)) / math.sqrt(n) / float(s.mean()) if n > 1 else math.inf
+        # At least the relative uncertainty of the success probability (Wilson): when no
+        # cycle failed the sample variance is 0 but the success rate is not known exactly.
+        lo, hi = self.success_interval
+        se = max(se, ratio * (hi - lo) / (2.0 * _Z * self.observed_success))
+        return ratio, ratio - _Z * se, ratio + _Z * se
+
+    @property
+    def agrees(self) -> bool:
+        """Every claim of the policy lies in its interval (success, cycle cost, actions, cost)."""
+        pol = self.policy
+        lo, hi = self.success_interval
+        checks = [
+            (pol.success_probability, (0.0, lo, hi)),
+            (pol.cycle_cost, self.cycle_cost),
+            (pol.expected_actions, self.mean_actions),
+            (pol.expected_cost, self.cost_per_success),
+        ]
+        slack = 1e-9
+        return all(
+            c[1] - slack * (1 + abs(v)) <= v <= c[2] + slack * (1 + abs(v)) for v, c in checks
+        )
+
+
+# -- the kinematic engine -------------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class _Run:
+    """Per-cycle state of a vectorised kinematic run."""
+
+    problems: tuple[Problem, ...]
+    sensor: WidthSensor
+    noise: GripperNoise
+    gen: np.random.Generator
+    part: IntArray
+    theta: FloatArray
+    cost: FloatArray
+    acts: FloatArray
+    ok: BoolArray
+    rejected: BoolArray
+    errors: list[FloatArray]
+
+    def node(self, node: PolicyNode, idx: IntArray, first: bool) -> None:
+        """Run the cycles ``idx`` through ``node`` and what follows it."""
+        step = node.step
+        cost = self.problems[0].cost
+        err = self.noise.draw((len(idx),), self.gen)
+        th = self.theta[idx] - (step.alpha + err)
+        width = np.empty(len(idx))
+        truth = np.empty(len(idx))
+        parts = self.part[idx]
+        for j in np.unique(parts):
+            m = parts == j
+            pb = self.problems[int(j)]
+            th[m] = pb.transfer(step.kind)(th[m])
+            width[m] = pb.diameter(th[m])
+            truth[m] = pb.widths[nearest_state(pb.states, th[m])]
+        self.theta[idx] = th
+        self.cost[idx] += cost.action_cost(step.kind, first=first)
+        self.acts[idx] += 1
+        reading = self.sensor.read(width, self.gen)
+        self.errors.append(reading - truth)
+        his = np.array([b.hi for b in node.branches[:-1]])
+        which = np.searchsorted(his, reading, side="right")
+        for bi, br in enumerate(node.branches):
+            sub = idx[which == bi]
+            if len(sub) == 0:
+                continue
+            if isinstance(br.next, PolicyNode):
+                self.node(br.next, sub, False)
+            else:
+                self.leaf(br.next, sub)
+
+    def leaf(self, leaf: Declare | Reject, idx: IntArray) -> None:
+        cost = self.problems[0].cost
+        if isinstance(leaf, Declare):
+            self.cost[idx] += cost.verify
+            pb = self.problems[leaf.part]
+            mine = idx[self.part[idx] == leaf.part]
+            good = pb.success_states(leaf.orientation)[nearest_state(pb.states, self.theta[mine])]
+            self.ok[mine] = good
+        else:
+            self.rejected[idx] = True
+        failed = idx[~self.ok[idx]]
+        self.cost[failed] += cost.retry
+
+
+def _problems(problems: Problem | Iterable[Problem], policy: Policy) -> tuple[Problem, ...]:
+    pbs = (problems,) if isinstance(problems, Problem) else tuple(problems)
+    if len(pbs) != len(policy.parts):
+        raise SimulationError(
+            f"the policy tells {len(policy.parts)} part(s) apart; got {len(pbs)} problem(s)"
+        )
+    for pb in pbs:
+        missing = set(_kinds(policy.root)) - set(pb.action_kinds)
+        if missing:
+            raise SimulationError(
+                f"the policy uses {', '.join(sorted(missing))} actions but the problem of "
+                f"{pb.part.name!r} has only {', '.join(pb.action_kinds)}"
+            )
+    return pbs
+
+
+def _kinds(node: PolicyNode) -> Iterator[str]:
+    yield node.step.kind
+    for b in node.branches:
+        if isinstance(b.next, PolicyNode):
+            yield from _kinds(b.next)
+
+
+def simulate_policy(
+    problems: Problem | Iterable[Problem],
+    policy: Policy,
+    cycles: int,
+    noise: GripperNoise | None = None,
+    rng: np.random.Generator | int | None = None,
+    chunk: int = 1 << 16,
+    progress: Progress | None = None,
+) -> PolicySimulation:
+    """Run ``cycles`` cycles of a policy on the model, readings drawn from its sensor.
+
+    Parameters
+    ----------
+    problems : Problem or iterable of Problem
+        The problems the policy was planned for (one per candidate part, in order); the
+        first one's prior and cost model are used.
+    policy : Policy
+    cycles : int
+    noise : GripperNoise, optional
+        Error added to every commanded gripper angle (default none; each node's
+        ``margin`` bounds the error that changes nothing).
+    rng : numpy.random.Generator or int or None
+    chunk : int
+        Cycles per vectorised batch.
+    progress : callable, optional
+        ``progress(done, total)`` after each batch.
+
+    Returns
+    -------
+    PolicySimulation
+
+    Raises
+    ------
+    SimulationError
+        Bad ``cycles`` or ``chunk``, or problems that do not match the policy.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.planning.policy import plan_policy
+    >>> tri = Problem.build(Part.from_points([(0, 0), (3, 0), (1, 2)]))
+    >>> pol = plan_policy(tri, "width:0.1,0.05", 2)
+    >>> sim = simulate_policy(tri, pol, 20000, rng=0)
+    >>> sim.agrees, round(pol.success_probability, 3), round(sim.observed_success, 2)
+    (True, 0.449, 0.44)
+    """
+    check_trials(cycles)
+    if chunk < 1:
+        raise SimulationError(f"`chunk` must be >= 1; got {chunk}")
+    pbs = _problems(problems, policy)
+    gen = np.random.default_rng(rng)
+    noise = noise or GripperNoise()
+    out: dict[str, list[Any]] = {k: [] for k in ("cost", "acts", "ok", "rej", "err")}
+    t0 = time.perf_counter()
+    done = 0
+    while done < cycles:
+        m = min(chunk, cycles - done)
+        run = _Run(
+            pbs,
+            policy.sensor,
+            noise,
+            gen,
+            np.asarray(gen.choice(len(pbs), size=m, p=np.asarray(policy.part_prior)), np.intp),
+            sample_prior(pbs[0].prior, m, gen),
+            np.zeros(m),
+            np.zeros(m),
+            np.zeros(m, dtype=bool),
+            np.zeros(m, dtype=bool),
+            [],
+        )
+        run.node(policy.root, np.arange(m), True)
+        out["cost"].append(run.cost)
+        out["acts"].append(run.acts)
+        out["ok"].append(run.ok)
+        out["rej"].append(run.rejected)
+        out["err"].extend(run.errors)
+        done += m
+        if progress is not None:
+            progress(done, cycles)
+    ok = np.concatenate(out["ok"])
+    return PolicySimulation(
+        "kinematic",
+        policy,
+        cycles,
+        int(ok.sum()),
+        int(np.concatenate(out["rej"]).sum()),
+        0,
+        np.concatenate(out["cost"]),
+        np.concatenate(out["acts"]),
+        ok,
+        np.concatenate(out["err"]),
+        time.perf_counter() - t0,
+    )
+
+
+# -- MuJoCo ---------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class _Cycle:
+    part: int
+    theta0: float  # world orientation
+    angle_err: tuple[float, ...]  # gripper error of each action (radians)
+    offsets: tuple[float, ...]  # signed offset of each action (metres)
+    reading_err: tuple[float, ...]  # the model's sensor error of each reading (part units)
+
+
+@dataclass(frozen=True, slots=True)
+class _CycleOut:
+    cost: float
+    actions: int
+    success: bool
+    rejected: bool
+    jammed: bool
+    errors: tuple[float, ...]
+    sim_time: float
+
+
+_CTX: dict[str, Any] = {}
+
+
+def _init_mujoco(
+    problems: tuple[Problem, ...], policy: Policy, scales: tuple[float, ...], params: SimParams
+) -> None:
+    _CTX.clear()
+    _CTX.update(problems=problems, policy=policy, scales=scales, params=params, squeezers={})
+
+
+def _squeezer(j: int) -> Any:
+    from .engine import Squeezer
+
+    sq = _CTX["squeezers"]
+    if j not in sq:
+        pb = _CTX["problems"][j]
+        sq[j] = Squeezer(pb.part, _CTX["scales"][j], _CTX["params"])
+    return sq[j]
+
+
+def _run_cycle(c: _Cycle) -> _CycleOut:
+    problems: tuple[Problem, ...] = _CTX["problems"]
+    policy: Policy = _CTX["policy"]
+    params: SimParams = _CTX["params"]
+    sensor = policy.sensor
+    pb = problems[c.part]
+    scale = _CTX["scales"][c.part]
+    sq = _squeezer(c.part)
+    cost = pb.cost
+    yaw = c.theta0
+    node: PolicyNode | Declare | Reject = policy.root
+    total, acts, jammed, t_sim = 0.0, 0, False, 0.0
+    errors: list[float] = []
+    while isinstance(node, PolicyNode):
+        step = node.step
+        start = float(np.mod(yaw - step.alpha - c.angle_err[acts], TWO_PI))
+        res = sq.act(start, c.offsets[acts], get_action(step.kind).pushes_first)
+        t_sim += res.sim_time
+        total += cost.action_cost(step.kind, first=acts == 0)
+        yaw = res.end
+        state = int(nearest_state(pb.states, np.array([yaw]))[0])
+        stuck = (not res.settled) or float(
+            circle_distance(yaw, pb.states.stable[state])
+        ) > params.jam_tol
+        jammed |= stuck
+        width = res.width / scale + c.reading_err[acts]
+        reading = float(WidthSensor(0.0, sensor.resolution).read(np.array([width]))[0])
+        if not stuck:  # a jammed part is at no state: its reading strays by construction
+            errors.append(reading - float(pb.widths[state]))
+        acts += 1
+        node = node.branch(reading).next
+    ok = False
+    if isinstance(node, Declare):
+        total += cost.verify
+        if node.part == c.part:
+            state = int(nearest_state(pb.states, np.array([yaw]))[0])
+            ok = bool(pb.success_states(node.orientation)[state])
+    if not ok:
+        total += cost.retry
+    return _CycleOut(total, acts, ok, isinstance(node, Reject), jammed, tuple(errors), t_sim)
+
+
+def _map_cycles(
+    init: tuple[Any, ...], cycles: Sequence[_Cycle], workers: int
+) -> Iterator[_CycleOut]:
+    if workers <= 1:
+        _init_mujoco(*init)
+        for c in cycles:
+            yield _run_cycle(c)
+        return
+    methods = multiprocessing.get_all_start_methods()
+    ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+    chunk = max(1, min(8, len(cycles) // (4 * workers)))
+    with ctx.Pool(workers, initializer=_init_mujoco, initargs=init) as pool:
+        yield from pool.imap(_run_cycle, cycles, chunksize=chunk)
+
+
+def simulate_policy_mujoco(
+    problems: Problem | Iterable[Problem],
+    policy: Policy,
+    cycles: int,
+    params: SimParams | None = None,
+    offset: float = 0.0,
+    noise: GripperNoise | None = None,
+    rng: np.random.Generator | int | None = None,
+    workers: int = 1,
+    scale: float | None = None,
+    add_sensor_error: bool = False,
+    progress: Progress | None = None,
+) -> PolicySimulation:
+    """Run ``cycles`` cycles of a policy in MuJoCo, acting on the real jaw separation.
+
+    Each reading is the jaw separation at the end of the action, less the vertex capsules'
+    diameter (:meth:`~bayesgrasp.sim.engine.Squeezer.width`), in the part's units, quantised
+    at the sensor's resolution (``add_sensor_error``: plus the sensor model's normal error).
+
+    Parameters
+    ----------
+    problems : Problem or iterable of Problem
+    policy : Policy
+    cycles : int
+    params : SimParams, optional
+    offset : float
+        Distance (metres) of the part's centre from the gripper centre at each action, on a
+        random side.
+    noise : GripperNoise, optional
+        Error added to every commanded gripper angle.
+    rng : numpy.random.Generator or int or None
+    workers : int
+        Processes (1: run here).
+    scale : float, optional
+        Metres per unit of the parts' coordinates (default from each part's units).
+    add_sensor_error : bool
+        Also add ``e ~ Normal(0, SIGMA^2)`` of the policy's sensor to every reading.
+    progress : callable, optional
+
+    Returns
+    -------
+    PolicySimulation
+        With ``engine="mujoco"``.
+
+    Raises
+    ------
+    MissingExtraError
+        MuJoCo is not installed (extra ``sim``).
+    SimulationError
+        Bad ``cycles``, ``workers`` or ``offset``, or problems that do not match the policy.
+    """
+    from .engine import SIZE_RANGE, require_mujoco
+    from .scene import units_scale
+
+    require_mujoco()
+    check_trials(cycles)
+    if not isinstance(workers, int | np.integer) or workers < 1:
+        raise SimulationError(f"`workers` must be an integer >= 1; got {workers!r}")
+    if not (math.isfinite(offset) and offset >= 0):
+        raise SimulationError(f"`offset` must be a finite distance >= 0 (metres); got {offset!r}")
+    pbs = _problems(problems, policy)
+    params = params or SimParams()
+    noise = noise or GripperNoise()
+    scales = tuple(units_scale(p.part.units) if scale is None else scale for p in pbs)
+    for pb, sc in zip(pbs, scales, strict=True):
+        across = 2.0 * pb.part.hull.size * sc
+        if not SIZE_RANGE[0] <= across <= SIZE_RANGE[1]:
+            raise SimulationError(
+                f"{pb.part.name!r} measures {across:.3g} m across at {sc:g} m per unit; the "
+                f"physics settings suit parts of {SIZE_RANGE[0] * 1000:g} mm to "
+                f"{SIZE_RANGE[1] * 100:g} cm: give the part's units"
+            )
+    gen = np.random.default_rng(rng)
+    k = policy.max_actions
+    parts = gen.choice(len(pbs), size=cycles, p=np.asarray(policy.part_prior))
+    theta0 = sample_prior(pbs[0].prior, cycles, gen)
+    errs = noise.draw((cycles, k), gen)
+    signs = np.where(gen.random((cycles, k)) < 0.5, -1.0, 1.0) * offset
+    sig = policy.sensor.sigma if add_sensor_error else 0.0
+    read_err = gen.normal(0.0, 1.0, (cycles, k)) * sig
+    tasks = [
+        _Cycle(int(parts[i]), float(theta0[i]), tuple(errs[i].tolist()),
+               tuple(signs[i].tolist()), tuple(read_err[i].tolist()))
+        for i in range(cycles)
+    ]  # fmt: skip
+    t0 = time.perf_counter()
+    outs: list[_CycleOut] = []
+    for o in _map_cycles((pbs, policy, scales, params), tasks, workers):
+        outs.append(o)
+        if progress is not None:
+            progress(len(outs), cycles)
+    ok = np.array([o.success for o in outs], dtype=bool)
+    return PolicySimulation(
+        "mujoco",
+        policy,
+        cycles,
+        int(ok.sum()),
+        sum(o.rejected for o in outs),
+        sum(o.jammed for o in outs),
+        np.array([o.cost for o in outs]),
+        np.array([float(o.actions) for o in outs]),
+        ok,
+        np.array([e for o in outs for e in o.errors], dtype=np.float64),
+        time.perf_counter() - t0,
+    )
+
+
+# -- presentation ---------------------------------------------------------------------------
+
+
+def _figures(sim: PolicySimulation) -> list[tuple[str, float, tuple[float, float, float]]]:
+    pol = sim.policy
+    lo, hi = sim.success_interval
+    return [
+        ("success a cycle", pol.success_probability, (sim.observed_success, lo, hi)),
+        ("cost a cycle", pol.cycle_cost, sim.cycle_cost),
+        ("actions a cycle", pol.expected_actions, sim.mean_actions),
+        ("cost per oriented part", pol.expected_cost, sim.cost_per_success),
+    ]
+
+
+def policy_simulation_text(sim: PolicySimulation, title: str = "") -> str:
+    """Predicted against observed figures, one line each, with the intervals (``z = 4``)."""
+    units = sim.policy.units or "part units"
+    e = sim.reading_errors if len(sim.reading_errors) else np.zeros(1)
+    lines = [
+        f"{title}{sim.cycles} cycles ({sim.engine}), sensor {sim.policy.sensor.spec}, "
+        f"{sim.seconds:.2f} s",
+        f"{'':24s}{'predicted':>11s}{'observed':>11s}   interval (z = 4)",
+    ]
+    for name, pred, (obs, lo, hi) in _figures(sim):
+        inside = "" if lo - 1e-9 <= pred <= hi + 1e-9 else "   OUTSIDE"
+        lines.append(f"{name:24s}{pred:11.4f}{obs:11.4f}   [{lo:.4f}, {hi:.4f}]{inside}")
+    lines.append(
+        f"rejected cycles {sim.rejects}, jammed cycles {sim.jams}; reading - d(sigma) "
+        f"({units}): mean {e.mean():.4g}, sd {e.std():.4g}, largest {np.abs(e).max():.4g}"
+    )
+    lines.append("every claim within its interval" if sim.agrees else "NOT every claim agrees")
+    return "\n".join(lines)
+
+
+def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
+    """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals."""
+    e = sim.reading_errors if len(sim.reading_errors) else np.full(1, math.nan)
+    keys = ["success_probability", "cycle_cost", "expected_actions", "expected_cost"]
+    figs = {
+        k: {"predicted": pred, "observed": obs, "interval": [lo, hi]}
+        for k, (_, pred, (obs, lo, hi)) in zip(keys, _figures(sim), strict=True)
+    }
+    return {
+        "schema": "bayesgrasp.policy-simulation/1",
+        "engine": sim.engine,
+        "parts": list(sim.policy.parts),
+        "sensor": sim.policy.sensor.to_json(),
+        "cycles": sim.cycles,
+        "successes": sim.successes,
+        "rejects": sim.rejects,
+        "jams": sim.jams,
+        "z": _Z,
+        **figs,
+        "reading_error": {
+            "mean": float(e.mean()),
+            "sd": float(e.std()),
+            "max_abs": float(np.abs(e).max()),
+            "readings": len(sim.reading_errors),
+        },
+        "agrees": sim.agrees,
+        "seconds": sim.seconds,
+    }

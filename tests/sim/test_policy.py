@@ -1,0 +1,254 @@
+"""Executing sensing policies (bayesgrasp.sim.policy): cycles against the policies' claims.
+
+Every policy the planner returns, replayed by simulation from prior samples with sensor
+errors drawn from the model, must reach its claimed success per cycle, cost per cycle,
+actions per cycle and cost per oriented part within ``z = 4`` standard errors (Wilson and
+CLT intervals, fixed seeds). The planner computes its claims from reading bins and beliefs;
+the simulation only follows the tree with the transfer functions and draws readings from
+``WidthSensor.read``, so they share nothing but the model. In MuJoCo (marked ``physics``)
+the policy acts on the real jaw separation.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import math
+
+import numpy as np
+import pytest
+
+from bayesgrasp import shapes
+from bayesgrasp.cli import main
+from bayesgrasp.errors import SimulationError
+from bayesgrasp.geometry import Part
+from bayesgrasp.model import CostModel, Goal, Problem
+from bayesgrasp.model.prior import von_mises
+from bayesgrasp.model.sensing import WidthSensor
+from bayesgrasp.planning.policy import plan_policy
+from bayesgrasp.sim.noise import GripperNoise
+from bayesgrasp.sim.policy import (
+    MUJOCO_SIGMA,
+    mujoco_sensor,
+    policy_simulation_json,
+    policy_simulation_text,
+    simulate_policy,
+)
+
+TRIANGLE = [(0.0, 0.0), (3.0, 0.0), (1.0, 2.0)]
+QUAD = [(0.0, 0.0), (4.0, 0.0), (3.6, 2.2), (0.5, 2.6)]
+RECT = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)]
+PENTA = [(0.0, 0.0), (3.0, 0.2), (3.4, 1.9), (1.2, 3.0), (-0.4, 1.5)]
+
+
+def build(points: list[tuple[float, float]], **kw: object) -> Problem:
+    return Problem.build(Part.from_points(points), **kw)  # type: ignore[arg-type]
+
+
+CASES = [
+    ("quad-exact", [QUAD], ("squeeze",), WidthSensor(), 3, None, {}),
+    ("quad-quantised", [QUAD], ("squeeze",), WidthSensor(0.0, 0.4), 3, None, {}),
+    ("quad-noisy", [QUAD], ("squeeze",), WidthSensor(0.15, 0.1), 3, None, {}),
+    ("penta-noisy", [PENTA], ("squeeze",), WidthSensor(0.05, 0.05), 2, None, {}),
+    ("quad-push", [QUAD], ("push-grasp",), WidthSensor(0.1, 0.1), 2, None, {}),
+    ("quad-both", [QUAD], ("squeeze", "push-grasp"), WidthSensor(0.0, 0.25), 2, None, {}),
+    (
+        "tri-costs",
+        [TRIANGLE],
+        ("squeeze",),
+        WidthSensor(0.1, 0.05),
+        2,
+        None,
+        {"cost": CostModel(verify=2.0, retry=0.5)},
+    ),
+    (
+        "reject",
+        [QUAD],
+        ("squeeze",),
+        WidthSensor(0.3, 0.1),
+        2,
+        None,
+        {"cost": CostModel(verify=4.0)},
+    ),
+    (
+        "von-mises",
+        [QUAD],
+        ("squeeze",),
+        WidthSensor(0.1, 0.1),
+        2,
+        None,
+        {"prior": von_mises(1.0, 2.0)},
+    ),
+    (
+        "symmetry-goal",
+        [RECT],
+        ("squeeze",),
+        WidthSensor(0.1, 0.1),
+        2,
+        None,
+        {"goal": Goal("symmetry")},
+    ),
+    ("two-parts", [TRIANGLE, RECT], ("squeeze",), WidthSensor(0.1, 0.05), 2, (0.4, 0.6), {}),
+    ("three-parts", [TRIANGLE, RECT, QUAD], ("squeeze",), WidthSensor(), 3, None, {}),
+]
+
+
+@pytest.mark.parametrize(
+    ("name", "parts", "actions", "sensor", "depth", "prior", "kw"), CASES, ids=[c[0] for c in CASES]
+)
+def test_every_policy_reaches_its_claims(
+    name: str,
+    parts: list[list[tuple[float, float]]],
+    actions: tuple[str, ...],
+    sensor: WidthSensor,
+    depth: int,
+    prior: tuple[float, ...] | None,
+    kw: dict[str, object],
+) -> None:
+    problems = [build(p, actions=actions, **kw) for p in parts]
+    pol = plan_policy(problems, sensor, depth, part_prior=prior)
+    sim = simulate_policy(problems, pol, 40_000, rng=3)
+    assert sim.agrees, policy_simulation_text(sim)
+    # The drawn reading errors are the sensor's: mean 0, sd SIGMA (plus rounding, at most
+    # RES / 2 away).
+    e = sim.reading_errors
+    assert np.all(np.abs(e) <= 10 * sensor.sigma + sensor.resolution / 2 + 1e-9)
+    if sensor.kind == "noisy":
+        assert (
+            abs(e.std() - math.hypot(sensor.sigma, sensor.resolution / math.sqrt(12)))
+            < 0.05 * sensor.sigma
+        )
+
+
+def test_catalogue_recognition_reaches_its_claims() -> None:
+    problems = [Problem.build(shapes.load(n)) for n in ("rectangle", "tuning-fork", "ic-chip")]
+    pol = plan_policy(problems, "width:0.5,0.1", 2)
+    sim = simulate_policy(problems, pol, 60_000, rng=5)
+    assert sim.agrees, policy_simulation_text(sim)
+
+
+def test_a_wrong_claim_is_caught() -> None:
+    """The check can fail: a policy whose claims are altered disagrees with its cycles."""
+    import dataclasses
+
+    pb = build(QUAD)
+    pol = plan_policy(pb, "width:0.15,0.1", 2)
+    liar = dataclasses.replace(pol, success_probability=pol.success_probability + 0.02)
+    assert simulate_policy(pb, pol, 40_000, rng=1).agrees
+    assert not simulate_policy(pb, liar, 40_000, rng=1).agrees
+
+
+def test_gripper_error_within_the_margins_changes_nothing() -> None:
+    pb = build(QUAD)
+    pol = plan_policy(pb, "width:0.15,0.1", 3)
+    margins = []
+
+    def walk(node: object) -> None:
+        from bayesgrasp.planning.policy import PolicyNode
+
+        if isinstance(node, PolicyNode):
+            if math.isfinite(node.margin):
+                margins.append(node.margin)
+            for b in node.branches:
+                walk(b.next)
+
+    walk(pol.root)
+    small = 0.5 * min(margins)
+    a = simulate_policy(pb, pol, 20_000, rng=2)
+    b = simulate_policy(pb, pol, 20_000, GripperNoise("uniform", small), rng=2)
+    assert a.agrees and b.agrees
+
+
+def test_chunks_and_seed_are_reproducible() -> None:
+    pb = build(QUAD)
+    pol = plan_policy(pb, "width:0.15,0.1", 2)
+    a = simulate_policy(pb, pol, 5000, rng=9, chunk=700)
+    b = simulate_policy(pb, pol, 5000, rng=9, chunk=700)
+    assert a.successes == b.successes and np.array_equal(a.cycle_costs, b.cycle_costs)
+
+
+def test_mismatched_problems_are_refused() -> None:
+    pol = plan_policy([build(TRIANGLE), build(RECT)], "width", 2)
+    with pytest.raises(SimulationError, match="tells 2 part"):
+        simulate_policy(build(TRIANGLE), pol, 10)
+    mixed = plan_policy(build(QUAD, actions=("push-grasp",)), "width", 1)
+    with pytest.raises(SimulationError, match="push-grasp"):
+        simulate_policy(build(QUAD), mixed, 10)
+    with pytest.raises(SimulationError, match="trials"):
+        simulate_policy(build(TRIANGLE), plan_policy(build(TRIANGLE), "width", 1), 0)
+
+
+def test_json_and_text() -> None:
+    pb = build(QUAD)
+    pol = plan_policy(pb, "width:0.15,0.1", 2)
+    sim = simulate_policy(pb, pol, 2000, rng=0)
+    doc = json.loads(json.dumps(policy_simulation_json(sim)))
+    assert doc["schema"] == "bayesgrasp.policy-simulation/1"
+    assert doc["success_probability"]["predicted"] == pol.success_probability
+    lo, hi = doc["expected_cost"]["interval"]
+    assert lo <= doc["expected_cost"]["observed"] <= hi
+    assert "cost per oriented part" in policy_simulation_text(sim)
+
+
+def test_cli_simulate_sense(capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["simulate", "house", "--sense", "width:0.5,0.1", "--trials", "20000", "--json"]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    pol = plan_policy(Problem.build(shapes.load("house")), "width:0.5,0.1", 3)
+    assert doc["expected_cost"]["predicted"] == pytest.approx(pol.expected_cost, rel=1e-12)
+    assert doc["agrees"] is True
+    argv = ["simulate", "rectangle", "--also", "ic-chip", "--sense", "width", "--trials", "5000"]
+    assert main(argv) == 0
+    assert "every claim within its interval" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "match"),
+    [
+        (["--sense", "width:0.1,0"], "needs a resolution RES > 0"),
+        (["--also", "key"], "need --sense"),
+        (["--sensor-error"], "need --sense"),
+    ],
+)
+def test_cli_bad_input(argv: list[str], match: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simulate", "house", *argv]) == 2
+    err = capsys.readouterr().err
+    assert match in err and "Traceback" not in err
+
+
+def test_mujoco_sensor_is_in_part_units() -> None:
+    mm = mujoco_sensor(shapes.load("house"), 0.001)
+    assert mm.sigma == pytest.approx(MUJOCO_SIGMA * 1000)
+
+
+HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
+
+
+@pytest.mark.physics
+@pytest.mark.skipif(
+    not HAVE_MUJOCO, reason="MuJoCo is not installed: pip install 'bayesgrasp[sim]'"
+)
+def test_mujoco_policy_acts_on_the_jaw_separation() -> None:
+    """In MuJoCo the readings stray from d(sigma) by well under the default SIGMA.
+
+    The policy (planned for MuJoCo's default sensor) then succeeds as often as claimed: a
+    cycle fails beyond the claim only where a squeeze jams near a basin boundary, so the
+    observed success may fall short by at most the jammed share.
+    """
+    from bayesgrasp.sim.policy import simulate_policy_mujoco
+
+    part = shapes.load("house")
+    pb = Problem.build(part)
+    pol = plan_policy(pb, mujoco_sensor(part, 0.001), 3)
+    sim = simulate_policy_mujoco(pb, pol, 60, rng=4)
+    e = sim.reading_errors
+    assert len(e) > 60
+    assert np.abs(e).max() < 0.2  # mm: MUJOCO_SIGMA
+    assert abs(e.mean()) < 0.15
+    lo, hi = sim.success_interval
+    assert lo - sim.jams / sim.cycles <= pol.success_probability <= hi + 1e-9
+    two = [Problem.build(shapes.load(n)) for n in ("rectangle", "key")]
+    pol2 = plan_policy(two, mujoco_sensor(part, 0.001), 2)
+    sim2 = simulate_policy_mujoco(two, pol2, 40, rng=5, workers=2)
+    lo, hi = sim2.success_interval
+    assert lo - sim2.jams / sim2.cycles <= pol2.success_probability <= hi + 1e-9
