@@ -19,6 +19,12 @@ turns each into one line on stderr and exit code 2.
     ``NoPlanError`` (a ``PlanningError``): no plan reaches the goal asked for (a guaranteed
     plan under a gripper accuracy no plan can honour); the command line exits with code 1.
 
+    ``SimulationError`` (also a ``ValueError``): bad simulation settings (trials, noise,
+    seed, plan).
+
+    ``ExportError`` (also a ``ValueError``): a robot file that cannot be written (its name
+    or its plan; ``plan --export``).
+
     ``MissingExtraError`` (also an ``ImportError``): an optional extra is not installed.
 """
 
@@ -27,6 +33,7 @@ from __future__ import annotations
 __all__ = [
     "BayesGraspError",
     "CostError",
+    "ExportError",
     "MissingExtraError",
     "NoPlanError",
     "PartError",
@@ -67,6 +74,10 @@ class NoPlanError(PlanningError):
 
 class SimulationError(BayesGraspError, ValueError):
     """Bad simulation settings (trials, noise, plan)."""
+
+
+class ExportError(BayesGraspError, ValueError):
+    """A robot file that cannot be written (its name or its plan)."""
 
 
 class MissingExtraError(BayesGraspError, ImportError):

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "guaranteed_text",
+    "num",
     "plan_table",
     "push_json",
     "push_table",
@@ -48,6 +49,21 @@ __all__ = [
     "squeeze_table",
     "transfer_json",
 ]
+
+
+def num(x: float, spec: str) -> str:
+    """``format(x, spec)`` without a negative zero: a value that rounds to 0 prints as 0.
+
+    Examples
+    --------
+    >>> num(-1e-12, "9.3f"), num(-1e-12, "+.2f"), num(-0.0, ".4f"), num(-0.5, ".3f")
+    ('    0.000', '+0.00', '0.0000', '-0.500')
+    """
+    text = format(x, spec)
+    if text.lstrip().startswith("-") and math.isfinite(x) and float(text) == 0.0:
+        return format(0.0, spec)
+    return text
+
 
 # The plan documents moved to bayesgrasp.io.plans; these names are kept for the transition.
 part_json = part_document
@@ -86,8 +102,8 @@ def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -
         f"{'state':>5}  {'stable (deg)':>12}  {'basin (deg)':>23}  {'probability':>11}",
     ]
     for i, (s, lo, hi, p) in enumerate(zip(f.stable, f.basin_lo, f.basin_hi, probs, strict=True)):
-        basin = f"({math.degrees(lo):9.3f}, {math.degrees(hi):9.3f})"
-        lines.append(f"{i:>5}  {math.degrees(s):12.3f}  {basin:>23}  {p:11.4f}")
+        basin = f"({num(math.degrees(lo), '9.3f')}, {num(math.degrees(hi), '9.3f')})"
+        lines.append(f"{i:>5}  {num(math.degrees(s), '12.3f')}  {basin:>23}  {p:11.4f}")
     from .report_curved import curved_lines
 
     lines += curved_lines(part) if f.kind == "squeeze" else []
@@ -97,12 +113,14 @@ def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -
 def guaranteed_text(g: GuaranteedPlan) -> str:
     """One paragraph: the guaranteed plan's steps, period, final orientation and tolerance."""
     o = g.option
-    steps = " ".join(f"{get_action(s.kind).tag}({math.degrees(s.alpha):+.2f})" for s in o.steps)
+    steps = " ".join(
+        f"{get_action(s.kind).tag}({num(math.degrees(s.alpha), '+.2f')})" for s in o.steps
+    )
     tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f} deg"
     return (
         f"guaranteed plan: {o.n_actions} action(s) {steps}\n"
         f"  ({_tags(ACTIONS.values())}; the first angle in the world frame, then turns)\n"
-        f"  sends every orientation to {math.degrees(o.final_orientation):.2f} deg modulo "
+        f"  sends every orientation to {num(math.degrees(o.final_orientation), '.2f')} deg modulo "
         f"{math.degrees(g.period):.4g} deg; tolerance {tol}\n"
         f"  for the goal: P(success) {o.success_probability:.4f}, "
         f"E[cost] {o.expected_cost:.3f}"
@@ -168,10 +186,10 @@ def _tags(actions: Iterable[Action]) -> str:
 def _plan_text(o: PlanOption, mixed: bool) -> str:
     """The relative turns in degrees; with several action kinds each step is tagged."""
     if not mixed:
-        alphas = ", ".join(f"{math.degrees(a):+.2f}" for a in o.alphas)
+        alphas = ", ".join(f"{num(math.degrees(a), '+.2f')}" for a in o.alphas)
         return f"[{alphas}]" if alphas else "-"
     first = get_action(o.steps[0].kind).tag
-    rest = [f"{get_action(s.kind).tag}{math.degrees(s.alpha):+.2f}" for s in o.steps[1:]]
+    rest = [f"{get_action(s.kind).tag}{num(math.degrees(s.alpha), '+.2f')}" for s in o.steps[1:]]
     return " ".join([first, *rest])
 
 
@@ -209,8 +227,8 @@ def plan_table(report: PlanReport, max_actions: int | None = None) -> str:
         marks = ("B" if i == report.bayes else " ") + ("C" if i == report.most_certain else " ")
         tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f}"
         lines.append(
-            f"{o.n_actions:>3} {math.degrees(o.first_angle):11.2f}  {text:<{width}} "
-            f"{math.degrees(o.final_orientation):11.2f} {o.success_probability:10.4f} "
+            f"{o.n_actions:>3} {num(math.degrees(o.first_angle), '11.2f')}  {text:<{width}} "
+            f"{num(math.degrees(o.final_orientation), '11.2f')} {o.success_probability:10.4f} "
             f"{o.expected_cost:8.3f} {tol:>9} {marks}".rstrip()
         )
     sure = report.most_certain_plan.success_probability >= 1.0 - pb.part.hull.tol.probability
@@ -289,15 +307,15 @@ def simulate_table(res: SimulationResult, title: str = "") -> str:
     steps = _plan_text(o, len(set(o.kinds)) > 1)
     lines = [
         f"{title}{res.engine} execution, {res.trials} trials",
-        f"plan: {steps} (first action at {math.degrees(o.first_angle):.2f} deg, "
-        f"{o.n_actions} action(s), tolerance {tol}); goal {math.degrees(o.final_orientation):.2f} "
-        "deg",
+        f"plan: {steps} (first action at {num(math.degrees(o.first_angle), '.2f')} deg, "
+        f"{o.n_actions} action(s), tolerance {tol}); "
+        f"goal {num(math.degrees(o.final_orientation), '.2f')} deg",
         f"{'final (deg)':>11}  {'predicted':>9}  {'observed':>9}  {'count':>9}",
     ]
     for i in _simulated_rows(res):
         mark = "  goal" if res.goal[i] else ""
         lines.append(
-            f"{math.degrees(res.orientations[i]):11.2f}  {res.predicted[i]:9.4f}  "
+            f"{num(math.degrees(res.orientations[i]), '11.2f')}  {res.predicted[i]:9.4f}  "
             f"{res.observed[i] / res.trials:9.4f}  {res.observed[i]:9d}{mark}"
         )
     rate = res.trials / res.seconds if res.seconds > 0 else math.inf

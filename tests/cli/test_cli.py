@@ -13,6 +13,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -441,3 +442,52 @@ def test_console_script_bad_file_one_line(files: Path) -> None:
     )
     assert proc.returncode == 0 and proc.stderr == ""
     assert strict_json(proc.stdout)["schema"] == "bayesgrasp.plan/1"
+
+
+def test_jaw_lag_is_refused_with_the_kinematic_engine(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 14: the MuJoCo jaw lag had no option; the kinematic model has no jaws to lag."""
+    code, _, err = run(capsys, "simulate", "triangle", "--jaw-lag", "1", "--trials", "10")
+    assert code == 2
+    assert "--jaw-lag" in err and "--engine mujoco only" in err and "--contact-noise" in err
+    assert len(err.strip().splitlines()) == 1
+    code, _, err = run(capsys, "simulate", "triangle", "--engine", "mujoco", "--jaw-lag", "100")
+    assert code == 2 and "more than twice its size" in err and "give at most 9.847 s" in err
+
+
+def test_jaw_lag_reaches_the_engine_and_the_provenance(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`--jaw-lag 2`: SimParams(jaw_lag=2), clearance the push (10 mm) + 1 mm, recorded."""
+    import bayesgrasp.sim
+    from bayesgrasp.sim.kinematic import simulate_kinematic
+
+    seen: list[Any] = []
+
+    def fake(pb: Any, option: Any, n: int, **kw: Any) -> Any:
+        seen.append(kw.get("params"))
+        return simulate_kinematic(pb, option, n, kw["noise"], rng=kw["rng"])
+
+    monkeypatch.setattr(bayesgrasp.sim, "simulate_mujoco", fake)
+    args = ["simulate", "triangle", "--engine", "mujoco", "--trials", "5", "--json"]
+    code, out, _ = run(capsys, *args, "--jaw-lag", "2")
+    assert code == 0
+    (params,) = seen
+    assert params.jaw_lag == 2.0 and params.lead_jaw == "random"
+    assert params.clearance == pytest.approx(params.jaw_speed * 2.0 / 2 + 0.001)
+    assert json.loads(out)["provenance"]["jaw_lag_s"] == 2.0
+    code, out, _ = run(capsys, *args)
+    assert code == 0 and seen[-1] is None
+    assert "jaw_lag_s" not in json.loads(out)["provenance"]
+
+
+@pytest.mark.physics
+def test_jaw_lag_in_mujoco(capsys: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("mujoco")
+    from bayesgrasp.sim import measure_asynchrony  # exported with the option
+
+    assert callable(measure_asynchrony)
+    args = ["simulate", "triangle", "--engine", "mujoco", "--trials", "3", "--seed", "1"]
+    code, out, _ = run(capsys, *args, "--jaw-lag", "0.5", "--json")
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["provenance"]["jaw_lag_s"] == 0.5 and doc["trials"] == 3

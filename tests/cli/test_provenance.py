@@ -268,3 +268,25 @@ def test_part_file_options_are_recorded(capsys: pytest.CaptureFixture[str]) -> N
     assert code == 0, err
     prov = json.loads(out)["provenance"]
     assert prov["flatten_tolerance"] == 0.5 and "element" not in prov  # not given: default
+
+
+def test_the_default_flattening_tolerance_is_recorded(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Issue 15: provenance named the flattening tolerance only when it was given.
+
+    The lever's Bezier curves are flattened at the reader's default (1e-3 of the drawing's
+    diagonal), which the part keeps as its curve error: the document records it, and a re-run
+    with it gives the same plans. The slot (segments and arcs only) flattens nothing.
+    """
+    lever = str(Path(__file__).resolve().parents[2] / "examples" / "lever.svg")
+    doc = plan_file(capsys, tmp_path / "p.json", lever)
+    tol = doc["provenance"]["flatten_tolerance"]
+    assert tol == doc["part"]["curved"]["curve_error"] > 0
+    again = plan_file(capsys, tmp_path / "q.json", lever, "--flatten-tol", repr(tol))
+    assert again["provenance"]["flatten_tolerance"] == tol
+    assert again["options"] == doc["options"] and again["part"] == doc["part"]
+    given = plan_file(capsys, tmp_path / "r.json", lever, "--flatten-tol", "0.5")
+    assert given["provenance"]["flatten_tolerance"] == 0.5
+    slot = str(Path(__file__).resolve().parents[2] / "examples" / "slot.dxf")
+    assert "flatten_tolerance" not in plan_file(capsys, tmp_path / "s.json", slot)["provenance"]

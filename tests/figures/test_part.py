@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Callable
 from typing import Any
@@ -12,6 +13,8 @@ from numpy.testing import assert_allclose
 
 from bayesgrasp.errors import MissingExtraError
 from bayesgrasp.figures import part_figure
+from bayesgrasp.figures.part import DRAWING_SAGITTA
+from bayesgrasp.geometry.curved import CurvedRing, curved_part
 from bayesgrasp.geometry.diameter import diameter_function
 from bayesgrasp.geometry.polygon import Part
 from bayesgrasp.model.problem import Problem
@@ -70,6 +73,56 @@ def test_the_legend_covers_neither_jaw_nor_the_part(name: str, by_gid: ByGid) ->
         assert not legend.overlaps(by_gid(ax, gid)[0].get_window_extent()), gid
     assert not legend.overlaps(ax.get_window_extent())  # outside the axes, below them
     assert fig.bbox.contains(legend.x0, legend.y0) and fig.bbox.contains(legend.x1, legend.y1)
+
+
+def _stadium_gap(xy: np.ndarray) -> np.ndarray:
+    """Distance of points to the boundary of the stadium of radius 1 about (0, 0)-(2, 0)."""
+    t = np.clip(xy[:, 0], 0.0, 2.0)
+    return np.abs(np.hypot(xy[:, 0] - t, xy[:, 1]) - 1.0)
+
+
+def _with_midpoints(ring: np.ndarray) -> np.ndarray:
+    closed = np.vstack([ring, ring[:1]])
+    return np.vstack([ring, 0.5 * (closed[1:] + closed[:-1])])
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.7, 2.2])
+def test_a_curved_part_is_drawn_with_its_arcs_not_its_file_chords(
+    theta: float, by_gid: ByGid
+) -> None:
+    """Issue 16: the figures drew the chords the part file was flattened to.
+
+    A slot (stadium) with a round hole, built with chords 5% of its size: every drawn point
+    and every drawn chord's midpoint must lie within the drawing sagitta of the true arcs.
+    """
+    slot = CurvedRing([(0, -1), (2, -1), (2, 1), (0, 1)], [0, 1, 0, 1])
+    hole = CurvedRing([(0.8, 0), (1.2, 0)], [1.0, 1.0])
+    part = curved_part(slot, [hole], name="slot", display_tol=0.05 * 2.0)
+    size = part.curved_hull.size
+    bound = 1.01 * DRAWING_SAGITTA * size
+    ax = part_figure(part, theta).axes[0]
+    # Undo place_part's turn and shift with the centre of mass, which it puts at y = 0.
+    c, s = math.cos(theta), math.sin(theta)
+    rot = np.array([[c, -s], [s, c]])
+    placed_com = np.asarray(by_gid(ax, "com")[0].get_xydata())[0]
+    shift = placed_com - part.center_of_mass @ rot.T
+
+    def unplaced(xy: np.ndarray) -> np.ndarray:
+        return np.asarray((xy - shift) @ rot)
+
+    path = by_gid(ax, "outline")[0].get_path()
+    rings = [unplaced(r) for r in path.to_polygons(closed_only=False)]
+    outer = max(rings, key=len)
+    inner = [r for r in rings if r is not outer]
+    assert len(inner) == 1
+    assert _stadium_gap(_with_midpoints(outer)).max() <= bound
+    hole_gap = np.abs(np.hypot(*(_with_midpoints(inner[0]) - (1.0, 0.0)).T) - 0.2)
+    assert hole_gap.max() <= bound
+    hull = unplaced(np.asarray(by_gid(ax, "hull")[0].get_xydata()))
+    assert _stadium_gap(_with_midpoints(hull)).max() <= bound
+    left, right = by_gid(ax, "jaw-left")[0], by_gid(ax, "jaw-right")[0]
+    gap = right.get_x() - (left.get_x() + left.get_width())
+    assert_allclose(gap, 2.0 + 2.0 * abs(math.cos(theta)), atol=2 * bound)
 
 
 def test_missing_matplotlib_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -110,3 +110,11 @@ def test_write_robot_and_cli(
     err = capsys.readouterr().err
     assert "exists; use --force" in err and "must end in .csv or .json" in err
     assert main(["plan", "triangle", "--export", "r.csv", "--force"]) == 0
+
+
+def test_export_error_lives_in_errors_and_is_still_importable_from_export() -> None:
+    """Issue 15: every library error is defined in bayesgrasp.errors."""
+    from bayesgrasp import errors
+
+    assert errors.ExportError is ExportError and "ExportError" in errors.__all__
+    assert issubclass(ExportError, errors.BayesGraspError) and issubclass(ExportError, ValueError)

@@ -332,3 +332,23 @@ def test_cli_simulate_guaranteed_plan(capsys: pytest.CaptureFixture[str]) -> Non
                          "2000", "--goal", "symmetry", "--json")  # fmt: skip
     assert code == 0, err
     assert json.loads(out)["observed_success"] == 1.0
+
+
+@pytest.mark.parametrize("seed", [-1, -(2**70), True, 1.5, "3", np.int64(-2)])
+def test_a_bad_seed_is_a_simulation_error_naming_rng(seed: object) -> None:
+    """Issue 15: ``rng=-1`` raised numpy's ValueError naming no parameter."""
+    pb = Problem.build(load("triangle"))
+    plan = plan_exact(pb).bayes_plan
+    with pytest.raises(SimulationError, match=r"`rng` must be a numpy Generator, None or an"):
+        simulate_kinematic(pb, plan, 10, rng=seed)  # type: ignore[arg-type]
+    with pytest.raises(SimulationError, match=r"`rng` must be"):
+        sample_prior(UniformPrior(), 3, rng=seed)  # type: ignore[arg-type]
+
+
+def test_good_seeds_give_numpy_s_draws() -> None:
+    pb = Problem.build(load("triangle"))
+    plan = plan_exact(pb).bayes_plan
+    a = simulate_kinematic(pb, plan, 1000, rng=np.int64(7))
+    b = simulate_kinematic(pb, plan, 1000, rng=np.random.default_rng(7))
+    c = simulate_kinematic(pb, plan, 1000, rng=np.random.SeedSequence(7))
+    assert np.array_equal(a.observed, b.observed) and np.array_equal(a.observed, c.observed)

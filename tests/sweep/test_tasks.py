@@ -72,6 +72,25 @@ def test_rows_equal_the_cli_for_other_options(
         rows_check([plan_part(f, options) for f in files], files, options)
 
 
+def test_shape_tol_rows_equal_the_cli(rows_check: Check) -> None:
+    """Issue 16: `--shape-tol` was not a sweep option; with 0.5 mm the bracket has 2 states."""
+    bracket = str(Path(__file__).resolve().parents[2] / "examples" / "bracket.dxf")
+    options = SweepOptions(shape_tol=0.5)
+    assert "--shape-tol" in options.plan_args()
+    rows = [plan_part(bracket, options)]
+    rows_check(rows, [bracket], options)
+    data = Path(bracket).read_bytes()
+    assert plan_part(PartSource(bracket, data=data), options)["plan_json"] == rows[0]["plan_json"]
+    assert plan_part(bracket, SweepOptions())["plan_json"] != rows[0]["plan_json"]
+    assert json.loads(rows[0]["plan_json"])["part"]["curved"]["shape_tol"] == 0.5
+    # the key of options without it is the key they had before it existed
+    assert "shape_tol" not in SweepOptions().to_json()
+    assert SweepOptions.from_json(options.to_json()) == options
+    assert options.key != SweepOptions().key
+    with pytest.raises(SweepError, match="`shape_tol` must be a finite number >= 0"):
+        SweepOptions(shape_tol=-1.0)
+
+
 def test_bytes_give_the_same_row_and_messages_as_the_path(
     make_catalogue: Callable[[Path, np.random.Generator, int], list[str]], tmp_path: Path
 ) -> None:

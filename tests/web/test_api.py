@@ -270,6 +270,28 @@ def test_prior_of_squeeze_and_push_equals_cli(
     assert r.json() == cli_json(command, "key", "--prior", prior)[1]
 
 
+def test_shape_tol_equals_cli(
+    client: TestClient, cli_json: CliJson, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 16: `--shape-tol` was missing from the API; the bracket keeps 1 state of 3."""
+    bracket = Path(__file__).resolve().parents[2] / "examples" / "bracket.dxf"
+    (tmp_path / "bracket.dxf").write_bytes(bracket.read_bytes())
+    monkeypatch.chdir(tmp_path)
+    f = {"format": "dxf", "data_base64": base64.b64encode(bracket.read_bytes()).decode()}
+    part = {"name": "bracket", "file": f}
+    for shape_tol in (None, 0.5):
+        args = [] if shape_tol is None else ["--shape-tol", str(shape_tol)]
+        code, want = cli_json("squeeze", "bracket.dxf", *args)
+        assert code == 0
+        body = part if shape_tol is None else {**part, "shape_tol": shape_tol}
+        r = client.post("/api/v1/squeeze", json={"part": body})
+        assert r.status_code == 200, r.text
+        assert r.json() == want
+        assert len(want["stable_orientations_rad"]) == (6 if shape_tol is None else 2)
+    r = client.post("/api/v1/squeeze", json={"part": {**part, "shape_tol": -1}})
+    assert r.status_code == 422
+
+
 def test_file_options_equal_cli(
     client: TestClient, cli_json: CliJson, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

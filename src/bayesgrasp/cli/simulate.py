@@ -71,6 +71,17 @@ UnitsOpt = Annotated[
     str | None,
     typer.Option(help="mujoco: units of the part's coordinates (default: the part's, or m)."),
 ]
+JawLagOpt = Annotated[
+    float,
+    typer.Option(
+        min=0,
+        metavar="SECONDS",
+        help="mujoco: contact asynchrony: in each squeeze one jaw (either, equally likely) "
+        "starts closing SECONDS before the other and pushes the part jaw_speed * SECONDS / 2 "
+        "(5 mm per second at the default 10 mm/s) before the other touches; the clearance is "
+        "raised to that push + 1 mm, as in the README's calibration of --contact-noise.",
+    ),
+]
 SensorErrorOpt = Annotated[
     bool,
     typer.Option(
@@ -104,6 +115,7 @@ def simulate(
     part_prior: PartPriorOpt = None,
     max_actions: MaxActionsOpt = 3,
     sensor_error: SensorErrorOpt = False,
+    jaw_lag: JawLagOpt = 0.0,
 ) -> None:
     """Execute a plan many times and compare the final orientations with the prediction.
 
@@ -137,8 +149,16 @@ def simulate(
             "within +-3.1e-5 and take about half an hour; more would run for hours)",
             param_hint="--trials",
         )
+    if jaw_lag and engine is Engine.kinematic:
+        raise typer.BadParameter(
+            "applies to --engine mujoco only (the kinematic model's contact asynchrony is "
+            "plan --contact-noise Q)",
+            param_hint="--jaw-lag",
+        )
     err = GripperNoise(noise_kind.value, math.radians(noise))
     if sense is not None:
+        if jaw_lag:
+            raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
         from .sensing import simulate_policy_command
 
         if turn_noise is not None:
@@ -160,6 +180,7 @@ def simulate(
             "centroid to its farthest vertex): the jaws would close beside it",
             param_hint="--offset",
         )
+    params = _lagged(jaw_lag, p, units) if jaw_lag else None
     pb, option, label = chosen_plan(which, spec, p, force)
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
     if turn_noise is not None:  # the spelling of plan --turn-noise
@@ -186,6 +207,7 @@ def simulate(
             workers=workers,
             scale=scale if units is not None else None,
             progress=progress,
+            params=params,
         )
 
     res = with_progress(f"{engine.value} trials", n, run)
@@ -204,13 +226,43 @@ def simulate(
             engine.value, which, seed, n, noise, noise_kind.value, offset, units,
             workers if mujoco else None,
         )  # fmt: skip
+        how["jaw_lag_s"] = jaw_lag or None
         doc["provenance"] = provenance(pb, None, **how, **run_inputs(part, spec))
         emit_json(doc)
     else:
         title = f"{p.name}: {label} plan, prior {pb.prior.name}; "
         if turn_noise is not None:
             title += f"predicted under turn error {t.spec()} deg; "
+        if jaw_lag:
+            title += f"jaw lag {jaw_lag:g} s; "
         typer.echo(report.simulate_table(res, title))
+
+
+def _lagged(lag: float, part: Any, units: str | None) -> Any:
+    """The MuJoCo settings of ``--jaw-lag``: the lag, and room for the push it makes.
+
+    The leading jaw pushes ``jaw_speed * lag / 2`` before the other touches; the clearance is
+    raised to that push + 1 mm (as :func:`~bayesgrasp.sim.asynchrony.measure_asynchrony`
+    does) so the push does not saturate. A push of more than twice the part's size (the
+    travel of a push-grasp, ``SimParams.push_distance``) is refused: it adds nothing but time.
+    """
+    from dataclasses import replace
+
+    from ..sim.params import SimParams
+    from ..sim.scene import units_scale
+
+    base = SimParams()
+    push = base.jaw_speed * lag / 2.0
+    size = part.hull.size * units_scale(units if units is not None else part.units)
+    if push > 2.0 * size:
+        most = 4.0 * size / base.jaw_speed
+        raise typer.BadParameter(
+            f"a lag of {lag:g} s pushes the part {push * 1000:.4g} mm, more than twice its "
+            f"size ({size * 1000:.4g} mm from its centroid to its farthest vertex): give at "
+            f"most {most:.4g} s",
+            param_hint="--jaw-lag",
+        )
+    return replace(base, jaw_lag=lag, clearance=max(base.clearance, push + 0.001))
 
 
 def _kinematic_blocks(pb: Any, option: Any, n: int, err: Any, seed: int, progress: Any) -> Any:

@@ -6,6 +6,7 @@ centred on the jaws (:func:`place_part`), and its outline as a filled patch with
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -13,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..geometry.curved import CurvedPart, mesh_vertices
 from ..geometry.polygon import Part
 from ..model.problem import Problem
 from .canvas import GOAL_COLOR, HULL_COLOR, JAW_COLOR, PART_COLOR, PART_EDGE, as_problem, new_figure
@@ -22,9 +24,22 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["Placed", "draw_part", "outline_path", "part_figure", "part_patch", "place_part"]
+__all__ = [
+    "DRAWING_SAGITTA",
+    "Placed",
+    "draw_part",
+    "drawn_rings",
+    "outline_path",
+    "part_figure",
+    "part_patch",
+    "place_part",
+]
 
 FloatArray = NDArray[np.float64]
+
+#: A curved part's arcs are drawn as polylines whose sagitta is at most this fraction of its
+#: size (a fraction of a pixel in any figure), not as the chords the part file was read at.
+DRAWING_SAGITTA = 2e-4
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,11 +63,33 @@ class Placed:
     width: float
 
 
+@functools.lru_cache(maxsize=16)
+def drawn_rings(part: Part) -> tuple[FloatArray, tuple[FloatArray, ...], FloatArray]:
+    """Outline, holes and convex hull to draw, in the part's frame.
+
+    A polygon's own. A :class:`~bayesgrasp.geometry.curved.CurvedPart` keeps its arcs exact
+    (:attr:`~bayesgrasp.geometry.curved.CurvedPart.ring`, ``hole_rings``), and its
+    ``outline``, ``holes`` and ``hull`` are flattened at the part file's chordal tolerance,
+    which shows the chords; so its outline and holes are sampled on the arcs within
+    :data:`DRAWING_SAGITTA` of its size, and its hull is the exact hull sampled as finely
+    (:func:`~bayesgrasp.geometry.curved.mesh_vertices`, Bezier and elliptic curves from their
+    exact form). Non-arc curves of the outline stay the chords the model has (within its
+    ``curve_error``).
+    """
+    if not isinstance(part, CurvedPart) or part.ring is None:
+        return part.outline, part.holes, part.hull.vertices
+    fine = DRAWING_SAGITTA * part.curved_hull.size
+    outline = part.ring.flattened(fine)
+    holes = tuple(h.flattened(fine) for h in part.hole_rings) if part.hole_rings else part.holes
+    return outline, holes, mesh_vertices(part, DRAWING_SAGITTA)
+
+
 def place_part(part: Part, theta: float) -> Placed:
     """Rotate the part by ``theta`` (counter-clockwise) and centre it between the jaws.
 
     Translation does not matter to the gripper, so the rotated part is shifted to put the
-    middle of its x-extent at 0 and its centre of mass at y = 0.
+    middle of its x-extent at 0 and its centre of mass at y = 0. A curved part is drawn with
+    its arcs as arcs (:func:`drawn_rings`).
 
     Examples
     --------
@@ -62,13 +99,14 @@ def place_part(part: Part, theta: float) -> Placed:
     """
     c, s = math.cos(theta), math.sin(theta)
     rot = np.array([[c, -s], [s, c]])
-    hull = part.hull.vertices @ rot.T
+    outline, holes, vertices = drawn_rings(part)
+    hull = vertices @ rot.T
     lo, hi = hull[:, 0].min(), hull[:, 0].max()
     com = part.center_of_mass @ rot.T
     shift = np.array([-(lo + hi) / 2.0, -com[1]])
     return Placed(
-        part.outline @ rot.T + shift,
-        tuple(h @ rot.T + shift for h in part.holes),
+        outline @ rot.T + shift,
+        tuple(h @ rot.T + shift for h in holes),
         hull + shift,
         com + shift,
         float(hi - lo),

@@ -1063,6 +1063,8 @@ class CurvedPart(Part):
         part lies within it of the drawn outline.
     patches : CurvePatches or None
         The flattened curves in exact form (they place the extrema the curves carry).
+    hole_rings : tuple of CurvedRing
+        The holes with their arcs exact (counter-clockwise), for drawing.
     """
 
     ring: CurvedRing | None = None
@@ -1070,6 +1072,7 @@ class CurvedPart(Part):
     shape_tol: float = 0.0
     patches: CurvePatches | None = None
     _model: dict[str, object] = field(default_factory=dict, repr=False)
+    hole_rings: tuple[CurvedRing, ...] = ()
 
     @property
     def error(self) -> float:
@@ -1151,6 +1154,7 @@ def curved_part(
         float(curve_error),
         float(shape_tol),
         patches,
+        hole_rings=tuple(oriented),
     )
     part._model["hull"] = hull
     return part

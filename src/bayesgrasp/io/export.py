@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import BayesGraspError
+from ..errors import ExportError  # defined in errors.py; importable from here as before
 from ..model.problem import Problem, nearest_state
 from ..planning.result import PlanOption
 from .plans import json_float, part_document
@@ -71,10 +71,6 @@ CSV_COLUMNS = (
     "width_after_min",
     "width_after_max",
 )
-
-
-class ExportError(BayesGraspError, ValueError):
-    """A robot file that cannot be written (its name or its plan)."""
 
 
 @dataclass(frozen=True, slots=True)

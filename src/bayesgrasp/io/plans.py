@@ -238,6 +238,9 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
     ``more`` (the command line's part-file options, the longest plan asked for...) is added;
     ``None`` values (an option not given, its default applied) are left out, so the command
     line and the web service, which share no part-file options, write the same document.
+    ``flatten_tolerance`` not given is the tolerance the reader flattened a curved part's
+    non-arc curves with (its ``curve_error``), so a re-run with it gives the same numbers;
+    a file of segments and arcs only has none (its arcs are exact).
     """
     from .. import __version__
 
@@ -251,6 +254,10 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
     }
     if method is not None:
         out["method"] = method
+    used = getattr(problem.part, "curve_error", 0.0)  # a curved part's flattened curves
+    if more.get("flatten_tolerance") is None and used:
+        # not given: the reader's default, which a curved part keeps as its curve error
+        more = {**more, "flatten_tolerance": float(used)}
     out.update({k: v for k, v in more.items() if v is not None})
     return out
 

@@ -10,10 +10,13 @@
 - :mod:`~bayesgrasp.sim.result`: :class:`SimulationResult`, what both return, built by
   :func:`summarize` against the exact :func:`predicted_distribution`.
 - :mod:`~bayesgrasp.sim.stats`: :func:`wilson_interval`, :func:`goodness_of_fit`.
+- :mod:`~bayesgrasp.sim.asynchrony`: :func:`measure_asynchrony`, the contact-noise ``q`` a
+  jaw lag (``SimParams.jaw_lag``) gives in MuJoCo (:class:`AsynchronyResult`).
 
 Bad settings raise :class:`~bayesgrasp.errors.SimulationError`.
 """
 
+from .asynchrony import AsynchronyResult, measure_asynchrony
 from .engine import ActionOutcome, Squeezer, require_mujoco, simulate_mujoco
 from .kinematic import sample_prior, simulate_kinematic
 from .noise import GripperNoise
@@ -31,6 +34,7 @@ from .stats import goodness_of_fit, wilson_interval
 __all__ = [
     "DEFAULT_BOUNDARY_MARGIN",
     "ActionOutcome",
+    "AsynchronyResult",
     "GripperNoise",
     "Prism",
     "SimParams",
@@ -38,6 +42,7 @@ __all__ = [
     "Squeezer",
     "boundary_distance",
     "goodness_of_fit",
+    "measure_asynchrony",
     "part_inertia",
     "predicted_distribution",
     "prism",

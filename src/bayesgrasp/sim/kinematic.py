@@ -48,6 +48,40 @@ __all__ = [
 JAM_TOLERANCE_FACTOR = 10.0
 
 
+def as_generator(rng: object, name: str = "rng") -> np.random.Generator:
+    """``np.random.default_rng(rng)``, refusing a bad seed with a :class:`SimulationError`.
+
+    A generator, bit generator or seed sequence is used as is; ``None`` seeds from the
+    operating system; an integer must be >= 0 (numpy's own ``ValueError`` for a negative
+    seed named no parameter).
+
+    Raises
+    ------
+    SimulationError
+        ``rng`` is a negative integer, a bool, or anything numpy cannot seed with.
+
+    Examples
+    --------
+    >>> as_generator(3).integers(10) == np.random.default_rng(3).integers(10)
+    np.True_
+    >>> as_generator(-1)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bayesgrasp.errors.SimulationError: `rng` must be ... an integer seed >= 0; got -1
+    """
+    if isinstance(rng, np.random.Generator):
+        return rng
+    want = f"`{name}` must be a numpy Generator, None or an integer seed >= 0; got {rng!r}"
+    if isinstance(rng, bool | float | str | bytes) or (
+        isinstance(rng, int | np.integer) and rng < 0
+    ):
+        raise SimulationError(want)
+    try:
+        return np.random.default_rng(rng)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise SimulationError(want) from None
+
+
 def sample_prior(prior: Prior, n: int, rng: np.random.Generator | int | None = None) -> FloatArray:
     """Draw ``n`` initial orientations in ``[0, 2 pi)`` from a prior.
 
@@ -70,7 +104,7 @@ def sample_prior(prior: Prior, n: int, rng: np.random.Generator | int | None = N
     Raises
     ------
     SimulationError
-        ``n`` is negative.
+        ``n`` is negative, or ``rng`` is not a generator, None or an integer seed >= 0.
 
     Examples
     --------
@@ -80,7 +114,7 @@ def sample_prior(prior: Prior, n: int, rng: np.random.Generator | int | None = N
     """
     if n < 0:
         raise SimulationError(f"`n` must be >= 0; got {n}")
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     own = getattr(prior, "sample", None)
     if callable(own):
         return mod_2pi(own(n, gen))
@@ -139,7 +173,8 @@ def simulate_kinematic(
     Raises
     ------
     SimulationError
-        ``trials`` or ``chunk`` below 1, or a step whose action the problem does not have.
+        ``trials`` or ``chunk`` below 1, a step whose action the problem does not have, or
+        an ``rng`` that is not a generator, None or an integer seed >= 0.
 
     Examples
     --------
@@ -156,7 +191,7 @@ def simulate_kinematic(
         raise SimulationError(f"`chunk` must be >= 1; got {chunk}")
     check_steps(problem, option.steps)
     noise = noise or GripperNoise()
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     transfers = [problem.transfer(s.kind) for s in option.steps]
     bounds = [f.boundaries for f in transfers]
     alphas = np.array([s.alpha for s in option.steps])

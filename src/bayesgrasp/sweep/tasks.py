@@ -108,6 +108,10 @@ class SweepOptions:
         DXF: read only this layer.
     flatten_tol : float, optional
         Chordal tolerance of curve flattening, in each file's units.
+    shape_tol : float
+        Manufacturing tolerance of every part, in its units (``--shape-tol``): minima of the
+        width it could lose are not states (0: none; left out of :meth:`to_json` then, so
+        the keys of sweeps run before it existed still resume).
 
     Examples
     --------
@@ -139,6 +143,7 @@ class SweepOptions:
     offset_mm: float = 0.0
     layer: str | None = None
     flatten_tol: float | None = None
+    shape_tol: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("squeeze_cost", "push_grasp_cost", "verify_cost", "retry_cost"):
@@ -149,6 +154,7 @@ class SweepOptions:
         _number("noise_deg", self.noise_deg)
         _number("offset_mm", self.offset_mm)
         _number("flatten_tol", self.flatten_tol, optional=True)
+        _number("shape_tol", self.shape_tol)
         if self.goal not in GOALS:
             raise SweepError(f"`goal` must be one of {', '.join(GOALS)}; got {self.goal!r}")
         if self.method not in METHODS:
@@ -184,6 +190,8 @@ class SweepOptions:
         """The options as a JSON object (recorded in the results' metadata)."""
         out = asdict(self)
         out["actions"] = list(self.actions)
+        if not self.shape_tol:
+            del out["shape_tol"]
         return out
 
     @classmethod
@@ -218,6 +226,7 @@ class SweepOptions:
             ("max_actions", "--max-squeezes"),
             ("layer", "--layer"),
             ("flatten_tol", "--flatten-tol"),
+            ("shape_tol", "--shape-tol"),
         )
         for name, flag in flags:
             v = getattr(self, name)
@@ -364,19 +373,19 @@ def _read_bytes_part(path: str, data: bytes, options: SweepOptions) -> Any:
 
 def _read_part(source: PartSource, options: SweepOptions) -> tuple[Any, str]:
     """The part and the hash of the bytes it was read from."""
+    from ..geometry.curved import with_shape_tol
     from ..io import resolve_part
 
     if source.data is not None:
-        return _read_bytes_part(source.path, source.data, options), hashlib.sha256(
-            source.data
-        ).hexdigest()
+        part = _read_bytes_part(source.path, source.data, options)
+        return with_shape_tol(part, options.shape_tol), hashlib.sha256(source.data).hexdigest()
     try:
         with open(source.path, "rb") as f:
             digest = hashlib.file_digest(f, "sha256").hexdigest()
     except OSError:
         digest = ""  # the reader says why, in the CLI's words
     part = resolve_part(source.path, layer=options.layer, tolerance=options.flatten_tol)
-    return part, digest
+    return with_shape_tol(part, options.shape_tol), digest
 
 
 def _outline(part: Any) -> str:

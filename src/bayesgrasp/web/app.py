@@ -211,6 +211,16 @@ class Service:
     # -- parts and problems ----------------------------------------------------------------
 
     def part(self, spec: PartIn) -> Part:
+        """Read the part of a request (in memory), with its ``shape_tol`` (``--shape-tol``).
+
+        See :func:`~bayesgrasp.geometry.curved.with_shape_tol`; as on the command line, the
+        tolerance applies to any part (vertices, catalogue or file).
+        """
+        from ..geometry.curved import with_shape_tol
+
+        return with_shape_tol(self._read(spec), spec.shape_tol)
+
+    def _read(self, spec: PartIn) -> Part:
         """Read the part of a request (in memory), refusing more than ``max_vertices``."""
         from ..io import read_part_bytes
         from ..shapes import names

@@ -59,6 +59,13 @@ class PartIn(_Strict):
     center_of_mass: tuple[float, float] | None = Field(
         None, description="Centre of mass of a vertices part (default: its centroid)."
     )
+    shape_tol: float = Field(
+        0.0,
+        ge=0,
+        le=1e12,
+        description="Manufacturing tolerance of the part, in its units (--shape-tol): minima "
+        "of the width it could lose are not stable orientations.",
+    )
 
 
 class PartRequest(_Strict):
