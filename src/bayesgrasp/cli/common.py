@@ -198,6 +198,21 @@ def save_figure(fig: Any, path: Path) -> None:
         raise typer.BadParameter(f"cannot write {path}: {reason}", param_hint="--plot") from None
 
 
+def write_failed(out: Path, exc: OSError) -> NoReturn:
+    """``--out`` could not be written: one line, exit 2."""
+    reason = exc.strerror or exc
+    raise typer.BadParameter(f"cannot write into {out}: {reason}", param_hint="--out") from None
+
+
+def list_files(files: Sequence[Path], as_json: bool) -> None:
+    """Print the figures a command wrote: one path a line, or ``bayesgrasp.plot/1``."""
+    if as_json:
+        emit_json({"schema": "bayesgrasp.plot/1", "files": [str(f) for f in files]})
+    else:
+        for f in files:
+            typer.echo(str(f))
+
+
 def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
     """The guaranteed plan of a problem, or the reason none exists (a string)."""
     from ..planning import guaranteed

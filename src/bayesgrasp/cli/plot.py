@@ -7,7 +7,14 @@ from typing import Annotated
 
 import typer
 
-from .common import IMAGE_FORMATS, check_outputs, chosen_plan, emit_json, input_files
+from .common import (
+    IMAGE_FORMATS,
+    check_outputs,
+    chosen_plan,
+    input_files,
+    list_files,
+    write_failed,
+)
 from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
 from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
 from .specs import PartSpec, ProblemSpec
@@ -104,10 +111,5 @@ def plot(
             frames_per_step=frames,
         )
     except OSError as exc:
-        reason = exc.strerror or exc
-        raise typer.BadParameter(f"cannot write into {out}: {reason}", param_hint="--out") from None
-    if as_json:
-        emit_json({"schema": "bayesgrasp.plot/1", "files": [str(f) for f in files]})
-    else:
-        for f in files:
-            typer.echo(str(f))
+        write_failed(out, exc)
+    list_files(files, as_json)

@@ -8,7 +8,7 @@ from typing import Any
 
 import typer
 
-from .common import emit_json, with_progress
+from .common import emit_json, list_files, with_progress, write_failed
 from .specs import Engine, PartSpec, ProblemSpec
 
 
@@ -107,10 +107,5 @@ def plot_policy_command(
             fig.savefig(path, dpi=110)
             files.append(path)
     except OSError as exc:
-        reason = exc.strerror or exc
-        raise typer.BadParameter(f"cannot write into {out}: {reason}", param_hint="--out") from None
-    if as_json:
-        emit_json({"schema": "bayesgrasp.plot/1", "files": [str(f) for f in files]})
-    else:
-        for f in files:
-            typer.echo(str(f))
+        write_failed(out, exc)
+    list_files(files, as_json)
