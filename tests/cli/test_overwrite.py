@@ -179,3 +179,17 @@ def test_sweep_never_writes_over_its_inputs(
     assert code == 2
     one_error(err, "input")
     assert digest(part) == before and report.read_text(encoding="utf-8") == "mine"
+
+
+@pytest.mark.parametrize("sense", [[], ["--sense", "width"]], ids=["plan", "policy"])
+def test_plot_into_an_unwritable_folder_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, sense: list[str]
+) -> None:
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("mine")
+    out = blocker / "figures"  # a folder below a file cannot be made
+    args = ["plot", "triangle", "--out", str(out), "--no-animation", *sense]
+    code, stdout, err = run(capsys, *args)
+    assert (code, stdout) == (2, "")
+    one_error(err, "cannot write into", str(out))
+    assert blocker.read_text() == "mine"
