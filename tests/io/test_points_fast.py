@@ -92,3 +92,40 @@ def test_fast_path_taken_for_small_lists() -> None:
     ]
     assert points_module._small_floats([[0, 0], [1, 0], [0, True]]) is None
     assert points_module._small_floats(np.zeros((3, 2)).tolist() * 30) is None  # above SMALL
+
+
+def _read(fn: object, *args: object) -> tuple[object, ...] | None:
+    try:
+        part = fn(*args)  # type: ignore[operator]
+    except BayesGraspError as exc:
+        return (type(exc).__name__, str(exc))
+    if part is None:
+        return None
+    return (part.name, part.units, part.hull.vertices.tolist(), part.center_of_mass.tolist())
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        '{"name": "a", "vertices": [[0, 0], [3, 0], [0, 1]], "units": "mm"}',
+        '{"vertices": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}',
+        '{"vertices": [[0, 0], [1, 0], [2, 0]]}',  # collinear: the same error
+        '{"vertices": [[0, 0], [1, 0], [0, 1]], "center_of_mass": [5, 5]}',
+        '{"vertices": "none"}',
+        '{"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [0, 1], [0, 0]]]}',
+        '{"vertices": [[0, 0], [1, 0], [0, 1e999]]}',  # too large: the general path
+        '{"vertices": [[0, 0], [1, 0], [0, NaN]]}',
+        "[[0, 0], [1, 0], [0, 1]]",  # not an object: the general path
+        '{"vertices": [[0, 0], [1, 0], [0, 1]]',  # malformed: the general path
+    ],
+)
+def test_json_line_part_reads_as_parse_json(line: str) -> None:
+    from bayesgrasp.io._common import ReadOptions
+    from bayesgrasp.io.points import json_line_part, parse_json
+
+    fast = _read(json_line_part, line, "b.jsonl:3")
+    general = _read(parse_json, line.encode(), Path("b.jsonl:3"), ReadOptions())
+    general_path = "1e999" in line or line.startswith("[") or not line.endswith("}")
+    assert (fast is None) == general_path
+    if fast is not None:
+        assert fast == general

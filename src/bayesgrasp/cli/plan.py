@@ -267,10 +267,13 @@ def _many(
     """Plan each part in turn, one JSON document a line; errors stay in their line."""
     code = 0
     inputs = run_inputs(part, spec)
+    encode = json.JSONEncoder(allow_nan=False).encode  # json.dumps(doc, allow_nan=False)
+    out = sys.stdout
     for label, load in _batch_parts(part, more, batch):
         doc, status = _one_document(label, load, spec, guaranteed, best_only, inputs)
         code = max(code, status)
-        typer.echo(json.dumps(doc, allow_nan=False))
+        out.write(encode(doc) + "\n")  # a line at a time, as typer.echo
+        out.flush()
     if code:
         raise typer.Exit(code)
 
@@ -284,6 +287,7 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
 
     from ..errors import PartFileError
     from ..io import read_part_bytes
+    from ..io.points import json_line_part
 
     names = ([part.part] if part.part is not None else []) + more
     for name in names:
@@ -305,6 +309,9 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
             label = f"{batch}:{number}"
 
             def load(text: str = text, label: str = label) -> Part:
+                found = json_line_part(text, label)  # a part object, parsed once
+                if found is not None:
+                    return found
                 try:
                     value = json.loads(text)
                 except ValueError as exc:

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import math
 import numbers
 from pathlib import Path
@@ -36,20 +37,32 @@ from ..errors import PartError
 from ..geometry import Part, as_points, find_crossing
 from ..sizes import SMALL
 from ._common import (
+    MAX_BYTES,
     MAX_COORDINATE,
+    MAX_NESTING,
     ReadOptions,
+    _json_float,
+    _json_int,
     brief,
     check_coordinates,
     check_count,
     decode_text,
     fail,
     load_json,
+    nesting_depth,
     quote,
     read_bytes,
     refuse_options,
 )
 
-__all__ = ["parse_csv", "parse_json", "point_list_part", "read_csv", "read_json"]
+__all__ = [
+    "json_line_part",
+    "parse_csv",
+    "parse_json",
+    "point_list_part",
+    "read_csv",
+    "read_json",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -307,7 +320,44 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
     >>> p.name, p.hull.n_sides
     ('w', 3)
     """
-    doc: Any = load_json(path, decode_text(path, data))
+    return _json_document_part(load_json(path, decode_text(path, data)), path, options)
+
+
+# load_json's parser (numbers too large refused), made once.
+_DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
+
+
+def json_line_part(text: str, name: str) -> Part | None:
+    """The part of one line of a JSONL batch holding a part object, as :func:`parse_json`.
+
+    The same part, or the same error, as ``parse_json(text.encode(), Path(name), ...)`` with
+    the default options, without encoding the text and parsing it twice. ``None`` when the
+    line is not a JSON object that parses cleanly (malformed, a number too large, nested too
+    deep, too long, not an object): the caller then reads it the general way.
+
+    Examples
+    --------
+    >>> json_line_part('{"vertices": [[0, 0], [3, 0], [0, 1]]}', "b.jsonl:1").hull.n_sides
+    3
+    >>> json_line_part('[1, 2]', "b.jsonl:2") is None
+    True
+    """
+    if len(text) > MAX_BYTES // 4:  # UTF-8 may take 4 bytes a character: check the bytes
+        return None
+    try:
+        doc = _DECODER.decode(text)
+    except Exception:  # any failure: the general path gives its error
+        return None
+    if not isinstance(doc, dict):
+        return None
+    # Nesting deeper than MAX_NESTING needs more brackets than that (counted in C).
+    if text.count("[") + text.count("{") > MAX_NESTING and nesting_depth(doc) > MAX_NESTING:
+        return None
+    return _json_document_part(doc, Path(name), ReadOptions())
+
+
+def _json_document_part(doc: Any, path: Path, options: ReadOptions) -> Part:
+    """:func:`parse_json` of the parsed document."""
     if (
         isinstance(doc, dict)
         and isinstance(doc.get("type"), str)
