@@ -55,6 +55,17 @@ def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
     >>> as_points([(0, 0), (1, 0), (0, 1)]).shape
     (3, 2)
     """
+    if (
+        type(points) is np.ndarray
+        and points.dtype == np.float64
+        and points.ndim == 2
+        and points.shape[1] == 2
+    ):  # already float64 (N, 2): a copy, if finite (the same result as below, sooner)
+        arr = points.copy()
+        if arr.size and not np.isfinite(arr).all():
+            bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
+            raise PartError(f"`{what}` must be finite; point {bad} is {arr[bad].tolist()}")
+        return arr
     try:
         raw = np.asarray(points)
         items = None
@@ -282,7 +293,9 @@ def _hull_python(
         Area and centroid (area 0 when degenerate).
     """
     px, py = coords if coords is not None else (pts[:, 0].tolist(), pts[:, 1].tolist())
-    order = sorted(range(len(px)), key=lambda i: (px[i], py[i]))  # stable, as np.lexsort
+    order = sorted(
+        range(len(px)), key=list(zip(px, py, strict=True)).__getitem__
+    )  # stable: np.lexsort
     sx, sy = [px[i] for i in order], [py[i] for i in order]
     chain = _monotone_chain(sx, sy)
     xs, ys = [sx[i] for i in chain], [sy[i] for i in chain]
