@@ -79,6 +79,29 @@ def test_batch_equals_each_part_alone(
     assert lines(out) == [single(capsys, "key"), *expected]
 
 
+@pytest.mark.parametrize(
+    "options",
+    [*OPTION_SETS[1:3], ["--prior", "vonmises:30,4", "--verify-cost", "2"]],
+    ids=lambda o: " ".join(o),
+)
+def test_batch_with_options_equals_each_part_alone(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, options: list[str]
+) -> None:
+    # The batch makes the prior, costs and goal once for all its parts.
+    parts = names()[:3]
+    rows = [json.dumps(p) for p in parts]
+    rows.append(json.dumps({"name": "sq", "vertices": [[0, 0], [2, 0], [2, 1], [0, 1]]}))
+    batch = tmp_path / "parts.jsonl"
+    batch.write_text("\n".join(rows))
+    sq = tmp_path / "sq.json"
+    sq.write_text(rows[-1])
+    code, out, err = run(capsys, "plan", "--batch", str(batch), *options)
+    assert (code, err) == (0, "")
+    alone = [single(capsys, p, *options) for p in [*parts, str(sq)]]
+    docs = lines(out)
+    assert docs == alone
+
+
 def test_bad_parts_are_reported_in_their_line(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:

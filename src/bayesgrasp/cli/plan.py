@@ -267,12 +267,30 @@ def _many(
     """Plan each part in turn, one JSON document a line; errors stay in their line."""
     code = 0
     inputs = run_inputs(part, spec)
+    encode = json.JSONEncoder(allow_nan=False).encode  # json.dumps(doc, allow_nan=False)
+    out = sys.stdout
+    build = _builder(spec)
     for label, load in _batch_parts(part, more, batch):
-        doc, status = _one_document(label, load, spec, guaranteed, best_only, inputs)
+        doc, status = _one_document(label, load, spec, guaranteed, best_only, inputs, build)
         code = max(code, status)
-        typer.echo(json.dumps(doc, allow_nan=False))
+        out.write(encode(doc) + "\n")  # a line at a time, as typer.echo
+        out.flush()
     if code:
         raise typer.Exit(code)
+
+
+def _builder(spec: ProblemSpec) -> Any:
+    """``spec.build`` for many parts: the prior, costs and goal made once (all immutable).
+
+    When making them fails, every part is built (and fails) the usual way, in its own line.
+    """
+    from ..model.problem import Problem
+
+    try:
+        made = spec.problem_inputs()
+    except Exception:  # any failure: each part meets it as spec.build would
+        return spec.build
+    return functools.partial(Problem.build, **made)
 
 
 def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterator[tuple[str, Any]]:
@@ -284,6 +302,7 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
 
     from ..errors import PartFileError
     from ..io import read_part_bytes
+    from ..io.points import json_line_part
 
     names = ([part.part] if part.part is not None else []) + more
     for name in names:
@@ -305,6 +324,9 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
             label = f"{batch}:{number}"
 
             def load(text: str = text, label: str = label) -> Part:
+                found = json_line_part(text, label)  # a part object, parsed once
+                if found is not None:
+                    return found
                 try:
                     value = json.loads(text)
                 except ValueError as exc:
@@ -327,13 +349,14 @@ def _one_document(
     guaranteed: bool,
     best_only: bool,
     inputs: dict[str, Any],
+    build: Any = None,
 ) -> tuple[dict[str, Any], int]:
     """The plan document of one part (as ``plan --json``) and its exit code, or its error."""
     from ..errors import BayesGraspError
     from ..io.plans import plan_document
 
     try:
-        pb = spec.build(load())
+        pb = (build or spec.build)(load())
         result = spec.plan(pb, best_only=best_only)
         found = guaranteed_plan(pb) if guaranteed else None
     except BayesGraspError as exc:

@@ -6,7 +6,7 @@ import enum
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
@@ -125,20 +125,26 @@ class ProblemSpec:
 
         ``prior`` replaces the ``--prior`` text (a plan file's prior).
         """
+        from ..model.problem import Problem
+
+        return Problem.build(part, **self.problem_inputs(more_actions, prior))
+
+    def problem_inputs(
+        self, more_actions: tuple[str, ...] = (), prior: Prior | None = None
+    ) -> dict[str, Any]:
+        """The keywords of ``Problem.build`` but the part (immutable: a batch makes them once)."""
         from ..model.cost import CostModel
         from ..model.goal import Goal
         from ..model.prior import parse_prior
-        from ..model.problem import Problem
 
         cost = CostModel(self.costs or {}, self.verify, self.first or {}, self.retry)
-        return Problem.build(
-            part,
-            prior=parse_prior(self.prior) if prior is None else prior,
-            cost=cost,
-            goal=Goal(self.goal.value),
-            actions=tuple(dict.fromkeys((*self.actions, *more_actions))),
-            accuracy=math.radians(self.accuracy_deg),
-        )
+        return {
+            "prior": parse_prior(self.prior) if prior is None else prior,
+            "cost": cost,
+            "goal": Goal(self.goal.value),
+            "actions": tuple(dict.fromkeys((*self.actions, *more_actions))),
+            "accuracy": math.radians(self.accuracy_deg),
+        }
 
     def plan(self, problem: Problem, best_only: bool = False) -> PlanReport:
         """The best plan of every length, by the chosen planner.

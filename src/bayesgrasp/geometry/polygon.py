@@ -55,6 +55,17 @@ def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
     >>> as_points([(0, 0), (1, 0), (0, 1)]).shape
     (3, 2)
     """
+    if (
+        type(points) is np.ndarray
+        and points.dtype == np.float64
+        and points.ndim == 2
+        and points.shape[1] == 2
+    ):  # already float64 (N, 2): a copy, if finite (the same result as below, sooner)
+        arr = points.copy()
+        if arr.size and not np.isfinite(arr).all():
+            bad = int(np.argwhere(~np.isfinite(arr))[0, 0])
+            raise PartError(f"`{what}` must be finite; point {bad} is {arr[bad].tolist()}")
+        return arr
     try:
         raw = np.asarray(points)
         items = None
@@ -267,7 +278,7 @@ def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
 
 
 def _hull_python(
-    pts: FloatArray, eps: float
+    pts: FloatArray, eps: float, coords: tuple[list[float], list[float]] | None = None
 ) -> tuple[list[float], list[float], float, float, float]:
     """Hull, area and centroid of a few points in plain Python.
 
@@ -281,8 +292,10 @@ def _hull_python(
     area, cx, cy : float
         Area and centroid (area 0 when degenerate).
     """
-    px, py = pts[:, 0].tolist(), pts[:, 1].tolist()
-    order = sorted(range(len(px)), key=lambda i: (px[i], py[i]))  # stable, as np.lexsort
+    px, py = coords if coords is not None else (pts[:, 0].tolist(), pts[:, 1].tolist())
+    order = sorted(
+        range(len(px)), key=list(zip(px, py, strict=True)).__getitem__
+    )  # stable: np.lexsort
     sx, sy = [px[i] for i in order], [py[i] for i in order]
     chain = _monotone_chain(sx, sy)
     xs, ys = [sx[i] for i in chain], [sy[i] for i in chain]
@@ -466,15 +479,26 @@ class ConvexPolygon:
         [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]
         """
         _check_tolerance(tol)
-        pts = as_points(points)
-        extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
-        _check_magnitude(pts, extent)
+        return cls._hull_of(as_points(points), tol)
+
+    @classmethod
+    def _hull_of(cls, pts: FloatArray, tol: Tolerance) -> ConvexPolygon:
+        """:meth:`from_points` of points already checked by :func:`as_points`."""
+        coords = None
+        if 3 <= len(pts) <= _SMALL:  # the extent and magnitude on Python floats (same values)
+            coords = px, py = pts[:, 0].tolist(), pts[:, 1].tolist()
+            extent = max(max(px) - min(px), max(py) - min(py))
+            if max(max(map(abs, px)), max(map(abs, py))) > _MAX_COORD or 0.0 < extent < _MIN_EXTENT:
+                _check_magnitude(pts, extent)
+        else:
+            extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
+            _check_magnitude(pts, extent)
         eps = tol.length_for(extent)
         area = 0.0
         if len(pts) < 3 or extent == 0.0:
             hull = pts[:0]
         elif len(pts) <= _SMALL:
-            xs, ys, area, cx, cy = _hull_python(pts, eps)
+            xs, ys, area, cx, cy = _hull_python(pts, eps, coords)
             hull = np.array([xs, ys], dtype=np.float64).T.copy()
             centroid = np.array([cx, cy])
         else:
@@ -737,9 +761,16 @@ class Part:
         PartError
             Bad coordinates, or a centre of mass outside the hull.
         """
-        outline = as_points(points).copy()
-        hull = ConvexPolygon.from_points(outline, tol)
-        com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
+        outline = as_points(points)  # a fresh array
+        _check_tolerance(tol)
+        hull = ConvexPolygon._hull_of(outline, tol)
+        com = None
+        if center_of_mass is None:  # the hull's centroid: finite floats already
+            c = hull.centroid
+            if math.isfinite(c[0]) and math.isfinite(c[1]) and hull_contains(hull, c):
+                com = np.array(c, dtype=np.float64)
+        if com is None:
+            com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
         outline.setflags(write=False)
         com.setflags(write=False)
         return cls(name, hull, outline, com, units)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import json
 import math
 import numbers
 from pathlib import Path
@@ -34,20 +35,34 @@ from numpy.typing import NDArray
 
 from ..errors import PartError
 from ..geometry import Part, as_points, find_crossing
+from ..sizes import SMALL
 from ._common import (
+    MAX_BYTES,
+    MAX_COORDINATE,
+    MAX_NESTING,
     ReadOptions,
+    _json_float,
+    _json_int,
     brief,
     check_coordinates,
     check_count,
     decode_text,
     fail,
     load_json,
+    nesting_depth,
     quote,
     read_bytes,
     refuse_options,
 )
 
-__all__ = ["parse_csv", "parse_json", "point_list_part", "read_csv", "read_json"]
+__all__ = [
+    "json_line_part",
+    "parse_csv",
+    "parse_json",
+    "point_list_part",
+    "read_csv",
+    "read_json",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -96,6 +111,120 @@ def _is_convex(ring: FloatArray) -> bool:
     return bool(np.all(cross >= -slack) or np.all(cross <= slack))
 
 
+# Where math.hypot and np.hypot (an ulp apart at most) could decide a straightness test
+# differently: within this relative band of the threshold the numpy test decides.
+_BAND = 1e-9
+
+# Python ints above this may convert to float differently through numpy's integer arrays.
+_EXACT_INT = 2**53
+
+
+def _small_floats(points: Any) -> list[tuple[float, float]] | None:
+    """A short plain list of ``[x, y]`` numbers as Python floats; ``None`` for any other input.
+
+    The fast path of :func:`point_list_part` (at most :data:`bayesgrasp.sizes.SMALL` points):
+    only lists whose every coordinate is an ``int`` or ``float``, finite and within
+    :data:`MAX_COORDINATE`, so these are exactly the values ``np.asarray`` would give. Anything
+    else (booleans, text, big integers, bad shapes, non-finite values) returns ``None`` and takes
+    the general path, which gives its errors.
+    """
+    if not isinstance(points, list) or not 3 <= len(points) <= SMALL:
+        return None
+    out: list[tuple[float, float]] = []
+    for p in points:
+        if type(p) is not list or len(p) != 2:
+            return None
+        x, y = p
+        tx, ty = type(x), type(y)
+        if (tx is not float and tx is not int) or (ty is not float and ty is not int):
+            return None
+        if (tx is int and abs(x) > _EXACT_INT) or (ty is int and abs(y) > _EXACT_INT):
+            return None
+        fx, fy = float(x), float(y)
+        # abs(nan) <= M is False: NaN and infinities take the general path too.
+        if not (abs(fx) <= MAX_COORDINATE and abs(fy) <= MAX_COORDINATE):
+            return None
+        out.append((fx, fy))
+    return out
+
+
+def _small_ring(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """:func:`_ring` on Python floats: drop each point equal to the next (cyclically)."""
+    n = len(pts)
+    return [p for i, p in enumerate(pts) if p != pts[(i + 1) % n]]
+
+
+def _turns(ring: list[tuple[float, float]]) -> list[tuple[float, float, float]]:
+    """(cross, dot, |u| |w|) at each vertex of the ring (u incoming, w outgoing edge).
+
+    The cross and dot products are the numpy paths' operations, in the same order.
+    """
+    n = len(ring)
+    out = []
+    for i in range(n):
+        (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
+        ux, uy, wx, wy = bx - ax, by - ay, cx - bx, cy - by
+        out.append((ux * wy - uy * wx, ux * wx + uy * wy, math.hypot(ux, uy) * math.hypot(wx, wy)))
+    return out
+
+
+def _near(value: float, threshold: float) -> bool:
+    """Whether ``value`` is too close to ``threshold`` for math.hypot to decide."""
+    return abs(value - threshold) <= _BAND * abs(threshold)
+
+
+def _small_is_simple(
+    ring: list[tuple[float, float]], turns: list[tuple[float, float, float]]
+) -> bool:
+    """:func:`_is_simple` on Python floats, for rings of at most :data:`SMALL` points.
+
+    The fold-back test as :func:`_is_simple` (numpy decides within :data:`_BAND` of the
+    threshold); the crossing test pairs every two non-adjacent edges whose bounding boxes
+    overlap (the pairs ``find_crossing``'s sweep examines) and settles them by the same
+    orientation signs as ``_segments_meet``.
+    """
+    for cross, dot, scale in turns:
+        if dot < 0:
+            if _near(abs(cross), _STRAIGHT * scale):
+                return _is_simple(np.array(ring, dtype=np.float64))
+            if abs(cross) <= _STRAIGHT * scale:
+                return False
+    n = len(ring)
+    edges = []
+    for i in range(n):
+        (px, py), (qx, qy) = ring[i], ring[(i + 1) % n]
+        edges.append((px, py, qx, qy, min(px, qx), max(px, qx), min(py, qy), max(py, qy)))
+    for i in range(n):
+        px, py, qx, qy, xlo, xhi, ylo, yhi = edges[i]
+        for j in range(i + 2, n if i else n - 1):
+            rx, ry, sx, sy, xlo2, xhi2, ylo2, yhi2 = edges[j]
+            if xlo > xhi2 or xlo2 > xhi or ylo > yhi2 or ylo2 > yhi:
+                continue
+            o1 = (qx - px) * (ry - py) - (qy - py) * (rx - px)
+            o2 = (qx - px) * (sy - py) - (qy - py) * (sx - px)
+            if (o1 > 0 and o2 > 0) or (o1 < 0 and o2 < 0):
+                continue
+            o3 = (sx - rx) * (py - ry) - (sy - ry) * (px - rx)
+            o4 = (sx - rx) * (qy - ry) - (sy - ry) * (qx - rx)
+            if not ((o3 > 0 and o4 > 0) or (o3 < 0 and o4 < 0)):
+                return False
+    return True
+
+
+def _small_is_convex(
+    ring: list[tuple[float, float]], turns: list[tuple[float, float, float]]
+) -> bool:
+    """:func:`_is_convex` on Python floats (numpy decides within :data:`_BAND` of a threshold)."""
+    left = right = True
+    for cross, _, scale in turns:
+        slack = _STRAIGHT * scale
+        if _near(cross, -slack) or _near(cross, slack):
+            return _is_convex(np.array(ring, dtype=np.float64))
+        left = left and cross >= -slack
+        right = right and cross <= slack
+    return left or right
+
+
 def point_list_part(
     path: Path,
     points: Any,
@@ -127,15 +256,25 @@ def point_list_part(
     >>> point_list_part(Path("L.csv"), cloud, "L").center_of_mass.round(4).tolist()
     [0.9048, 0.9048]
     """
+    small = _small_floats(points)
+    if small is not None:  # the same decisions on Python floats
+        pts = np.array(small, dtype=np.float64)
+        sring = _small_ring(small)
+        turns = _turns(sring) if len(sring) >= 3 else []
+        simple = len(sring) >= 3 and _small_is_simple(sring, turns)
+        concave = simple and not _small_is_convex(sring, turns)
+        ring = np.array(sring, dtype=np.float64) if concave else pts
+    else:
+        try:
+            pts = as_points(points)
+        except PartError as exc:
+            raise fail(path, str(exc)) from None
+        check_coordinates(path, pts, "the point list")
+        ring = _ring(pts)
+        simple = len(ring) >= 3 and _is_simple(ring)
+        concave = simple and not _is_convex(ring)
     try:
-        pts = as_points(points)
-    except PartError as exc:
-        raise fail(path, str(exc)) from None
-    check_coordinates(path, pts, "the point list")
-    ring = _ring(pts)
-    simple = len(ring) >= 3 and _is_simple(ring)
-    try:
-        if simple and not _is_convex(ring):
+        if concave:
             return Part.from_outline(ring, name=name, center_of_mass=center_of_mass, units=units)
         part = Part.from_points(pts, name=name, center_of_mass=center_of_mass, units=units)
     except PartError as exc:
@@ -181,7 +320,44 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
     >>> p.name, p.hull.n_sides
     ('w', 3)
     """
-    doc: Any = load_json(path, decode_text(path, data))
+    return _json_document_part(load_json(path, decode_text(path, data)), path, options)
+
+
+# load_json's parser (numbers too large refused), made once.
+_DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
+
+
+def json_line_part(text: str, name: str) -> Part | None:
+    """The part of one line of a JSONL batch holding a part object, as :func:`parse_json`.
+
+    The same part, or the same error, as ``parse_json(text.encode(), Path(name), ...)`` with
+    the default options, without encoding the text and parsing it twice. ``None`` when the
+    line is not a JSON object that parses cleanly (malformed, a number too large, nested too
+    deep, too long, not an object): the caller then reads it the general way.
+
+    Examples
+    --------
+    >>> json_line_part('{"vertices": [[0, 0], [3, 0], [0, 1]]}', "b.jsonl:1").hull.n_sides
+    3
+    >>> json_line_part('[1, 2]', "b.jsonl:2") is None
+    True
+    """
+    if len(text) > MAX_BYTES // 4:  # UTF-8 may take 4 bytes a character: check the bytes
+        return None
+    try:
+        doc = _DECODER.decode(text)
+    except Exception:  # any failure: the general path gives its error
+        return None
+    if not isinstance(doc, dict):
+        return None
+    # Nesting deeper than MAX_NESTING needs more brackets than that (counted in C).
+    if text.count("[") + text.count("{") > MAX_NESTING and nesting_depth(doc) > MAX_NESTING:
+        return None
+    return _json_document_part(doc, Path(name), ReadOptions())
+
+
+def _json_document_part(doc: Any, path: Path, options: ReadOptions) -> Part:
+    """:func:`parse_json` of the parsed document."""
     if (
         isinstance(doc, dict)
         and isinstance(doc.get("type"), str)

@@ -1,0 +1,131 @@
+"""The point-list reader's plain-Python path for small parts against its numpy path (issue 12).
+
+``point_list_part`` decides outline or cloud, simple or not, convex or not, on Python floats
+for at most ``sizes.SMALL`` points; forcing the general path (``_small_floats`` returning
+``None``) must give the same part, or the same error, on every input.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from bayesgrasp.errors import BayesGraspError
+from bayesgrasp.io import points as points_module
+from bayesgrasp.io.points import point_list_part
+
+PATH = Path("p.json")
+
+
+def _outcome(pts: object) -> tuple[object, ...]:
+    """The part's arrays and name, or the error's type and message."""
+    try:
+        part = point_list_part(PATH, pts, "p")
+    except BayesGraspError as exc:
+        return (type(exc).__name__, str(exc))
+    return (
+        part.hull.vertices.tolist(),
+        part.outline.tolist(),
+        part.center_of_mass.tolist(),
+        [h.tolist() for h in part.holes],
+    )
+
+
+def _both(pts: object, monkeypatch: pytest.MonkeyPatch) -> tuple[object, object]:
+    fast = _outcome(pts)
+    with monkeypatch.context() as m:
+        m.setattr(points_module, "_small_floats", lambda _: None)
+        general = _outcome(pts)
+    return fast, general
+
+
+# Small integer grids make collinear runs, repeated points, touching and crossing edges
+# common; floats add near-degenerate turns.
+_grid = st.lists(st.lists(st.integers(-4, 4), min_size=2, max_size=2), min_size=3, max_size=12)
+_floats = st.lists(
+    st.lists(st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False), min_size=2, max_size=2),
+    min_size=3,
+    max_size=20,
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(pts=st.one_of(_grid, _floats))
+def test_fast_and_general_paths_agree(pts: list[list[float]]) -> None:
+    with pytest.MonkeyPatch.context() as mp:
+        fast, general = _both(pts, mp)
+    assert fast == general
+
+
+@pytest.mark.parametrize(
+    "pts",
+    [
+        [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],  # an L outline
+        [[0, 0], [1, 1], [1, 0], [0, 1]],  # a bow tie: a cloud
+        [[0, 0], [2, 0], [1, 0], [1, 1]],  # folds back along an edge
+        [[0, 0], [1, 0], [1, 0], [1, 1], [0, 0]],  # repeated and closing points
+        [[0, 0], [1, 0], [2, 0]],  # collinear: an error
+        [[0, 0], [0, 0], [0, 0]],  # one point: an error
+        [[0, 0], [1, 0], [0, float("nan")]],  # NaN: the general path's error
+        [[0, 0], [1, 0], [0, 1e200]],  # too large
+        [[0, 0], [1, 0], [True, 1]],  # a boolean
+        [[0, 0], [1, 0], [0, 10**400]],  # an int beyond floats
+        [[0, 0], [1, 0], [0, 2**60 + 1]],  # an int numpy and float() might round apart
+        [[0, 0], [1, 0], [0, 1, 2]],  # a bad shape
+        [[0.0, 0.0], [1.0, 1e-13], [2.0, 0.0], [1.0, 1.0]],  # a nearly straight turn
+    ],
+)
+def test_adversarial_inputs_agree(pts: list[list[object]], monkeypatch: pytest.MonkeyPatch) -> None:
+    fast, general = _both(pts, monkeypatch)
+    assert fast == general
+
+
+def test_fast_path_taken_for_small_lists() -> None:
+    assert points_module._small_floats([[0, 0], [1, 0], [0, 1]]) == [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+    ]
+    assert points_module._small_floats([[0, 0], [1, 0], [0, True]]) is None
+    assert points_module._small_floats(np.zeros((3, 2)).tolist() * 30) is None  # above SMALL
+
+
+def _read(fn: object, *args: object) -> tuple[object, ...] | None:
+    try:
+        part = fn(*args)  # type: ignore[operator]
+    except BayesGraspError as exc:
+        return (type(exc).__name__, str(exc))
+    if part is None:
+        return None
+    return (part.name, part.units, part.hull.vertices.tolist(), part.center_of_mass.tolist())
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        '{"name": "a", "vertices": [[0, 0], [3, 0], [0, 1]], "units": "mm"}',
+        '{"vertices": [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]}',
+        '{"vertices": [[0, 0], [1, 0], [2, 0]]}',  # collinear: the same error
+        '{"vertices": [[0, 0], [1, 0], [0, 1]], "center_of_mass": [5, 5]}',
+        '{"vertices": "none"}',
+        '{"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [0, 1], [0, 0]]]}',
+        '{"vertices": [[0, 0], [1, 0], [0, 1e999]]}',  # too large: the general path
+        '{"vertices": [[0, 0], [1, 0], [0, NaN]]}',
+        "[[0, 0], [1, 0], [0, 1]]",  # not an object: the general path
+        '{"vertices": [[0, 0], [1, 0], [0, 1]]',  # malformed: the general path
+    ],
+)
+def test_json_line_part_reads_as_parse_json(line: str) -> None:
+    from bayesgrasp.io._common import ReadOptions
+    from bayesgrasp.io.points import json_line_part, parse_json
+
+    fast = _read(json_line_part, line, "b.jsonl:3")
+    general = _read(parse_json, line.encode(), Path("b.jsonl:3"), ReadOptions())
+    general_path = "1e999" in line or line.startswith("[") or not line.endswith("}")
+    assert (fast is None) == general_path
+    if fast is not None:
+        assert fast == general
