@@ -44,7 +44,9 @@ that ignores its readings, or "one action, then declare the likeliest state"), e
 solves ``h(lambda_n)`` exactly, takes its minimiser ``pi_n`` and sets ``lambda_{n+1} =
 R(pi_n)``; the ratios fall strictly until ``h(lambda_n) = 0``, when ``lambda_n = R*`` (every
 policy has ``c - lambda_n P >= 0``, i.e. ``R >= lambda_n``). The number of policies is
-finite, so this ends; in practice after two to four steps.
+finite, so this ends; in practice after two to four steps. The programme of the best step
+is kept (one memo per step), so the last step, which only confirms ``h = 0`` and whose
+policy is no better, costs no extra solve to rebuild the best tree.
 
 For a fixed ``lambda`` the objective is additive over the leaves and ``h`` is a dynamic
 programme over *beliefs* (distributions over the states, or (part, orientation) pairs, after
@@ -1056,7 +1058,7 @@ def plan_policy(
     def solve(lam: float) -> tuple[float, int, float]:
         """``h(lambda)``, the best root, and the ratio of the policy that reaches it."""
         solver.lam = lam
-        solver.memo.clear()
+        solver.memo = {}
         h, pick, ratio = math.inf, -1, math.inf
         for ri in range(len(roots)):
             k = kinds[root_kind[ri]]
@@ -1066,6 +1068,7 @@ def plan_policy(
         return h, pick, ratio
 
     best_lam, best_ratio, best_pick = lam, math.inf, -1
+    best_memo = solver.memo
     it = 0
     for it in range(1, max_iterations + 1):
         h, pick, ratio = solve(lam)
@@ -1079,12 +1082,12 @@ def plan_policy(
         )
         improved = ratio < best_ratio
         if improved:
-            best_lam, best_ratio, best_pick = lam, ratio, pick
+            best_lam, best_ratio, best_pick, best_memo = lam, ratio, pick, solver.memo
         if h >= -_EPS * max(1.0, abs(lam)) or not improved:
             break
         lam = ratio
-    if solver.lam != best_lam:
-        _, best_pick, _ = solve(best_lam)
+    # The programme at the best price is kept, not solved again (the builder reads it).
+    solver.lam, solver.memo = best_lam, best_memo
     builder = _Builder(solver, max_actions)
     k = kinds[root_kind[best_pick]]
     root = builder.node(
