@@ -352,3 +352,21 @@ def test_good_seeds_give_numpy_s_draws() -> None:
     b = simulate_kinematic(pb, plan, 1000, rng=np.random.default_rng(7))
     c = simulate_kinematic(pb, plan, 1000, rng=np.random.SeedSequence(7))
     assert np.array_equal(a.observed, b.observed) and np.array_equal(a.observed, c.observed)
+
+
+def test_every_sampler_refuses_a_negative_seed_naming_rng() -> None:
+    """The noisy-plan and policy simulations and the gripper noise share ``as_generator``."""
+    from bayesgrasp.model.noise import NoiseModel, parse_turn_noise
+    from bayesgrasp.planning.policy import plan_policy
+    from bayesgrasp.sim.noise import GripperNoise
+    from bayesgrasp.sim.noisy import simulate_noise
+    from bayesgrasp.sim.policy import simulate_policy
+
+    pb = Problem.build(load("triangle"))
+    steps = plan_exact(pb).bayes_plan.steps
+    with pytest.raises(SimulationError, match=r"`rng` must be"):
+        simulate_noise(pb, NoiseModel(parse_turn_noise("normal:2")), steps, 10, rng=-1)
+    with pytest.raises(SimulationError, match=r"`rng` must be"):
+        simulate_policy(pb, plan_policy(pb, "width", 2), 10, rng=-1)
+    with pytest.raises(SimulationError, match=r"`rng` must be"):
+        GripperNoise("normal", 0.01).draw((3,), rng=-1)

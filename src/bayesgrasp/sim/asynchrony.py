@@ -37,6 +37,7 @@ from ..geometry.polygon import Part
 from ..geometry.push import push_grasp_function
 from ..geometry.transfer import squeeze_function
 from .engine import Squeezer
+from .noise import as_generator
 from .params import SimParams
 from .result import DEFAULT_BOUNDARY_MARGIN, boundary_distance
 from .stats import wilson_interval
@@ -170,7 +171,7 @@ def measure_asynchrony(
     base = params or SimParams()
     push = base.jaw_speed * lag / 2.0
     sp = replace(base, jaw_lag=lag, clearance=max(base.clearance, push + 0.001))
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     th, lead, sq, pg = differing_starts(part, trials, gen, margin)
     squeezer = Squeezer(part, scale, sp)
     t0 = time.perf_counter()

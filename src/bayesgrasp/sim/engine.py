@@ -45,7 +45,7 @@ from ..model.actions import get_action
 from ..model.problem import Problem
 from ..planning.result import PlanOption
 from .kinematic import sample_prior
-from .noise import GripperNoise
+from .noise import GripperNoise, as_generator
 from .params import SimParams
 from .result import (
     DEFAULT_BOUNDARY_MARGIN,
@@ -408,7 +408,7 @@ def simulate_mujoco(
             f"settings suit parts of {SIZE_RANGE[0] * 1000:g} mm to {SIZE_RANGE[1] * 100:g} cm: "
             "give the part's units (the part file's \"units\", or --units)"
         )
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     k = option.n_actions
     theta0 = sample_prior(problem.prior, trials, gen)
     alphas = np.array([s.alpha for s in option.steps])

@@ -18,7 +18,7 @@ from ..errors import SimulationError
 from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
 from ..model.problem import Problem
 from ..planning.result import PlanOption
-from .noise import GripperNoise
+from .noise import GripperNoise, as_generator
 from .result import (
     DEFAULT_BOUNDARY_MARGIN,
     BoolArray,
@@ -46,40 +46,6 @@ __all__ = [
 #: A kinematic trial jams when an action ends farther than this many times the states'
 #: angle tolerance from every stable orientation (only a start on a basin boundary can).
 JAM_TOLERANCE_FACTOR = 10.0
-
-
-def as_generator(rng: object, name: str = "rng") -> np.random.Generator:
-    """``np.random.default_rng(rng)``, refusing a bad seed with a :class:`SimulationError`.
-
-    A generator, bit generator or seed sequence is used as is; ``None`` seeds from the
-    operating system; an integer must be >= 0 (numpy's own ``ValueError`` for a negative
-    seed named no parameter).
-
-    Raises
-    ------
-    SimulationError
-        ``rng`` is a negative integer, a bool, or anything numpy cannot seed with.
-
-    Examples
-    --------
-    >>> as_generator(3).integers(10) == np.random.default_rng(3).integers(10)
-    np.True_
-    >>> as_generator(-1)  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    bayesgrasp.errors.SimulationError: `rng` must be ... an integer seed >= 0; got -1
-    """
-    if isinstance(rng, np.random.Generator):
-        return rng
-    want = f"`{name}` must be a numpy Generator, None or an integer seed >= 0; got {rng!r}"
-    if isinstance(rng, bool | float | str | bytes) or (
-        isinstance(rng, int | np.integer) and rng < 0
-    ):
-        raise SimulationError(want)
-    try:
-        return np.random.default_rng(rng)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise SimulationError(want) from None
 
 
 def sample_prior(prior: Prior, n: int, rng: np.random.Generator | int | None = None) -> FloatArray:

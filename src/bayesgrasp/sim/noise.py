@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from ..errors import SimulationError
 
-__all__ = ["GripperNoise"]
+__all__ = ["GripperNoise", "as_generator"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,9 +63,43 @@ class GripperNoise:
         self, shape: tuple[int, ...], rng: np.random.Generator | int | None
     ) -> NDArray[np.float64]:
         """Angle errors of the given shape (zeros when ``scale`` is 0)."""
-        gen = np.random.default_rng(rng)
+        gen = as_generator(rng)
         if self.scale == 0.0:
             return np.zeros(shape)
         if self.kind == "normal":
             return gen.normal(0.0, self.scale, shape)
         return gen.uniform(-self.scale, self.scale, shape)
+
+
+def as_generator(rng: object, name: str = "rng") -> np.random.Generator:
+    """``np.random.default_rng(rng)``, refusing a bad seed with a :class:`SimulationError`.
+
+    A generator, bit generator or seed sequence is used as is; ``None`` seeds from the
+    operating system; an integer must be >= 0 (numpy's own ``ValueError`` for a negative
+    seed named no parameter).
+
+    Raises
+    ------
+    SimulationError
+        ``rng`` is a negative integer, a bool, or anything numpy cannot seed with.
+
+    Examples
+    --------
+    >>> as_generator(3).integers(10) == np.random.default_rng(3).integers(10)
+    np.True_
+    >>> as_generator(-1)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bayesgrasp.errors.SimulationError: `rng` must be ... an integer seed >= 0; got -1
+    """
+    if isinstance(rng, np.random.Generator):
+        return rng
+    want = f"`{name}` must be a numpy Generator, None or an integer seed >= 0; got {rng!r}"
+    if isinstance(rng, bool | float | str | bytes) or (
+        isinstance(rng, int | np.integer) and rng < 0
+    ):
+        raise SimulationError(want)
+    try:
+        return np.random.default_rng(rng)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise SimulationError(want) from None

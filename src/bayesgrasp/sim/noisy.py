@@ -26,7 +26,7 @@ from ..model.problem import Problem
 from ..model.states import nearest_state
 from ..planning.result import PlanStep
 from .kinematic import sample_prior
-from .noise import GripperNoise
+from .noise import GripperNoise, as_generator
 from .result import check_steps, check_trials
 
 __all__ = ["simulate_noise"]
@@ -72,7 +72,7 @@ def simulate_noise(
     """
     check_trials(trials)
     check_steps(problem, steps)
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     turn = GripperNoise(noise.turn.kind, noise.turn.scale)
     q = noise.contact
     push = push_grasp_function(problem.part, problem.states) if q > 0 else None

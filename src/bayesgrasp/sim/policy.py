@@ -61,7 +61,7 @@ from ..model.problem import Problem, nearest_state
 from ..model.sensing import WidthSensor
 from ..planning.policy import Declare, Policy, PolicyNode, Reject
 from .kinematic import sample_prior
-from .noise import GripperNoise
+from .noise import GripperNoise, as_generator
 from .params import SimParams
 from .result import Progress, check_trials
 from .stats import wilson_interval
@@ -336,7 +336,7 @@ def simulate_policy(
     if chunk < 1:
         raise SimulationError(f"`chunk` must be >= 1; got {chunk}")
     pbs = _problems(problems, policy)
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     noise = noise or GripperNoise()
     out: dict[str, list[Any]] = {k: [] for k in ("cost", "acts", "ok", "rej", "err")}
     t0 = time.perf_counter()
@@ -553,7 +553,7 @@ def simulate_policy_mujoco(
                 f"physics settings suit parts of {SIZE_RANGE[0] * 1000:g} mm to "
                 f"{SIZE_RANGE[1] * 100:g} cm: give the part's units"
             )
-    gen = np.random.default_rng(rng)
+    gen = as_generator(rng)
     k = policy.max_actions
     parts = gen.choice(len(pbs), size=cycles, p=np.asarray(policy.part_prior))
     theta0 = sample_prior(pbs[0].prior, cycles, gen)
