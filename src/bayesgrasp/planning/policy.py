@@ -1145,8 +1145,19 @@ def _finish(
 # -- presentation --------------------------------------------------------------------------
 
 
-def policy_text(policy: Policy, units: str | None = None, digits: int = 2) -> str:
+def policy_text(
+    policy: Policy, units: str | None = None, digits: int = 2, min_probability: float = 0.0
+) -> str:
     """The policy as an indented tree a person can follow (angles in degrees).
+
+    Each node says the action; each branch the readings that take it (``below a``,
+    ``in [a, b)``, ``b or more``), the probability of such a reading where the node is
+    reached, and what follows. With noisy readings a node has a bin for nearly every
+    encoder step, most of them with a tiny probability; ``min_probability`` leaves out of the
+    text the branches whose probability where their node is reached is below it (and so
+    their subtrees), and says at each node how many were left out and their probability in
+    all. The JSON document (:func:`bayesgrasp.io.policies.policy_document`) keeps every
+    branch: a robot runs that, not the text.
 
     Parameters
     ----------
@@ -1155,6 +1166,9 @@ def policy_text(policy: Policy, units: str | None = None, digits: int = 2) -> st
         Units of the readings (default: the policy's, else none).
     digits : int
         Decimals of readings and angles.
+    min_probability : float
+        Leave out the branches whose probability at their node is below this (default 0:
+        every branch).
 
     Examples
     --------
@@ -1163,16 +1177,31 @@ def policy_text(policy: Policy, units: str | None = None, digits: int = 2) -> st
     >>> rect = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)], units="mm"))
     >>> print(policy_text(plan_policy(rect, "width", 2)))
     squeeze with the gripper at 0.00 deg
-      if the width reads in [-inf, 1.50) mm (p = 0.70): declare 90.00 deg (success 0.50)
-      if the width reads in [1.50, inf) mm (p = 0.30): declare 0.00 deg (success 0.50)
+      if the width reads below 1.50 mm (p = 0.70): declare 90.00 deg (success 0.50)
+      if the width reads 1.50 mm or more (p = 0.30): declare 0.00 deg (success 0.50)
     """
+    if not 0.0 <= min_probability <= 1.0:
+        raise PlanningError(f"min_probability must lie in [0, 1], got {min_probability!r}")
     u = policy.units if units is None else units
     unit = f" {u}" if u else ""
     lines: list[str] = []
     several = len(policy.parts) > 1
 
     def num(x: float) -> str:
-        return "-inf" if x == -math.inf else "inf" if x == math.inf else f"{x:.{digits}f}"
+        return f"{x:.{digits}f}"
+
+    def prob(p: float) -> str:
+        # Two significant digits below 10^-digits, so a small branch does not read "0.00".
+        return f"{p:.{digits}f}" if p >= 10.0**-digits or p == 0.0 else f"{p:.1e}"
+
+    def readings(b: Branch) -> str:
+        if b.lo == -math.inf and b.hi == math.inf:
+            return "any width"
+        if b.lo == -math.inf:
+            return f"the width reads below {num(b.hi)}{unit}"
+        if b.hi == math.inf:
+            return f"the width reads {num(b.lo)}{unit} or more"
+        return f"the width reads in [{num(b.lo)}, {num(b.hi)}){unit}"
 
     def leaf(x: Declare | Reject) -> str:
         if isinstance(x, Reject):
@@ -1189,16 +1218,24 @@ def policy_text(policy: Policy, units: str | None = None, digits: int = 2) -> st
             lines.append(f"{pad}{node.step.kind} with the gripper at {ang}")
         else:
             lines.append(f"{pad}turn {ang}, {node.step.kind}")
+        left_out, left_p = 0, 0.0
         for b in node.branches:
-            cond = (
-                f"{pad}  if the width reads in [{num(b.lo)}, {num(b.hi)}){unit} "
-                f"(p = {b.probability:.{digits}f})"
-            )
+            if b.probability < min_probability:
+                left_out += 1
+                left_p += b.probability
+                continue
+            cond = f"{pad}  if {readings(b)} (p = {prob(b.probability)})"
             if isinstance(b.next, PolicyNode):
                 lines.append(cond + ":")
                 walk(b.next, depth + 2, False)
             else:
                 lines.append(f"{cond}: {leaf(b.next)}")
+        if left_out:
+            s = "" if left_out == 1 else "s"
+            lines.append(
+                f"{pad}  ({left_out} more reading interval{s}, p = {prob(left_p)} in all, "
+                "left out here: --json lists every branch)"
+            )
 
     walk(policy.root, 0, True)
     return "\n".join(lines)

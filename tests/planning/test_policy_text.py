@@ -1,0 +1,62 @@
+"""The policy's text form: readings worded for a person, and small branches folded."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+from bayesgrasp import shapes
+from bayesgrasp.errors import PlanningError
+from bayesgrasp.model import Problem
+from bayesgrasp.planning.policy import Policy, PolicyNode, plan_policy, policy_text
+
+
+@pytest.fixture(scope="module")
+def noisy() -> Policy:
+    return plan_policy(Problem.build(shapes.load("house")), "width:0.5,0.1", 2)
+
+
+def shown_and_folded(node: PolicyNode, t: float) -> tuple[int, int]:
+    """Branches the text should print, and those it should fold, walking shown nodes only."""
+    shown = folded = 0
+    for b in node.branches:
+        if b.probability < t:
+            folded += 1
+            continue
+        shown += 1
+        if isinstance(b.next, PolicyNode):
+            s, f = shown_and_folded(b.next, t)
+            shown, folded = shown + s, folded + f
+    return shown, folded
+
+
+@pytest.mark.parametrize("t", [0.0, 1e-6, 0.01, 0.2])
+def test_folding_prints_exactly_the_branches_above_the_threshold(noisy: Policy, t: float) -> None:
+    text = policy_text(noisy, min_probability=t)
+    shown, folded = shown_and_folded(noisy.root, t)
+    assert sum(line.lstrip().startswith("if ") for line in text.splitlines()) == shown
+    counts = [int(m) for m in re.findall(r"\((\d+) more reading intervals?", text)]
+    assert sum(counts) == folded
+    if t == 0.0:
+        assert folded == 0 and "more reading" not in text
+    else:
+        assert folded > 0  # the noisy tree has bins of tiny probability
+
+
+def test_no_nonzero_probability_reads_as_zero(noisy: Policy) -> None:
+    text = policy_text(noisy)
+    assert "p = 0.00)" not in text
+    assert re.search(r"p = \d\.\de-\d\d\)", text)  # small ones in two significant digits
+
+
+def test_unbounded_readings_are_worded() -> None:
+    text = policy_text(plan_policy(Problem.build(shapes.load("rectangle")), "width", 2))
+    assert "inf" not in text
+    assert re.search(r"reads below [\d.]+ mm", text) and re.search(r"reads [\d.]+ mm or more", text)
+
+
+@pytest.mark.parametrize("t", [-0.1, 1.5, float("nan")])
+def test_bad_threshold_is_a_clear_error(noisy: Policy, t: float) -> None:
+    with pytest.raises(PlanningError, match="min_probability"):
+        policy_text(noisy, min_probability=t)
