@@ -77,3 +77,12 @@ def test_cli_study_sense(capsys: pytest.CaptureFixture[str]) -> None:
     assert set(doc["parts"]) >= {"triangle", "house", "key"}
     assert main(["study", "--sense", "width:-1,1", "--polygons", "2"]) == 2
     assert "sigma" in capsys.readouterr().err
+
+
+def test_a_malformed_study_sensor_is_worded_in_relative_units(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert main(["study", "--sense", "width:1", "--polygons", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "fractions of each part's largest diameter" in err and "part units" not in err
+    assert err.count("\n") == 1

@@ -338,8 +338,11 @@ def entropy_bits(belief: ArrayLike) -> float:
 _SPEC = re.compile(r"^\s*width\s*(?::\s*(?P<sigma>[^,\s]+)\s*,\s*(?P<res>[^,\s]+)\s*)?$")
 
 
-def parse_sensor(spec: str | WidthSensor) -> WidthSensor:
-    """A sensor from ``width`` or ``width:SIGMA,RES`` (part units).
+def parse_sensor(spec: str | WidthSensor, units: str = "part units") -> WidthSensor:
+    """A sensor from ``width`` or ``width:SIGMA,RES`` (in ``units``: the part's by default).
+
+    ``units`` only words the message of a malformed specification (the sensing study reads
+    SIGMA and RES as fractions of each part's largest diameter).
 
     Raises
     ------
@@ -360,7 +363,7 @@ def parse_sensor(spec: str | WidthSensor) -> WidthSensor:
     m = _SPEC.match(spec) if isinstance(spec, str) else None
     if m is None:
         raise SensorError(
-            f"sensor must be written `width` or `width:SIGMA,RES` (part units); got {spec!r}"
+            f"sensor must be written `width` or `width:SIGMA,RES` ({units}); got {spec!r}"
         )
     if m.group("sigma") is None:
         return EXACT

@@ -87,7 +87,7 @@ def sensing_columns(spec: str | None = "width") -> tuple[SensingColumn, ...]:
     ['none', 'exact', 'SIGMA 2%, RES 1%']
     """
     cols = [SensingColumn("none", "none"), SensingColumn("exact", "exact")]
-    s = parse_sensor(spec or "width")
+    s = parse_sensor(spec or "width", units="fractions of each part's largest diameter")
     if s.kind == "exact":
         cols += [SensingColumn(f"SIGMA {f:.0%}", "relative", f, f / 2) for f in (0.01, 0.05)]
     else:
