@@ -60,3 +60,16 @@ def test_unbounded_readings_are_worded() -> None:
 def test_bad_threshold_is_a_clear_error(noisy: Policy, t: float) -> None:
     with pytest.raises(PlanningError, match="min_probability"):
         policy_text(noisy, min_probability=t)
+
+
+def test_candidate_parts_in_different_units_are_refused() -> None:
+    from bayesgrasp.geometry import Part
+    from bayesgrasp.model.sensing import StateSpace
+
+    tri = [(0.0, 0.0), (4.0, 0.0), (1.0, 3.0)]
+    mm = Problem.build(Part.from_points(tri, name="a", units="mm"))
+    inch = Problem.build(Part.from_points(tri, name="b", units="in"))
+    bare = Problem.build(Part.from_points(tri, name="c"))
+    with pytest.raises(PlanningError, match=r"mm \(a\), in \(b\)"):
+        plan_policy([mm, inch], "width", 1)
+    assert StateSpace.build([mm, bare]).n_parts == 2  # unknown units are not a conflict

@@ -458,7 +458,8 @@ class StateSpace:
         SensorError
             On a bad part prior (see :func:`parse_part_prior`).
         PlanningError
-            If the problems do not share their action kinds.
+            If the problems do not share their action kinds, or two parts are in different
+            known units (their widths could not be compared; units are never converted).
         """
         pbs = (problems,) if isinstance(problems, Problem) else tuple(problems)
         if not pbs or not all(isinstance(p, Problem) for p in pbs):
@@ -468,6 +469,13 @@ class StateSpace:
             raise PlanningError(
                 "every candidate part must have the same actions; got "
                 + "; ".join(",".join(p.action_kinds) for p in pbs)
+            )
+        known = {p.part.units for p in pbs} - {None}
+        if len(known) > 1:
+            raise PlanningError(
+                "the candidate parts' widths are read in one unit, but the parts are in "
+                + ", ".join(f"{p.part.units} ({p.part.name})" for p in pbs if p.part.units)
+                + ": give them all in the same units"
             )
         w = parse_part_prior(part_prior, len(pbs))
         sizes = [p.n_states for p in pbs]
