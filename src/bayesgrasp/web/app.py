@@ -44,6 +44,7 @@ from .models import (
     PartIn,
     PartRequest,
     PlanRequest,
+    PolicyRequest,
     ProblemOptions,
     SimulateRequest,
 )
@@ -419,6 +420,19 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     return doc
 
 
+def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
+    """``bayesgrasp plan PART [--also PART ...] --sense ... --json``: the Bayes policy."""
+    from ..io.policies import policy_document
+    from ..planning.policy import plan_policy
+
+    spec = problem_spec(req)
+    parts = [service.part(p) for p in (req.part, *req.also)]
+    problems = [build_problem(p, req, spec) for p in parts]
+    prior = None if req.part_prior is None else ",".join(map(repr, req.part_prior))
+    pol = plan_policy(problems, sensor=req.sense, max_actions=req.max_actions, part_prior=prior)
+    return policy_document(pol)
+
+
 def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
     """``bayesgrasp simulate PART [options] --engine kinematic --json``."""
     from .. import report
@@ -570,6 +584,11 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
         """The best plan of every length, Bayes and most certain (``bayesgrasp plan --json``)."""
         return await answer(lambda: plan_result_document(service, req))
 
+    @app.post(f"{API}/policy", tags=["plans"])
+    async def policy(req: PolicyRequest) -> JSONResponse:
+        """The Bayes policy that branches on jaw widths (``plan --sense ... --json``)."""
+        return await answer(lambda: policy_document_of(service, req))
+
     @app.post(f"{API}/simulate", tags=["plans"])
     async def simulate(req: SimulateRequest) -> JSONResponse:
         """Kinematic executions of a plan (``bayesgrasp simulate --engine kinematic --json``)."""
@@ -589,7 +608,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
 
     @app.post(f"{API}/{{command}}/upload", tags=["parts"])
     async def upload(
-        command: Literal["squeeze", "push", "plan", "simulate"],
+        command: Literal["squeeze", "push", "plan", "policy", "simulate"],
         file: UploadFile = File(description="A part file (read in memory)."),  # noqa: B008
         format: str = Form(description="json, csv, wkt, geojson, svg or dxf."),
         options: str = Form("{}", description="The other members of the command's body, JSON."),
@@ -612,6 +631,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "squeeze": PartRequest,
             "push": PartRequest,
             "plan": PlanRequest,
+            "policy": PolicyRequest,
             "simulate": SimulateRequest,
         }
         model = models[command]
@@ -623,6 +643,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "squeeze": lambda: squeeze_document(service, req),
             "push": lambda: push_document(service, req),
             "plan": lambda: plan_result_document(service, req),
+            "policy": lambda: policy_document_of(service, req),
             "simulate": lambda: simulate_document(service, req),
         }
         return await answer(work[command])

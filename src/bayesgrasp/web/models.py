@@ -18,6 +18,7 @@ __all__ = [
     "PartIn",
     "PartRequest",
     "PlanRequest",
+    "PolicyRequest",
     "ProblemOptions",
     "SimulateRequest",
 ]
@@ -130,3 +131,25 @@ class FigureRequest(ProblemOptions):
     """The body of ``figures``: the figures ``plot`` makes."""
 
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
+
+
+class PolicyRequest(ProblemOptions):
+    """The body of ``policy``: ``bayesgrasp plan PART [--also PART ...] --sense ...``."""
+
+    sense: str = Field(
+        "width",
+        max_length=64,
+        description="The jaw-width sensor: `width` (exact readings) or `width:SIGMA,RES` in "
+        "the part's units (--sense).",
+    )
+    also: list[PartIn] = Field(
+        default_factory=list,
+        max_length=7,
+        description="More candidate parts to tell apart (--also); each given as `part` is.",
+    )
+    part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
+        None, max_length=8, description="Weights of the candidate parts (--part-prior)."
+    )
+    max_actions: int = Field(
+        3, ge=1, le=8, description="Deepest policy: actions on any path (--max-actions)."
+    )
