@@ -1234,7 +1234,7 @@ def policy_text(
             s = "" if left_out == 1 else "s"
             lines.append(
                 f"{pad}  ({left_out} more reading interval{s}, p = {prob(left_p)} in all, "
-                "left out here: --json lists every branch)"
+                "left out here; the JSON document lists every branch)"
             )
 
     walk(policy.root, 0, True)
