@@ -99,9 +99,14 @@ for a sample prior, a midpoint between them): the planner tries them all when th
 most ``max_first_angles`` (exact), else those of the sensorless exact plans plus a grid of
 360 (then ``Policy.first_angle_exact`` is False).
 
-The planner assumes exact gripper turns (``Problem.accuracy`` must be 0); each node's
-``margin`` is half the width of its action class, how far the turn may err without changing
-the effect on any state.
+Each node's ``margin`` is half the width of its action class: how far the turn may err
+without changing the effect on any state. With a gripper ``accuracy`` (``Problem.accuracy``,
+the bound on the error of every turn after the first, as for plans) only classes of half
+width at least ``accuracy`` are turns a later node may make: a turn at the class's middle
+then has the class's effect under any error below ``accuracy``, so the policy, its readings
+and its figures are exactly those of the model for every such error (the first action's
+angle is in the world frame, as for plans, and is not bounded by it). The policy is the
+best of those policies; ``accuracy = 0`` is the unrestricted search.
 
 Examples
 --------
@@ -964,8 +969,8 @@ def plan_policy(
     SensorError
         On a bad sensor or part prior.
     PlanningError
-        If ``max_actions < 1``, the problems' actions differ, or a problem has a gripper
-        ``accuracy`` (the planner assumes exact turns).
+        If ``max_actions < 1``, the problems' actions differ, or their gripper accuracies
+        differ (one gripper turns for every candidate part).
 
     Examples
     --------
@@ -980,17 +985,19 @@ def plan_policy(
         raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
     space = StateSpace.build(problems, part_prior)
     main = space.problems[0]
-    if any(p.accuracy > 0 for p in space.problems):
+    accuracy = main.accuracy
+    if any(p.accuracy != accuracy for p in space.problems):
         raise PlanningError(
-            "the policy planner assumes exact gripper turns: the problem's `accuracy` must be "
-            f"0; got {max(p.accuracy for p in space.problems):.6g} rad = "
-            f"{math.degrees(max(p.accuracy for p in space.problems)):g} deg"
+            "every candidate part's problem must have the same gripper `accuracy`; got "
+            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
         )
     cost = main.cost
     kinds: list[_Kind] = []
     for action in main.actions:
         cl = joint_transition(space, action.name)
         order = np.argsort(-(cl.hi - cl.lo), kind="stable")
+        # with an accuracy, only the turns that keep their effect under any error below it
+        order = order[0.5 * (cl.hi - cl.lo)[order] >= accuracy] if accuracy > 0 else order
         kinds.append(
             _Kind(
                 action,
