@@ -32,6 +32,10 @@ def cli_policy(capsys: pytest.CaptureFixture[str], *args: str) -> dict:
             ["--sense", "width:0.5,0.25", "--max-actions", "2", "--verify-cost", "2.0"],
         ),
         (
+            SweepOptions(sense="width:0.5,0.25", accuracy_deg=5.0),
+            ["--sense", "width:0.5,0.25", "--accuracy", "5.0"],
+        ),
+        (
             SweepOptions(sense="width", actions=("squeeze", "push-grasp")),
             ["--sense", "width", "--actions", "squeeze,push-grasp"],
         ),
@@ -81,7 +85,6 @@ def test_without_sense_there_are_no_policy_columns_and_the_key_is_unchanged(
     [
         ({"sense": "width:1"}, SensorError, "width:SIGMA,RES"),
         ({"sense": "width:-1,1"}, SensorError, "sigma"),
-        ({"sense": "width", "accuracy_deg": 1.0}, SweepError, "accuracy_deg"),
         ({"sense": "width", "sense_max_actions": 0}, SweepError, "sense_max_actions"),
     ],
 )

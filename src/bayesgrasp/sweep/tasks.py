@@ -193,9 +193,6 @@ class SweepOptions:
         if self.sense is not None:
             from ..model.sensing import parse_sensor
 
-            if self.accuracy_deg:
-                raise SweepError("`sense` needs `accuracy_deg` = 0 (policies assume exact turns)")
-
             parse_sensor(self.sense)  # a malformed sensor: SensorError saying why
 
     @property
