@@ -384,6 +384,7 @@ class _Kind:
     mid: FloatArray  # (A,)
     half_width: FloatArray  # (A,)
     pi_symmetric: bool
+    patterns: dict[bytes, tuple[IntArray, IntArray, int]] = field(default_factory=dict)
 
 
 @dataclass(slots=True)
@@ -479,7 +480,22 @@ class _Solver:
 
     def images(self, q: FloatArray, kind: _Kind) -> tuple[FloatArray, IntArray]:
         """Distinct beliefs after each class of ``kind`` (M, N) and the row of each."""
-        supp = np.flatnonzero(q > 0)
+        pos = q > 0
+        pattern = kind.patterns.get(pos.tobytes())
+        if pattern is None:
+            pattern = kind.patterns[pos.tobytes()] = self.pattern(pos, kind)
+        first, idx, m = pattern
+        w = np.broadcast_to(q[pos], (m, len(idx) // m)).ravel()
+        out = np.bincount(idx, weights=w, minlength=m * self.space.n_states)
+        return np.asarray(out.reshape(m, -1), dtype=np.float64), first
+
+    def pattern(self, pos: NDArray[np.bool_], kind: _Kind) -> tuple[IntArray, IntArray, int]:
+        """The distinct effects of ``kind`` on a belief of support ``pos``.
+
+        The class of each (widest first), the flat index of each (effect, state of the
+        support) in the (M, N) images, and their number M (:meth:`images` adds the masses).
+        """
+        supp = np.flatnonzero(pos)
         t = kind.transfer[:, supp]  # (A, S)
         n = self.space.n_states
         if len(supp) * math.log2(max(n, 2)) < 62:  # each row as one integer in base n
@@ -494,9 +510,7 @@ class _Solver:
         rows = t[first]
         m = len(first)
         idx = (rows + n * np.arange(m)[:, None]).ravel()
-        w = np.broadcast_to(q[supp], rows.shape).ravel()
-        out = np.bincount(idx, weights=w, minlength=m * n).reshape(m, n)
-        return np.asarray(out, dtype=np.float64), np.asarray(first, dtype=np.intp)
+        return np.asarray(first, dtype=np.intp), np.asarray(idx, dtype=np.intp), m
 
     def joint(self, imgs: FloatArray) -> FloatArray:
         """Joint (belief, reading) masses: (M, B, N)."""
@@ -510,8 +524,8 @@ class _Solver:
     def prepare(self, imgs: FloatArray) -> _Prepared:
         """What :meth:`best_act` needs of images ``imgs`` (M, N) at any price ``lambda``."""
         j = self.joint(imgs)  # (M, B, N)
-        s, _ = self.success(j)
-        return _Prepared(imgs, j.sum(axis=-1), s)
+        s = j if self.goal_is_identity else j @ self.goal.T.astype(np.float64)
+        return _Prepared(imgs, j.sum(axis=-1), np.max(s, axis=-1))
 
     def bound_of(self, prep: _Prepared) -> tuple[FloatArray, FloatArray]:
         """The bound's ``U`` and ``r`` (:meth:`bound`) of every (image, reading) pair: (M, B).
@@ -598,7 +612,7 @@ class _Solver:
                 # The child matters only if its value is below this (the class is
                 # abandoned otherwise): it may stop as soon as it knows it is not.
                 budget = (best - _EPS - total - rest) / pb if self.cut else math.inf
-                val, cv, pv, exact = self.value(q, r_after, budget)
+                val, cv, pv, exact = self.value(q, r_after, budget, True)
                 if floor is None:
                     floor = np.full(pm.shape, _NO_FLOOR)
                     if self.use_floor:
@@ -610,7 +624,7 @@ class _Solver:
                     if total + pb * val + rest >= best - _EPS:
                         aborted = True
                         break
-                    val, cv, pv, exact = self.value(q, r_after)
+                    val, cv, pv, exact = self.value(q, r_after, math.inf, True)
                 floor[i, b] = val
                 total += pb * val
                 c_sum += pb * cv
@@ -653,7 +667,7 @@ class _Solver:
         return hit
 
     def value(
-        self, q: FloatArray, r: int, budget: float = math.inf
+        self, q: FloatArray, r: int, budget: float = math.inf, unsettled: bool = False
     ) -> tuple[float, float, float, bool]:
         """``V(q, r)`` per unit mass (``q`` normalised), its cycle cost and success, exactly.
 
@@ -662,6 +676,10 @@ class _Solver:
         ``V(q, r) >= bound >= budget`` (a cut). Otherwise the last item is True and the value
         is the one the unbudgeted search finds. Memoised with the decision that reaches it
         (a cut is memoised as its bound, and searched again for a larger budget).
+
+        ``unsettled``: the caller (:meth:`best_act`) has found the leaf worse than the bound
+        on acting (:meth:`act_bound`, from the images' figures), and any finite budget above
+        that bound: the search acts without computing the bound again.
         """
         qk = self.key(q)
         k = (qk, r)
@@ -686,7 +704,7 @@ class _Solver:
         # that is lower (then only a value below the budget is of use).
         cutting = budget + _EPS < best
         limit = budget + _EPS if cutting else best
-        if r > 0 and limit > float(self.act_bound(q)) + _EPS:
+        if r > 0 and (unsettled or limit > float(self.act_bound(q)) + _EPS):
             for ti, kind in enumerate(self.kinds):
                 prep, rows = self.prepared(qk, q, ti)
                 val, i, ci, pi = self.best_act(prep, kind.cost, r - 1, limit)
