@@ -589,23 +589,22 @@ class _Solver:
         floor = self.floor(prep, r_after)
         if floor is not None:
             lb_child = np.maximum(lb_child, pm * floor)
-        lb = cost + lb_child.sum(axis=1)
         # A child whose leaf is no worse than acting's bound is a leaf (as `value` decides).
         settled = (leaf <= act + _EPS * pm) | (leaf - act < _TINY)
+        # Each class's settled leaves, and the bounds of the rest (before any child).
+        done_sum = (cost + np.where(settled, leaf, 0.0).sum(axis=1)).tolist()
+        rest_sum = np.where(settled, 0.0, lb_child).sum(axis=1).tolist()
         lik_t = self.bins.likelihood.T  # (B, N)
-        for i in np.argsort(ub, kind="stable"):
-            if lb[i] >= best - _EPS:
-                continue
-            done = settled[i]
-            total = cost + float(leaf[i, done].sum())
-            rest = float(lb_child[i, ~done].sum())
+        for i in np.argsort(ub, kind="stable").tolist():
+            total, rest = done_sum[i], rest_sum[i]
             if total + rest >= best - _EPS:
                 continue
-            lc, lp = self.leaf_figures_of(pm[i, done], s[i, done])
-            c_sum, p_sum = cost + float(lc.sum()), float(lp.sum())
             aborted = False
             img = prep.images[i]
-            for b in np.flatnonzero((pm[i] > 0) & ~done):
+            kids: list[tuple[float, float]] = []
+            # The children most above their bounds first: the class is abandoned soonest.
+            open_ = np.flatnonzero((pm[i] > 0) & ~settled[i])
+            for b in open_[np.argsort(lb_child[i, open_] - leaf[i, open_], kind="stable")]:
                 rest -= float(lb_child[i, b])
                 pb = float(pm[i, b])
                 q = img * lik_t[b] / pb
@@ -627,12 +626,17 @@ class _Solver:
                     val, cv, pv, exact = self.value(q, r_after, math.inf, True)
                 floor[i, b] = val
                 total += pb * val
-                c_sum += pb * cv
-                p_sum += pb * pv
+                kids.append((pb * cv, pb * pv))
                 if total + rest >= best - _EPS:
                     aborted = True
                     break
             if not aborted and total < best - _EPS:
+                done = settled[i]
+                lc, lp = self.leaf_figures_of(pm[i, done], s[i, done])
+                c_sum, p_sum = cost + float(lc.sum()), float(lp.sum())
+                for cv, pv in kids:
+                    c_sum += cv
+                    p_sum += pv
                 best, pick, pick_c, pick_p = total, int(i), c_sum, p_sum
         return best, pick, pick_c, pick_p
 
