@@ -6,11 +6,13 @@
   (target: under 60 s);
 - a 3-part recognition policy for catalogue parts (target: under 1 s).
 
-Run: ``python benchmarks/bench_policy.py [--polygons N] [--depth K]``. Times include building
-each problem; the second figure excludes it. ``plan_policy(..., sensorless=False)`` unless
-said (the sensorless Bayes plan is then not computed inside the planner). Each figure is
-given as wall time and as CPU time of this process (``time.process_time``): on a shared,
-loaded machine the CPU time is the one-core figure the targets speak of.
+Run: ``python benchmarks/bench_policy.py [--polygons N] [--depth K] [--noisy-polygons N]``;
+``--polygon I`` times the noisy polygon ``I`` of the draw alone (1402 is the slowest).
+Times include building each problem; the second figure excludes it.
+``plan_policy(..., sensorless=False)`` unless said (the sensorless Bayes plan is then not
+computed inside the planner). Each figure is given as wall time and as CPU time of this
+process (``time.process_time``): on a shared, loaded machine the CPU time is the one-core
+figure the targets speak of.
 """
 
 from __future__ import annotations
@@ -31,6 +33,23 @@ from bayesgrasp.planning.policy import plan_policy
 def polygons(n: int, seed: int = 0) -> list[Problem]:
     rng = np.random.default_rng(seed)
     return [Problem.build(random_polygon(rng)) for _ in range(n)]
+
+
+def bench_one(index: int, depth: int, noisy: float) -> None:
+    """Polygon ``index`` of the benchmark's draw alone (1402: the noisy run's slowest)."""
+    rng = np.random.default_rng(0)
+    for _ in range(index + 1):
+        part = random_polygon(rng)
+    pb = Problem.build(part)
+    sigma = noisy * float(pb.diameter.lengths.max())
+    c0 = time.process_time()
+    pol = plan_policy(pb, WidthSensor(sigma, sigma / 2), depth, sensorless=False)
+    cpu = time.process_time() - c0
+    print(
+        f"polygon {index} alone, SIGMA {noisy:.0%} of diameter, depth <= {depth}: "
+        f"{cpu:.2f} s CPU; cost {pol.expected_cost:.6f}, {pol.searched} beliefs searched, "
+        f"{pol.iterations} parametric steps"
+    )
 
 
 def bench_random(n: int, depth: int, noisy: float | None, with_sensorless: bool) -> None:
@@ -83,7 +102,11 @@ def main() -> None:
     ap.add_argument("--polygons", type=int, default=2000)
     ap.add_argument("--depth", type=int, default=4)
     ap.add_argument("--noisy-polygons", type=int, default=None)
+    ap.add_argument("--polygon", type=int, default=None, help="only this noisy polygon")
     args = ap.parse_args()
+    if args.polygon is not None:
+        bench_one(args.polygon, args.depth, 0.01)
+        return
     for with_sensorless in (False, True):
         bench_random(args.polygons, args.depth, None, with_sensorless)
     bench_random(args.noisy_polygons or args.polygons, args.depth, 0.01, False)

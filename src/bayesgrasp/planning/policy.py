@@ -45,8 +45,12 @@ solves ``h(lambda_n)`` exactly, takes its minimiser ``pi_n`` and sets ``lambda_{
 R(pi_n)``; the ratios fall strictly until ``h(lambda_n) = 0``, when ``lambda_n = R*`` (every
 policy has ``c - lambda_n P >= 0``, i.e. ``R >= lambda_n``). The number of policies is
 finite, so this ends; in practice after two to four steps. The programme of the best step
-is kept (one memo per step), so the last step, which only confirms ``h = 0`` and whose
-policy is no better, costs no extra solve to rebuild the best tree.
+is kept (one memo per step), so no extra solve rebuilds the best tree. At every step a known
+policy (the start's, or the last step's) has value about 0, so the step only looks for a
+policy of value below ``-1e-12 max(1, lambda)`` (the stopping rule's threshold): the last
+step, which confirms ``h = 0``, is cut off almost at once. With noisy readings the search
+first runs within ``K - 1`` actions and starts the ``K``-action search from that ratio (a
+known policy's: it has at most ``K`` actions), which saves a step or two of the large search.
 
 For a fixed ``lambda`` the objective is additive over the leaves and ``h`` is a dynamic
 programme over *beliefs* (distributions over the states, or (part, orientation) pairs, after
@@ -76,9 +80,30 @@ width and the same future up to pi, so a policy never separates them and
 otherwise ``U = 1``. A node whose leaf value is no worse than ``c_min + min(rho, v + rho -
 (lambda + rho) U(q))`` is a leaf; a class whose bound (its cost plus the children's bounds)
 cannot beat the best found is skipped, and one is abandoned as soon as its exact children so
-far plus the bounds of the rest cannot. Classes with the same effect on the belief's support
-are one (the widest is kept: the most margin for the turn). Ties go to fewer actions and to
-declaring over rejecting.
+far plus the bounds of the rest cannot; its children are searched most above their bounds
+first, so that a losing class is found out after one or two. Classes with the same effect on
+the belief's support are one (the widest is kept: the most margin for the turn). Ties go to
+fewer actions and to declaring over rejecting.
+
+Two more bounds, each exact (they only skip work whose result could not change the answer):
+
+- *Budgets.* A child searched inside a class matters only if its value is below ``beta =
+  (best - total so far - bounds of the other children left) / P(reading)``: past that the
+  class is abandoned anyway. The child is searched with the budget: its actions must beat
+  ``min(leaf, beta)``, and when none does and its leaf is above ``beta`` it returns ``beta``
+  as a lower bound instead of its value (a *cut*; memoised as such and searched again for a
+  larger budget). The parent then abandons the class by the same comparison it would have
+  made with the exact value (the comparison is monotone in the value), and if rounding
+  says otherwise it asks for the exact value. The root's budget is the known policy's value.
+- *Floors.* ``V(q, r)`` at price ``lambda`` is the least of ``c(pi) - lambda P(pi)`` over
+  the continuations, each non-increasing in ``lambda`` (``P >= 0``), so ``V`` is too. The
+  prices fall from step to step, so every value (or cut bound) found for a child at an
+  earlier step is a lower bound at the later ones, and it replaces the weaker bound above
+  where it is larger (kept per prepared belief and depth; dropped if a price ever rises).
+
+With the same comparisons as the search without them, these change nothing but which of two
+policies equal to about ``1e-12`` is returned (``plan_policy(..., _prune=())`` turns them
+off; the tests compare the two).
 
 Where the search grows: every reading bin of positive probability leads to its own belief,
 and with noisy readings almost every such belief is new (the memo only helps where readings
@@ -87,9 +112,11 @@ distinct class images and ``B`` bins a node. The last action's children are sett
 vectorised step, the bounds prune the rest, and the per-belief work that does not depend on
 ``lambda`` (the images of each class, their reading masses and success masses, the bound's
 ``U`` and ``r``, computed by a matrix product over the pi pairs' common likelihoods) is kept
-across the parametric steps. Noisy readings with push-grasps (no pi-pair bound) or with
-SIGMA large against the width differences (many ambiguous bins) are the slow cases: see
-the README's figures. Neighbouring readings that lead to the same subtree are joined into
+across the parametric steps; the effect pattern of each class on a support is kept too (a
+belief's images are then one weighted count). What remains is about 0.1 ms of numpy per
+searched belief. Noisy readings with push-grasps (no pi-pair bound) or with SIGMA large
+against the width differences (many ambiguous bins) are the slow cases: see the README's
+figures. Neighbouring readings that lead to the same subtree are joined into
 one branch of the returned tree (the policy is the same).
 
 First gripper angle: under the uniform prior it does not matter (0). Otherwise the root
@@ -122,7 +149,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Collection, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, cast
 
@@ -162,6 +189,12 @@ _QUANT = float(2**40)  # beliefs are memoised after rounding to multiples of 2**
 _EPS = 1e-12  # value comparisons (ties go to fewer actions)
 _TINY = 1e-13  # a reading this unlikely times its most to gain by acting again ends in a leaf
 _DEFAULT_MAX_ACTIONS = 3
+_Memo = dict[tuple[bytes, int], tuple[float, tuple[Any, ...] | None, float, float]]
+_NO_FLOOR = -1e300  # no lower bound known (finite, so that 0 * it is 0)
+# The exact search's prunings (each can be turned off to test it against the search without):
+# budgets passed down ("cut"), values at higher prices as lower bounds ("floor"), and
+# starting the parametric search from the best ratio one action shorter ("deepen").
+_PRUNE = frozenset({"cut", "floor", "deepen"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -264,9 +297,13 @@ class Policy:
         The sensorless Bayes plan's expected cost within ``max_actions`` (one part, when
         asked for; else ``None``).
     iterations : int
-        Parametric (Dinkelbach) steps taken.
+        Parametric (Dinkelbach) steps taken (over both depths when deepening).
     beliefs : int
-        Distinct (belief, actions left) pairs evaluated in the last step.
+        Distinct (belief, actions left) pairs in the programme of the step whose policy is
+        returned.
+    searched : int
+        (Belief, actions left) pairs searched over all the parametric steps (the search's
+        work: a belief searched again with a larger budget counts again).
     first_angle_exact : bool
         Every first gripper angle that can be optimal was tried (see the module notes).
     units : str or None
@@ -289,6 +326,7 @@ class Policy:
     beliefs: int = 0
     first_angle_exact: bool = True
     units: str | None = None
+    searched: int = 0
 
     @property
     def expected_total_actions(self) -> float:
@@ -378,6 +416,7 @@ class _Kind:
     mid: FloatArray  # (A,)
     half_width: FloatArray  # (A,)
     pi_symmetric: bool
+    patterns: dict[bytes, tuple[IntArray, IntArray, int]] = field(default_factory=dict)
 
 
 @dataclass(slots=True)
@@ -387,12 +426,18 @@ class _Prepared:
     ``mass[i, b]`` is the probability of reading bin ``b`` after image ``i``; ``success`` the
     best declaration's success mass there; ``bound`` the bound's ``U`` and ``r``
     (:meth:`_Solver.bound_of`) of those (image, reading) pairs, once asked for.
+
+    ``floor[r][i, b]`` is a lower bound on ``V(post(i, b), r)`` (per unit mass): the value
+    (or a cut's bound) found at this or an earlier, higher price of generation
+    ``floor_gen``; ``_NO_FLOOR`` where none was found (:meth:`_Solver.floor`).
     """
 
     images: FloatArray  # (M, N)
     mass: FloatArray  # (M, B)
     success: FloatArray  # (M, B)
     bound: tuple[FloatArray, FloatArray] | None = None
+    floor: dict[int, FloatArray] = field(default_factory=dict)
+    floor_gen: int = 0
 
 
 @dataclass(slots=True)
@@ -410,9 +455,11 @@ class _Solver:
     use_pairs: bool
     pair_likelihood: FloatArray  # (P, B): a reading's likelihood in either state of a pair
     lam: float = 0.0
-    memo: dict[tuple[bytes, int], tuple[float, tuple[Any, ...], float, float]] = field(
-        default_factory=dict
-    )
+    cut: bool = True  # children stop as soon as they cannot matter (see `value`)
+    use_floor: bool = True  # values at earlier (higher) prices bound later ones from below
+    floor_gen: int = 0
+    searched: int = 0
+    memo: _Memo = field(default_factory=dict)
     prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
     @property
@@ -465,7 +512,22 @@ class _Solver:
 
     def images(self, q: FloatArray, kind: _Kind) -> tuple[FloatArray, IntArray]:
         """Distinct beliefs after each class of ``kind`` (M, N) and the row of each."""
-        supp = np.flatnonzero(q > 0)
+        pos = q > 0
+        pattern = kind.patterns.get(pos.tobytes())
+        if pattern is None:
+            pattern = kind.patterns[pos.tobytes()] = self.pattern(pos, kind)
+        first, idx, m = pattern
+        w = np.broadcast_to(q[pos], (m, len(idx) // m)).ravel()
+        out = np.bincount(idx, weights=w, minlength=m * self.space.n_states)
+        return np.asarray(out.reshape(m, -1), dtype=np.float64), first
+
+    def pattern(self, pos: NDArray[np.bool_], kind: _Kind) -> tuple[IntArray, IntArray, int]:
+        """The distinct effects of ``kind`` on a belief of support ``pos``.
+
+        The class of each (widest first), the flat index of each (effect, state of the
+        support) in the (M, N) images, and their number M (:meth:`images` adds the masses).
+        """
+        supp = np.flatnonzero(pos)
         t = kind.transfer[:, supp]  # (A, S)
         n = self.space.n_states
         if len(supp) * math.log2(max(n, 2)) < 62:  # each row as one integer in base n
@@ -480,9 +542,7 @@ class _Solver:
         rows = t[first]
         m = len(first)
         idx = (rows + n * np.arange(m)[:, None]).ravel()
-        w = np.broadcast_to(q[supp], rows.shape).ravel()
-        out = np.bincount(idx, weights=w, minlength=m * n).reshape(m, n)
-        return np.asarray(out, dtype=np.float64), np.asarray(first, dtype=np.intp)
+        return np.asarray(first, dtype=np.intp), np.asarray(idx, dtype=np.intp), m
 
     def joint(self, imgs: FloatArray) -> FloatArray:
         """Joint (belief, reading) masses: (M, B, N)."""
@@ -496,8 +556,8 @@ class _Solver:
     def prepare(self, imgs: FloatArray) -> _Prepared:
         """What :meth:`best_act` needs of images ``imgs`` (M, N) at any price ``lambda``."""
         j = self.joint(imgs)  # (M, B, N)
-        s, _ = self.success(j)
-        return _Prepared(imgs, j.sum(axis=-1), s)
+        s = j if self.goal_is_identity else j @ self.goal.T.astype(np.float64)
+        return _Prepared(imgs, j.sum(axis=-1), np.max(s, axis=-1))
 
     def bound_of(self, prep: _Prepared) -> tuple[FloatArray, FloatArray]:
         """The bound's ``U`` and ``r`` (:meth:`bound`) of every (image, reading) pair: (M, B).
@@ -558,35 +618,80 @@ class _Solver:
         gain = top * (v / np.maximum(share, 0.5) - lam - rho)
         act = (self.c_min + rho) * pm + np.minimum(0.0, gain)
         lb_child = np.minimum(leaf, act)
-        lb = cost + lb_child.sum(axis=1)
+        floor = self.floor(prep, r_after)
+        if floor is not None:
+            lb_child = np.maximum(lb_child, pm * floor)
         # A child whose leaf is no worse than acting's bound is a leaf (as `value` decides).
         settled = (leaf <= act + _EPS * pm) | (leaf - act < _TINY)
+        # Each class's settled leaves, and the bounds of the rest (before any child).
+        done_sum = (cost + np.where(settled, leaf, 0.0).sum(axis=1)).tolist()
+        rest_sum = np.where(settled, 0.0, lb_child).sum(axis=1).tolist()
         lik_t = self.bins.likelihood.T  # (B, N)
-        for i in np.argsort(ub, kind="stable"):
-            if lb[i] >= best - _EPS:
-                continue
-            done = settled[i]
-            total = cost + float(leaf[i, done].sum())
-            rest = float(lb_child[i, ~done].sum())
+        for i in np.argsort(ub, kind="stable").tolist():
+            total, rest = done_sum[i], rest_sum[i]
             if total + rest >= best - _EPS:
                 continue
-            lc, lp = self.leaf_figures_of(pm[i, done], s[i, done])
-            c_sum, p_sum = cost + float(lc.sum()), float(lp.sum())
             aborted = False
             img = prep.images[i]
-            for b in np.flatnonzero((pm[i] > 0) & ~done):
+            kids: list[tuple[float, float]] = []
+            # The children most above their bounds first: the class is abandoned soonest.
+            open_ = np.flatnonzero((pm[i] > 0) & ~settled[i])
+            for b in open_[np.argsort(lb_child[i, open_] - leaf[i, open_], kind="stable")]:
                 rest -= float(lb_child[i, b])
                 pb = float(pm[i, b])
-                val, cv, pv = self.value(img * lik_t[b] / pb, r_after)
+                q = img * lik_t[b] / pb
+                # The child matters only if its value is below this (the class is
+                # abandoned otherwise): it may stop as soon as it knows it is not.
+                budget = (best - _EPS - total - rest) / pb if self.cut else math.inf
+                val, cv, pv, exact = self.value(q, r_after, budget, True)
+                if floor is None:
+                    floor = np.full(pm.shape, _NO_FLOOR)
+                    if self.use_floor:
+                        prep.floor[r_after] = floor
+                if not exact:
+                    # ``val`` is a lower bound: abandon the class if that already tells,
+                    # with the same arithmetic as below (it is monotone in ``val``).
+                    floor[i, b] = max(floor[i, b], val)
+                    if total + pb * val + rest >= best - _EPS:
+                        aborted = True
+                        break
+                    val, cv, pv, exact = self.value(q, r_after, math.inf, True)
+                floor[i, b] = val
                 total += pb * val
-                c_sum += pb * cv
-                p_sum += pb * pv
+                kids.append((pb * cv, pb * pv))
                 if total + rest >= best - _EPS:
                     aborted = True
                     break
             if not aborted and total < best - _EPS:
+                done = settled[i]
+                lc, lp = self.leaf_figures_of(pm[i, done], s[i, done])
+                c_sum, p_sum = cost + float(lc.sum()), float(lp.sum())
+                for cv, pv in kids:
+                    c_sum += cv
+                    p_sum += pv
                 best, pick, pick_c, pick_p = total, int(i), c_sum, p_sum
         return best, pick, pick_c, pick_p
+
+    def floor(self, prep: _Prepared, r_after: int) -> FloatArray | None:
+        """The lower bounds ``prep.floor[r_after]`` if still valid at this price, else None.
+
+        ``V(q, r)`` is the least of ``c(pi) - lambda P(pi)`` over the continuations ``pi``,
+        each non-increasing in ``lambda`` (``P >= 0``), so it is non-increasing too: a value
+        (or a lower bound) found at a price is a lower bound at every lower price. The
+        parametric steps lower the price; a step at a higher price starts a new generation
+        (:meth:`set_price`) and the old bounds are dropped.
+        """
+        if not self.use_floor or prep.floor_gen != self.floor_gen:
+            prep.floor = {}
+            prep.floor_gen = self.floor_gen
+        return prep.floor.get(r_after)
+
+    def set_price(self, lam: float) -> None:
+        """Solve at price ``lam`` next (a fresh memo; the floors stay if it is no higher)."""
+        if lam > self.lam:
+            self.floor_gen += 1
+        self.lam = lam
+        self.memo = {}
 
     def prepared(self, key: bytes, q: FloatArray, ti: int) -> tuple[_Prepared, IntArray]:
         """The images of belief ``q`` under kind ``ti``, prepared (kept across prices)."""
@@ -597,16 +702,30 @@ class _Solver:
             self.prep_cache[(key, ti)] = hit
         return hit
 
-    def value(self, q: FloatArray, r: int) -> tuple[float, float, float]:
-        """``V(q, r)`` per unit mass (``q`` normalised), with its cycle cost and success.
+    def value(
+        self, q: FloatArray, r: int, budget: float = math.inf, unsettled: bool = False
+    ) -> tuple[float, float, float, bool]:
+        """``V(q, r)`` per unit mass (``q`` normalised), its cycle cost and success, exactly.
 
-        Memoised with the decision that reaches it.
+        With a finite ``budget`` the caller only needs the value if it is below ``budget``:
+        the search may then stop early and return ``(bound, nan, nan, False)`` with
+        ``V(q, r) >= bound >= budget`` (a cut). Otherwise the last item is True and the value
+        is the one the unbudgeted search finds. Memoised with the decision that reaches it
+        (a cut is memoised as its bound, and searched again for a larger budget).
+
+        ``unsettled``: the caller (:meth:`best_act`) has found the leaf worse than the bound
+        on acting (:meth:`act_bound`, from the images' figures), and any finite budget above
+        that bound: the search acts without computing the bound again.
         """
         qk = self.key(q)
         k = (qk, r)
         hit = self.memo.get(k)
         if hit is not None:
-            return hit[0], hit[2], hit[3]
+            if hit[1] is not None:
+                return hit[0], hit[2], hit[3], True
+            if hit[0] >= budget:
+                return hit[0], math.nan, math.nan, False
+        self.searched += 1
         s, o = self.success(q)
         lam, v, rho = self.lam, self.verify, self.retry
         sf = float(s)
@@ -617,20 +736,31 @@ class _Solver:
             best, decision, c, p = declare, ("declare", int(o)), v + rho * (1 - sf), sf
         else:
             best, decision, c, p = rho, ("reject",), rho, 0.0
-        if r > 0 and best > float(self.act_bound(q)) + _EPS:
+        # An action must beat ``limit - _EPS`` to be taken: the leaf, or the budget when
+        # that is lower (then only a value below the budget is of use).
+        cutting = budget + _EPS < best
+        limit = budget + _EPS if cutting else best
+        if r > 0 and (unsettled or limit > float(self.act_bound(q)) + _EPS):
             for ti, kind in enumerate(self.kinds):
+                if not len(kind.classes):  # an accuracy left no turn of this kind
+                    continue
                 prep, rows = self.prepared(qk, q, ti)
-                val, i, ci, pi = self.best_act(prep, kind.cost, r - 1, best)
+                val, i, ci, pi = self.best_act(prep, kind.cost, r - 1, limit)
                 if i >= 0:
                     best, decision, c, p = val, ("act", ti, int(rows[i])), ci, pi
+                    limit, cutting = val, False
+        if cutting:
+            self.memo[k] = (budget, None, math.nan, math.nan)
+            return budget, math.nan, math.nan, False
         self.memo[k] = (best, decision, c, p)
-        return best, c, p
+        return best, c, p, True
 
     def decision(self, q: FloatArray, r: int) -> tuple[Any, ...]:
         k = (self.key(q), r)
-        if k not in self.memo:
+        hit = self.memo.get(k)
+        if hit is None or hit[1] is None:
             self.value(q, r)
-        return self.memo[k][1]
+        return cast(tuple[Any, ...], self.memo[k][1])
 
 
 # -- building the tree and its figures -----------------------------------------------------
@@ -922,6 +1052,53 @@ def _pairs(space: StateSpace) -> tuple[IntArray, IntArray, NDArray[np.bool_], bo
     return a, b, np.asarray(both, dtype=bool), ok
 
 
+def _solver(space: StateSpace, sens: WidthSensor, prune: Collection[str] = _PRUNE) -> _Solver:
+    """The programme of a state space and sensor (its kinds, bins, goal and bounds)."""
+    main = space.problems[0]
+    cost = main.cost
+    kinds: list[_Kind] = []
+    for action in main.actions:
+        cl = joint_transition(space, action.name)
+        order = np.argsort(-(cl.hi - cl.lo), kind="stable")
+        # with an accuracy, only the turns that keep their effect under any error below it
+        if main.accuracy > 0:
+            order = order[0.5 * (cl.hi - cl.lo)[order] >= main.accuracy]
+        kinds.append(
+            _Kind(
+                action,
+                action.name,
+                cost.action_cost(action.name),
+                cost.action_cost(action.name, first=True),
+                np.ascontiguousarray(cl.transfer[order]),
+                np.asarray(order, dtype=np.intp),
+                cl.mid[order],
+                0.5 * (cl.hi - cl.lo)[order],
+                math.isclose(action.gripper_period, math.pi),
+            )
+        )
+    goal = space.success_matrix()
+    pa, pb, both, paired = _pairs(space)
+    bins = space.bins(sens)
+    pair_lik = np.maximum(bins.likelihood[pa], bins.likelihood[pb]) if paired else np.zeros((0, 1))
+    solver = _Solver(
+        space,
+        bins,
+        kinds,
+        cost.verify,
+        cost.retry,
+        goal,
+        bool(np.array_equal(goal, np.eye(space.n_states, dtype=bool))),
+        pa,
+        pb,
+        both,
+        paired and all(k.pi_symmetric for k in kinds),
+        np.ascontiguousarray(pair_lik),
+        cut="cut" in prune,
+        use_floor="floor" in prune,
+    )
+    return solver
+
+
 def plan_policy(
     problems: Problem | Iterable[Problem],
     sensor: str | WidthSensor = "width",
@@ -932,6 +1109,7 @@ def plan_policy(
     max_first_angles: int = 512,
     max_iterations: int = 50,
     sensorless: bool = True,
+    _prune: Collection[str] = _PRUNE,
 ) -> Policy:
     """The Bayes policy: least expected cost over all policies of at most ``max_actions``.
 
@@ -985,50 +1163,14 @@ def plan_policy(
         raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
     space = StateSpace.build(problems, part_prior)
     main = space.problems[0]
-    accuracy = main.accuracy
-    if any(p.accuracy != accuracy for p in space.problems):
+    if any(p.accuracy != main.accuracy for p in space.problems):
         raise PlanningError(
             "every candidate part's problem must have the same gripper `accuracy`; got "
             + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
         )
     cost = main.cost
-    kinds: list[_Kind] = []
-    for action in main.actions:
-        cl = joint_transition(space, action.name)
-        order = np.argsort(-(cl.hi - cl.lo), kind="stable")
-        # with an accuracy, only the turns that keep their effect under any error below it
-        order = order[0.5 * (cl.hi - cl.lo)[order] >= accuracy] if accuracy > 0 else order
-        kinds.append(
-            _Kind(
-                action,
-                action.name,
-                cost.action_cost(action.name),
-                cost.action_cost(action.name, first=True),
-                np.ascontiguousarray(cl.transfer[order]),
-                np.asarray(order, dtype=np.intp),
-                cl.mid[order],
-                0.5 * (cl.hi - cl.lo)[order],
-                math.isclose(action.gripper_period, math.pi),
-            )
-        )
-    goal = space.success_matrix()
-    pa, pb, both, paired = _pairs(space)
-    bins = space.bins(sens)
-    pair_lik = np.maximum(bins.likelihood[pa], bins.likelihood[pb]) if paired else np.zeros((0, 1))
-    solver = _Solver(
-        space,
-        bins,
-        kinds,
-        cost.verify,
-        cost.retry,
-        goal,
-        bool(np.array_equal(goal, np.eye(space.n_states, dtype=bool))),
-        pa,
-        pb,
-        both,
-        paired and all(k.pi_symmetric for k in kinds),
-        np.ascontiguousarray(pair_lik),
-    )
+    solver = _solver(space, sens, _prune)
+    kinds = solver.kinds
     if first_angles is not None:
         angles = [float(a) for a in first_angles]
         if not angles or not all(math.isfinite(a) for a in angles):
@@ -1062,38 +1204,75 @@ def plan_policy(
 
     root_preps = [solver.prepare(roots[ri : ri + 1]) for ri in range(len(roots))]
 
-    def solve(lam: float) -> tuple[float, int, float]:
-        """``h(lambda)``, the best root, and the ratio of the policy that reaches it."""
-        solver.lam = lam
-        solver.memo = {}
-        h, pick, ratio = math.inf, -1, math.inf
+    def solve(lam: float, above: float, depth: int) -> tuple[float, int, float]:
+        """``h(lambda)``, the best root, and the ratio of the policy that reaches it.
+
+        Only policies of value below ``above - _EPS`` are looked for (pick -1: none).
+        """
+        solver.set_price(lam)
+        h, pick, ratio = above, -1, math.inf
         for ri in range(len(roots)):
             k = kinds[root_kind[ri]]
-            val, i, c, p = solver.best_act(root_preps[ri], k.first_cost, max_actions - 1, h)
+            val, i, c, p = solver.best_act(root_preps[ri], k.first_cost, depth - 1, h)
             if i >= 0:
                 h, pick, ratio = val, ri, (c / p if p > 0 else math.inf)
         return h, pick, ratio
 
-    best_lam, best_ratio, best_pick = lam, math.inf, -1
-    best_memo = solver.memo
+    def dinkelbach(lam: float, depth: int) -> tuple[float, float, int, _Memo, int]:
+        """The parametric search within ``depth`` actions from the known ratio ``lam``.
+
+        Returns the best step's price, ratio, root and memo, and the steps taken.
+        """
+        best_lam, best_ratio, best_pick = lam, math.inf, -1
+        best_memo = solver.memo
+        it = 0
+        for it in range(1, max_iterations + 1):
+            # A known policy has ratio ``lam`` (the start's, or the last step's), so value
+            # about 0 at this price: only a policy below it is of use, and the bound prunes
+            # from the root down. The first step must return a policy (just above 0, or
+            # unbounded if the known one lies outside the first angles tried); a later step
+            # that finds none below ``-_EPS max(1, |lam|)`` has shown ``h >=`` that, which is
+            # the stopping rule.
+            scale = max(1.0, abs(lam))
+            if it == 1:
+                h, pick, ratio = solve(lam, 1e-9 * scale if solver.cut else math.inf, depth)
+                if pick < 0:
+                    h, pick, ratio = solve(lam, math.inf, depth)
+            else:
+                h, pick, ratio = solve(lam, _EPS - _EPS * scale if solver.cut else math.inf, depth)
+                if pick < 0:
+                    break
+            logger.debug(
+                "policy depth %d step %d: lambda %.12g, h %.3g, ratio %.12g, %d beliefs",
+                depth,
+                it,
+                lam,
+                h,
+                ratio,
+                len(solver.memo),
+            )
+            improved = ratio < best_ratio
+            if improved:
+                best_lam, best_ratio, best_pick, best_memo = lam, ratio, pick, solver.memo
+            if h >= -_EPS * scale or not improved:
+                break
+            lam = ratio
+        return best_lam, best_ratio, best_pick, best_memo, it
+
+    # Deepening (noisy readings): the best ratio within K - 1 actions is a known policy's
+    # within K, a much better start than the first one, and the programme's work at the
+    # lower depth (the prepared images, the floors) is of use at the next. (With exact or
+    # quantised readings the search is small and the extra solve does not pay.)
     it = 0
-    for it in range(1, max_iterations + 1):
-        h, pick, ratio = solve(lam)
-        logger.debug(
-            "policy step %d: lambda %.12g, h %.3g, ratio %.12g, %d beliefs",
-            it,
-            lam,
-            h,
-            ratio,
-            len(solver.memo),
-        )
-        improved = ratio < best_ratio
-        if improved:
-            best_lam, best_ratio, best_pick, best_memo = lam, ratio, pick, solver.memo
-        if h >= -_EPS * max(1.0, abs(lam)) or not improved:
-            break
-        lam = ratio
+    first = max_actions - 1 if "deepen" in _prune and sens.sigma > 0 else max_actions
+    for depth in range(max(first, 1), max_actions + 1):
+        best_lam, best_ratio, best_pick, best_memo, steps = dinkelbach(lam, depth)
+        it += steps
+        if math.isfinite(best_ratio):
+            lam = min(lam, best_ratio)
     # The programme at the best price is kept, not solved again (the builder reads it).
+    if best_lam > solver.lam:
+        solver.floor_gen += 1  # the builder may solve more at this higher price
     solver.lam, solver.memo = best_lam, best_memo
     builder = _Builder(solver, max_actions)
     k = kinds[root_kind[best_pick]]
@@ -1146,6 +1325,7 @@ def _finish(
         len(builder.solver.memo),
         angles_exact,
         units,
+        builder.solver.searched,
     )
 
 
