@@ -8,7 +8,7 @@ STAMP_DEV := $(VENV)/.installed-dev
 CHROMIUM := /usr/bin/chromium
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: demo test lint bench clean browser-deps
+.PHONY: demo test quick lint bench clean browser-deps
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -38,6 +38,11 @@ browser-deps:
 
 test: lint browser-deps
 	$(BIN)/python -m pytest -q
+
+# The quick run while working: no MuJoCo, Dask, browser or long statistical tests (CI runs
+# `make test`, which runs them all).
+quick: $(STAMP_DEV)
+	$(BIN)/python -m pytest -q -m "not physics and not dask and not browser and not slow"
 
 bench: $(STAMP_RUN)
 	for f in benchmarks/bench_*.py; do $(BIN)/python $$f || exit 1; done

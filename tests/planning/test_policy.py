@@ -69,11 +69,16 @@ def ref_bins(widths: np.ndarray, sigma: float, res: float) -> np.ndarray:
 
 
 def ref_classes(problems: Sequence[Problem], kind: str) -> np.ndarray:
-    """Joint transfer (A, N): each part's transfer at the middle of every common class."""
+    """Joint transfer (A, N): each part's transfer at the middle of every common class.
+
+    With a gripper accuracy, only the classes at least twice as wide as it (a turn at their
+    middle keeps its effect under any error below the accuracy).
+    """
     period = problems[0].action(kind).gripper_period
     crit = np.unique(np.concatenate([np.mod(p.transition(kind).lo, period) for p in problems]))
     crit = crit[np.append(True, np.diff(crit) > 1e-9)]
-    mids = 0.5 * (crit + np.append(crit[1:], crit[0] + period))
+    ends = np.append(crit[1:], crit[0] + period)
+    mids = 0.5 * (crit + ends)[0.5 * (ends - crit) >= problems[0].accuracy]
     cols, offset = [], 0
     for p in problems:
         f = p.transfer(kind)
@@ -553,9 +558,59 @@ def test_bad_input_is_a_clear_error(kwargs: dict, match: str) -> None:
         plan_policy(build(QUAD), **{"sensor": "width", **kwargs})
 
 
-def test_accuracy_is_refused() -> None:
-    with pytest.raises(PlanningError, match="accuracy"):
-        plan_policy(build(QUAD, accuracy=0.01), "width")
+def test_candidate_parts_must_share_the_accuracy() -> None:
+    with pytest.raises(PlanningError, match="same gripper `accuracy`"):
+        plan_policy([build(QUAD, accuracy=0.01), build(TRIANGLE)], "width")
+
+
+@pytest.mark.parametrize(("sigma", "res"), SENSORS, ids=["exact", "quantised", "noisy"])
+@pytest.mark.parametrize(("name", "parts", "actions", "prior"), CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize("accuracy_deg", [3.0, 12.0])
+def test_planner_with_an_accuracy_equals_and_or_search(
+    name: str,
+    parts: list[list[tuple[float, float]]],
+    actions: tuple[str, ...],
+    prior: tuple[float, ...] | None,
+    sigma: float,
+    res: float,
+    accuracy_deg: float,
+) -> None:
+    acc = math.radians(accuracy_deg)
+    problems = [build(p, actions=actions, accuracy=acc) for p in parts]
+    pol = plan_policy(problems, WidthSensor(sigma, res), 2, part_prior=prior)
+    ref = reference_cost(problems, sigma, res, 2, prior)
+    assert_allclose(pol.expected_cost, ref, rtol=0, atol=1e-9)
+    check_claims(pol)
+    assert all(m >= acc for m in margins(pol.root))
+
+
+def margins(node: PolicyNode) -> list[float]:
+    """The margins of every node below the root (the root's first angle is not bounded)."""
+    out: list[float] = []
+    for b in node.branches:
+        if isinstance(b.next, PolicyNode):
+            out += [b.next.margin, *margins(b.next)]
+    return out
+
+
+def test_accuracy_restricts_the_search() -> None:
+    """Not vacuous: on these parts an accuracy removes turns the exact policy would make."""
+    exact, changed = 0, 0
+    for _, parts, actions, prior in CASES:
+        for sigma, res in SENSORS:
+            costs = [
+                plan_policy(
+                    [build(p, actions=actions, accuracy=math.radians(a)) for p in parts],
+                    WidthSensor(sigma, res),
+                    2,
+                    part_prior=prior,
+                ).expected_cost
+                for a in (0.0, 12.0)
+            ]
+            assert costs[1] >= costs[0] - 1e-12  # a restriction never helps
+            exact += 1
+            changed += costs[1] > costs[0] + 1e-9
+    assert changed >= 3, (changed, exact)
 
 
 def test_sensor_error_is_a_value_error() -> None:

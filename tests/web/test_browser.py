@@ -319,3 +319,33 @@ def test_drag_undo_and_figures(server: str, page: Any) -> None:
         "document.getElementById('fig-plan').naturalWidth > 0"
         " && document.getElementById('fig-transfer').naturalWidth > 0"
     )
+
+
+def _policy_tree(page: Any) -> str:
+    page.click("#policy")
+    page.wait_for_function("['done', 'error'].includes(document.body.dataset.policy)")
+    text = str(page.locator("#policy-tree").text_content())
+    page.evaluate("delete document.body.dataset.policy")
+    return text
+
+
+def test_sensing_policy_reads_as_the_cli(server: str, page: Any) -> None:
+    from bayesgrasp import shapes
+    from bayesgrasp.model import Problem
+    from bayesgrasp.planning.policy import plan_policy, policy_text
+
+    page.goto(server + "/#part=house")
+    page.wait_for_selector("#plans tbody tr")
+    pb = Problem.build(shapes.load("house"))
+    exact = _policy_tree(page)
+    assert exact == policy_text(plan_policy(pb, "width", 3), min_probability=0.01)
+    assert "expected cost 4.58" in str(page.locator("#policy-summary").text_content())
+    # noisy readings: a bin for every encoder step; the small ones are folded into one line
+    page.fill("#sense", "width:0.5,0.1")
+    page.fill("#sense-depth", "2")
+    noisy = _policy_tree(page)
+    assert noisy == policy_text(plan_policy(pb, "width:0.5,0.1", 2), min_probability=0.01)
+    assert "more reading intervals" in noisy
+    page.fill("#sense", "width:-1,1")
+    assert _policy_tree(page) == ""
+    assert "sigma" in str(page.locator("#policy-summary.error").text_content())

@@ -22,6 +22,10 @@ CliJson = Callable[..., tuple[int, Any]]
             ["house", "--sense", "width:0.5,0.1", "--max-actions", "2"],
         ),
         (
+            {"part": {"catalogue": "key"}, "sense": "width:0.5,0.1", "accuracy": 10},
+            ["key", "--sense", "width:0.5,0.1", "--accuracy", "10"],
+        ),
+        (
             {"part": {"catalogue": "key"}, "actions": "squeeze,push-grasp", "verify_cost": 3},
             ["key", "--sense", "width", "--actions", "squeeze,push-grasp", "--verify-cost", "3"],
         ),
@@ -56,7 +60,6 @@ def test_policy_equals_cli(
         ({"part_prior": [1, 2]}, "one weight per part"),
         ({"max_actions": 0}, "max_actions"),
         ({"max_actions": 9}, "max_actions"),
-        ({"accuracy": 1}, "accuracy"),
         ({"also": [{"catalogue": "no-such-part"}]}, "not a catalogue part"),
     ],
 )

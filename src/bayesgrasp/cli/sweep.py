@@ -10,7 +10,7 @@ from typing import Annotated, Any
 import typer
 
 from .common import emit_json, with_progress
-from .options import JsonOpt, command_app, problem_options
+from .options import FLATTEN_HELP, SHAPE_HELP, JsonOpt, command_app, problem_options
 from .specs import Engine, ProblemSpec
 
 app = command_app()
@@ -60,6 +60,21 @@ def sweep(
         Path | None, typer.Option("--report", metavar="FILE.html", help="Also write a report.")
     ] = None,
     guaranteed: Annotated[bool, typer.Option(help="Also find each part's guaranteed plan.")] = True,
+    sense: Annotated[
+        str | None,
+        typer.Option(
+            "--sense",
+            metavar="width[:SIGMA,RES]",
+            help="Also plan each part's Bayes policy on jaw-width readings, as plan --sense "
+            "(SIGMA and RES in each part's units): the policy_* columns.",
+        ),
+    ] = None,
+    max_actions: Annotated[
+        int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
+    ] = 3,
+    layer: Annotated[str | None, typer.Option(help="DXF: read only this layer.")] = None,
+    flatten_tol: Annotated[float | None, typer.Option(help=FLATTEN_HELP)] = None,
+    shape_tol: Annotated[float, typer.Option(min=0, help=SHAPE_HELP)] = 0.0,
     as_json: JsonOpt = False,
 ) -> None:
     """Plan every part of a catalogue on a Dask cluster: one row a part in RESULTS.
@@ -95,6 +110,11 @@ def sweep(
         simulate=simulate.value if simulate else None,
         trials=trials,
         seed=seed,
+        layer=layer,
+        flatten_tol=flatten_tol,
+        shape_tol=shape_tol,
+        sense=sense,
+        sense_max_actions=max_actions,
     )
 
     def work(progress: Any) -> Any:

@@ -126,9 +126,14 @@ for a sample prior, a midpoint between them): the planner tries them all when th
 most ``max_first_angles`` (exact), else those of the sensorless exact plans plus a grid of
 360 (then ``Policy.first_angle_exact`` is False).
 
-The planner assumes exact gripper turns (``Problem.accuracy`` must be 0); each node's
-``margin`` is half the width of its action class, how far the turn may err without changing
-the effect on any state.
+Each node's ``margin`` is half the width of its action class: how far the turn may err
+without changing the effect on any state. With a gripper ``accuracy`` (``Problem.accuracy``,
+the bound on the error of every turn after the first, as for plans) only classes of half
+width at least ``accuracy`` are turns a later node may make: a turn at the class's middle
+then has the class's effect under any error below ``accuracy``, so the policy, its readings
+and its figures are exactly those of the model for every such error (the first action's
+angle is in the world frame, as for plans, and is not bounded by it). The policy is the
+best of those policies; ``accuracy = 0`` is the unrestricted search.
 
 Examples
 --------
@@ -512,9 +517,10 @@ class _Solver:
         if pattern is None:
             pattern = kind.patterns[pos.tobytes()] = self.pattern(pos, kind)
         first, idx, m = pattern
-        w = np.broadcast_to(q[pos], (m, len(idx) // m)).ravel()
-        out = np.bincount(idx, weights=w, minlength=m * self.space.n_states)
-        return np.asarray(out.reshape(m, -1), dtype=np.float64), first
+        n = self.space.n_states
+        w = np.broadcast_to(q[pos], (m, int(np.count_nonzero(pos)))).ravel()
+        out = np.bincount(idx, weights=w, minlength=m * n)
+        return np.asarray(out.reshape(m, n), dtype=np.float64), first
 
     def pattern(self, pos: NDArray[np.bool_], kind: _Kind) -> tuple[IntArray, IntArray, int]:
         """The distinct effects of ``kind`` on a belief of support ``pos``.
@@ -601,6 +607,8 @@ class _Solver:
         pm, s = prep.mass, prep.success
         leaf = np.minimum(rho * pm, (v + rho) * pm - (lam + rho) * s)  # (M, B): leaves
         ub = cost + leaf.sum(axis=1)
+        if len(ub) == 0:  # no class of this kind is allowed (a gripper accuracy)
+            return best, -1, math.nan, math.nan
         if r_after == 0:
             i = int(np.argmin(ub))
             if ub[i] < best - _EPS:
@@ -1053,6 +1061,9 @@ def _solver(space: StateSpace, sens: WidthSensor, prune: Collection[str] = _PRUN
     for action in main.actions:
         cl = joint_transition(space, action.name)
         order = np.argsort(-(cl.hi - cl.lo), kind="stable")
+        # with an accuracy, only the turns that keep their effect under any error below it
+        accuracy = main.accuracy
+        order = order[0.5 * (cl.hi - cl.lo)[order] >= accuracy] if accuracy > 0 else order
         kinds.append(
             _Kind(
                 action,
@@ -1137,8 +1148,8 @@ def plan_policy(
     SensorError
         On a bad sensor or part prior.
     PlanningError
-        If ``max_actions < 1``, the problems' actions differ, or a problem has a gripper
-        ``accuracy`` (the planner assumes exact turns).
+        If ``max_actions < 1``, the problems' actions differ, or their gripper accuracies
+        differ (one gripper turns for every candidate part).
 
     Examples
     --------
@@ -1153,11 +1164,11 @@ def plan_policy(
         raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
     space = StateSpace.build(problems, part_prior)
     main = space.problems[0]
-    if any(p.accuracy > 0 for p in space.problems):
+    accuracy = main.accuracy
+    if any(p.accuracy != accuracy for p in space.problems):
         raise PlanningError(
-            "the policy planner assumes exact gripper turns: the problem's `accuracy` must be "
-            f"0; got {max(p.accuracy for p in space.problems):.6g} rad = "
-            f"{math.degrees(max(p.accuracy for p in space.problems)):g} deg"
+            "every candidate part's problem must have the same gripper `accuracy`; got "
+            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
         )
     cost = main.cost
     solver = _solver(space, sens, _prune)
@@ -1412,7 +1423,7 @@ def policy_text(
             s = "" if left_out == 1 else "s"
             lines.append(
                 f"{pad}  ({left_out} more reading interval{s}, p = {prob(left_p)} in all, "
-                "left out here: --json lists every branch)"
+                "left out here; the JSON document lists every branch)"
             )
 
     walk(policy.root, 0, True)

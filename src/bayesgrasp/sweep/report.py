@@ -126,6 +126,11 @@ def _table(head: Sequence[str], body: Sequence[Sequence[Any]]) -> str:
     return "\n".join([*lines, "</table>"])
 
 
+def _fmean_or_none(xs: Sequence[float]) -> float | None:
+    """The mean, or ``None`` of no values."""
+    return statistics.fmean(xs) if xs else None
+
+
 def _num(x: float | None, digits: int = 4) -> str:
     return "-" if x is None or not math.isfinite(x) else f"{x:.{digits}g}"
 
@@ -177,6 +182,15 @@ def report_html(
             ("Bayes cost: median", _num(statistics.median(costs))),
             ("Bayes cost: max", _num(max(costs))),
             ("Bayes plan length: mean", _num(statistics.fmean(lengths), 3)),
+        ]
+    sensed = [r for r in planned if r.get("policy_cost") is not None]
+    if sensed:  # rows of a sweep with --sense: what reading the jaw width buys
+        acts = statistics.fmean(r["policy_actions"] for r in sensed)
+        ratio = [r["policy_cost"] / r["bayes_cost"] for r in sensed if r["bayes_cost"]]
+        summary += [
+            ("sensing policy cost: mean", _num(statistics.fmean(r["policy_cost"] for r in sensed))),
+            ("sensing policy actions a cycle: mean", _num(acts, 3)),
+            ("sensing policy cost / Bayes plan cost: mean", _num(_fmean_or_none(ratio), 3)),
         ]
     if sims:
         summary += [

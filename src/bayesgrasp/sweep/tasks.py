@@ -112,6 +112,13 @@ class SweepOptions:
         Manufacturing tolerance of every part, in its units (``--shape-tol``): minima of the
         width it could lose are not states (0: none; left out of :meth:`to_json` then, so
         the keys of sweeps run before it existed still resume).
+    sense : str, optional
+        Also plan each part's Bayes sensing policy with this jaw-width sensor (``width`` or
+        ``width:SIGMA,RES`` in each part's units, as ``plan --sense``); its cost, success
+        and actions fill the ``policy_*`` columns. ``None`` (default): no policy, and left
+        out of :meth:`to_json` like ``sense_max_actions``.
+    sense_max_actions : int
+        The policy's depth (``plan --sense ... --max-actions``).
 
     Examples
     --------
@@ -144,6 +151,8 @@ class SweepOptions:
     layer: str | None = None
     flatten_tol: float | None = None
     shape_tol: float = 0.0
+    sense: str | None = None
+    sense_max_actions: int = 3
 
     def __post_init__(self) -> None:
         for name in ("squeeze_cost", "push_grasp_cost", "verify_cost", "retry_cost"):
@@ -178,6 +187,13 @@ class SweepOptions:
                 raise SweepError(f"`{name}` must be None or an integer >= 1; got {v!r}")
         if self.offset_mm > 0 and self.simulate != "mujoco":
             raise SweepError("`offset_mm` applies to simulate='mujoco' only")
+        v = self.sense_max_actions
+        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 8:
+            raise SweepError(f"`sense_max_actions` must be an integer in [1, 8]; got {v!r}")
+        if self.sense is not None:
+            from ..model.sensing import parse_sensor
+
+            parse_sensor(self.sense)  # a malformed sensor: SensorError saying why
 
     @property
     def n_trials(self) -> int:
@@ -192,6 +208,8 @@ class SweepOptions:
         out["actions"] = list(self.actions)
         if not self.shape_tol:
             del out["shape_tol"]
+        if self.sense is None:
+            del out["sense"], out["sense_max_actions"]
         return out
 
     @classmethod
@@ -317,6 +335,10 @@ ROW_COLUMNS: tuple[tuple[str, type], ...] = (
     ("sim_jams", int),
     ("sim_seconds", float),
     ("plan_seconds", float),
+    ("policy_cost", float),  # with `sense`: the Bayes policy's expected cost
+    ("policy_success", float),
+    ("policy_actions", float),  # expected actions a cycle
+    ("policy_json", str),  # the document `bayesgrasp plan PATH --sense ... --json` prints
     ("outline", str),  # JSON: the outline's points (for the report's drawings)
     ("plan_json", str),  # the document `bayesgrasp plan PATH --json` prints
     ("sim_json", str),  # the document `bayesgrasp simulate PATH --json` prints
@@ -480,6 +502,21 @@ def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
     return doc
 
 
+def _policy(row: dict[str, Any], problem: Any, options: SweepOptions) -> None:
+    """The ``policy_*`` columns: the part's Bayes sensing policy (``plan --sense --json``)."""
+    from ..io.policies import policy_document
+    from ..planning.policy import plan_policy
+
+    pol = plan_policy(problem, sensor=str(options.sense), max_actions=options.sense_max_actions)
+    doc = policy_document(pol)
+    row.update(
+        policy_cost=doc["expected_cost"],
+        policy_success=doc["success_probability"],
+        policy_actions=doc["expected_actions"],
+        policy_json=json.dumps(doc, allow_nan=False, separators=(",", ":")),
+    )
+
+
 def _fill(row: dict[str, Any], part: Any, doc: dict[str, Any]) -> None:
     """The row's plan columns, all taken from the plan document."""
     info = doc["part"]
@@ -555,6 +592,11 @@ def plan_part(
     except Exception as exc:  # a bad part is a row; a bug in it too, with its class
         row["plan_seconds"] = time.perf_counter() - t0
         return _error(row, exc)
+    if options.sense is not None:
+        try:
+            _policy(row, rep.problem, options)
+        except Exception as exc:
+            _error(row, exc)
     row["plan_seconds"] = time.perf_counter() - t0
     if options.simulate is not None:
         t1 = time.perf_counter()

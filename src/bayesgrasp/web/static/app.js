@@ -483,6 +483,78 @@ async function showFigures() {
   }
 }
 
+// ---- the sensing policy (POST /policy: the document of plan --sense --json) ---------------
+
+const FOLD_BELOW = 0.01; // branches below this probability at their node are told as one line
+
+function prob(p) {
+  // as policy_text: two decimals, or two significant digits below 0.01 ("4.6e-13")
+  if (p >= 0.01 || p === 0) return p.toFixed(2);
+  const [m, e] = p.toExponential(1).split("e");
+  const n = Math.abs(Number(e));
+  return `${m}e${Number(e) < 0 ? "-" : "+"}${String(n).padStart(2, "0")}`;
+}
+
+function policyLines(node, depth, first, unit, lines) {
+  // the tree as policy_text prints it (bayesgrasp/planning/policy.py), small branches folded
+  const pad = "  ".repeat(depth);
+  const deg = (r) => `${((r * 180) / Math.PI).toFixed(2)} deg`;
+  const act = node.action;
+  lines.push(first ? `${pad}${act.type} with the gripper at ${deg(act.alpha_rad)}` : `${pad}turn ${deg(act.alpha_rad)}, ${act.type}`);
+  let folded = 0, foldedP = 0;
+  for (const b of node.branches) {
+    if (b.probability < FOLD_BELOW) {
+      folded += 1;
+      foldedP += b.probability;
+      continue;
+    }
+    const [lo, hi] = b.reading;
+    const reads =
+      lo === null && hi === null ? "any width"
+      : lo === null ? `the width reads below ${hi.toFixed(2)}${unit}`
+      : hi === null ? `the width reads ${lo.toFixed(2)}${unit} or more`
+      : `the width reads in [${lo.toFixed(2)}, ${hi.toFixed(2)})${unit}`;
+    const cond = `${pad}  if ${reads} (p = ${prob(b.probability)})`;
+    const n = b.next;
+    if (n.action) {
+      lines.push(cond + ":");
+      policyLines(n, depth + 2, false, unit, lines);
+    } else if (n.reject) lines.push(`${cond}: reject (back to the feeder)`);
+    else {
+      const what = state.policyParts > 1 ? `part '${n.declare.part}' at ` : "";
+      lines.push(`${cond}: declare ${what}${deg(n.declare.orientation_rad)} (success ${n.success_probability.toFixed(2)})`);
+    }
+  }
+  if (folded) {
+    const s = folded > 1 ? "s" : "";
+    lines.push(`${pad}  (${folded} more reading interval${s}, p = ${prob(foldedP)} in all, left out here; the JSON document lists every branch)`);
+  }
+  return lines;
+}
+
+async function showPolicy() {
+  const o = options();
+  const body = { part: partBody(), ...o, sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
+  $("policy-summary").textContent = "planning the policy...";
+  $("policy-tree").textContent = "";
+  try {
+    const doc = await post("/policy", body);
+    state.policyParts = doc.parts.length;
+    const units = state.last && state.last.plan ? state.last.plan.part.units : null;
+    $("policy-tree").textContent = policyLines(doc.root, 0, true, units ? ` ${units}` : "", []).join("\n");
+    const blind = doc.sensorless_cost === null ? "" : ` (sensorless Bayes plan ${doc.sensorless_cost.toFixed(4)})`;
+    $("policy-summary").textContent =
+      `expected cost ${doc.expected_cost.toFixed(4)}${blind}, success ${doc.success_probability.toFixed(4)} a cycle, ` +
+      `${doc.expected_actions.toFixed(3)} actions a cycle`;
+    $("policy-summary").classList.remove("error");
+    document.body.dataset.policy = "done";
+  } catch (err) {
+    $("policy-summary").textContent = String(err.message || err);
+    $("policy-summary").classList.add("error");
+    document.body.dataset.policy = "error";
+  }
+}
+
 // ---- catalogue, file, gallery --------------------------------------------------------------
 
 async function loadCatalogue() {
@@ -557,6 +629,7 @@ function start() {
   $("plan").addEventListener("click", run);
   $("play").addEventListener("click", play);
   $("figures").addEventListener("click", showFigures);
+  $("policy").addEventListener("click", showPolicy);
   $("options").addEventListener("change", schedule);
   window.addEventListener("hashchange", () => { readHash(); drawCanvas(); schedule(); });
   loadCatalogue().then(() => {
