@@ -517,10 +517,9 @@ class _Solver:
         if pattern is None:
             pattern = kind.patterns[pos.tobytes()] = self.pattern(pos, kind)
         first, idx, m = pattern
-        n = self.space.n_states
-        w = np.broadcast_to(q[pos], (m, int(np.count_nonzero(pos)))).ravel()
-        out = np.bincount(idx, weights=w, minlength=m * n)
-        return np.asarray(out.reshape(m, n), dtype=np.float64), first
+        w = np.broadcast_to(q[pos], (m, len(idx) // m)).ravel()
+        out = np.bincount(idx, weights=w, minlength=m * self.space.n_states)
+        return np.asarray(out.reshape(m, -1), dtype=np.float64), first
 
     def pattern(self, pos: NDArray[np.bool_], kind: _Kind) -> tuple[IntArray, IntArray, int]:
         """The distinct effects of ``kind`` on a belief of support ``pos``.
@@ -607,8 +606,6 @@ class _Solver:
         pm, s = prep.mass, prep.success
         leaf = np.minimum(rho * pm, (v + rho) * pm - (lam + rho) * s)  # (M, B): leaves
         ub = cost + leaf.sum(axis=1)
-        if len(ub) == 0:  # no class of this kind is allowed (a gripper accuracy)
-            return best, -1, math.nan, math.nan
         if r_after == 0:
             i = int(np.argmin(ub))
             if ub[i] < best - _EPS:
@@ -745,6 +742,8 @@ class _Solver:
         limit = budget + _EPS if cutting else best
         if r > 0 and (unsettled or limit > float(self.act_bound(q)) + _EPS):
             for ti, kind in enumerate(self.kinds):
+                if not len(kind.classes):  # an accuracy left no turn of this kind
+                    continue
                 prep, rows = self.prepared(qk, q, ti)
                 val, i, ci, pi = self.best_act(prep, kind.cost, r - 1, limit)
                 if i >= 0:
@@ -1062,8 +1061,8 @@ def _solver(space: StateSpace, sens: WidthSensor, prune: Collection[str] = _PRUN
         cl = joint_transition(space, action.name)
         order = np.argsort(-(cl.hi - cl.lo), kind="stable")
         # with an accuracy, only the turns that keep their effect under any error below it
-        accuracy = main.accuracy
-        order = order[0.5 * (cl.hi - cl.lo)[order] >= accuracy] if accuracy > 0 else order
+        if main.accuracy > 0:
+            order = order[0.5 * (cl.hi - cl.lo)[order] >= main.accuracy]
         kinds.append(
             _Kind(
                 action,
@@ -1164,8 +1163,7 @@ def plan_policy(
         raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
     space = StateSpace.build(problems, part_prior)
     main = space.problems[0]
-    accuracy = main.accuracy
-    if any(p.accuracy != accuracy for p in space.problems):
+    if any(p.accuracy != main.accuracy for p in space.problems):
         raise PlanningError(
             "every candidate part's problem must have the same gripper `accuracy`; got "
             + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
