@@ -9,6 +9,8 @@ optimal expected cost unchanged (to 1e-9); the exhaustive AND-OR test in
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -44,6 +46,7 @@ def agree(a: Policy, b: Policy) -> None:
     depth=st.integers(1, 3),
     actions=st.sampled_from(ACTIONS),
     verify=st.sampled_from([1.0, 4.0]),
+    accuracy_deg=st.sampled_from([0.0, 0.0, 3.0]),
 )
 def test_prunings_keep_the_optimum(
     seed: int,
@@ -53,8 +56,11 @@ def test_prunings_keep_the_optimum(
     depth: int,
     actions: tuple[str, ...],
     verify: float,
+    accuracy_deg: float,
 ) -> None:
-    pb = Problem.build(random_polygon(seed, points), actions=actions, cost=CostModel(verify=verify))
+    acc = math.radians(accuracy_deg)
+    cost = CostModel(verify=verify)
+    pb = Problem.build(random_polygon(seed, points), actions=actions, cost=cost, accuracy=acc)
     if depth == 3 and len(actions) > 1:
         depth = 2  # mixed noisy push-grasp trees at depth 3 take seconds without pruning
     sensor = noisy(pb, rel, res)
