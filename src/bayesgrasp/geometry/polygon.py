@@ -400,6 +400,8 @@ class ConvexPolygon:
     size: float = field(init=False)
     # symmetry_order once known; -k when only known to be below k; 0 before any test.
     _symmetry: int = field(init=False, repr=False)
+    # The vertices' x and y as Python floats (for the plain-Python paths), once asked for.
+    _xy: tuple[list[float], list[float]] | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         _check_tolerance(self.tol)
@@ -433,6 +435,16 @@ class ConvexPolygon:
         object.__setattr__(self, "centroid", centroid)
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "_symmetry", 0)
+        object.__setattr__(self, "_xy", None)
+
+    def _coords(self) -> tuple[list[float], list[float]]:
+        """The vertices' x and y coordinates as lists of Python floats (made once)."""
+        xy = self._xy
+        if xy is None:
+            xs, ys = self.vertices.T.tolist()
+            xy = (xs, ys)
+            object.__setattr__(self, "_xy", xy)
+        return xy
 
     @classmethod
     def _trusted(
