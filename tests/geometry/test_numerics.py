@@ -442,7 +442,8 @@ def test_symmetry_order_python_and_numpy_agree(n: int) -> None:
         poly = ConvexPolygon.from_points(near_regular(n, noise, rng))
         eps = poly.tol.symmetry_for(poly.size)
         orders = [r for r in range(2, n + 1) if n % r == 0][::-1]
-        expected = polygon._symmetry_order_python(poly.vertices, poly.centroid, orders, eps)
+        xs, ys = poly.vertices.T.tolist()
+        expected = polygon._symmetry_order_python(xs, ys, poly.centroid, orders, eps)
         assert poly.symmetry_order == expected
         # Asking for the orders from 3 up first, then for all, gives the same answers.
         fresh = ConvexPolygon.from_points(poly.vertices)
