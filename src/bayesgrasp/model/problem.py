@@ -266,7 +266,10 @@ class Problem:
     @property
     def action_kinds(self) -> tuple[str, ...]:
         """Names of the available actions, in order."""
-        return tuple(a.name for a in self.actions)
+        kinds: tuple[str, ...] | None = self._cache.get("kinds")
+        if kinds is None:  # planners ask often: made once
+            kinds = self._cache["kinds"] = tuple(a.name for a in self.actions)
+        return kinds
 
     def action(self, name: str | Action) -> Action:
         """The action of that name: the problem's own first, else the registry's."""
@@ -302,11 +305,12 @@ class Problem:
     @property
     def goal_group(self) -> int:
         """Number of orientations the goal counts as one (the part's symmetry only if asked)."""
-        if "goal_group" not in self._cache:
+        group: int | None = self._cache.get("goal_group")
+        if group is None:
             # The symmetry test only when the goal counts symmetric orientations as one.
             order = self.part.hull.symmetry_order if self.goal.kind == "symmetry" else 1
-            self._cache["goal_group"] = self.goal.group_order(order)
-        return int(self._cache["goal_group"])
+            group = self._cache["goal_group"] = int(self.goal.group_order(order))
+        return group
 
     def success_states(self, final_orientation: float) -> NDArray[np.bool_]:
         """Which states succeed when a plan ends at ``final_orientation`` (see :class:`Goal`)."""
