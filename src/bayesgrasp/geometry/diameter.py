@@ -524,9 +524,12 @@ def _merged(extrema: Extrema, origin: float, period: float) -> list[Extremum]:
         raise BayesGraspError(
             f"internal error: {len(min_at)} minima and {len(max_at)} maxima of the diameter"
         )
+    at = [(x - origin) % period for x in min_at + max_at]
+    if period in at:  # _wrap1: % can round a tiny negative up to the period
+        at = [0.0 if x >= period else x for x in at]
     return sorted(
         zip(
-            [_wrap1(x - origin, period) for x in min_at + max_at],
+            at,
             min_d + max_d,
             [False] * len(min_at) + [True] * len(max_at),
             strict=True,

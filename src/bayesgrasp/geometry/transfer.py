@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -319,7 +320,9 @@ def _from_sorted(
     # The boundary above each stable orientation (wrapping past 2 pi). They alternate when
     # that index counts up by one: 0, 1, ..., K - 1 or 1, 2, ..., K.
     k0 = bisect.bisect_right(bounds, stable[0])
-    if k0 > 1 or any(bisect.bisect_right(bounds, x) != k0 + i for i, x in enumerate(stable)):
+    if k0 > 1 or list(map(functools.partial(bisect.bisect_right, bounds), stable)) != list(
+        range(k0, k0 + n)
+    ):
         raise BayesGraspError(  # pragma: no cover - a bug
             "internal error: extrema of the transfer function do not alternate"
         )
@@ -370,7 +373,8 @@ def squeeze_function(
     d = part if isinstance(part, DiameterFunction) else diameter_function(part)
     tol = d.polygon.tol.angle
     pi = math.pi
-    stable, bounds = ([*x, *[_wrap(a + pi) for a in x]] for x in d.extrema)  # x in [0, pi)
+    # x in [0, pi): a + pi is no tiny negative, so % needs none of _wrap's care.
+    stable, bounds = ([*x, *[(a + pi) % TWO_PI for a in x]] for x in d.extrema)
     stable.sort()
     bounds.sort()
     half_turn = 2 if tol >= _HALF_TURN_TOL else 1
