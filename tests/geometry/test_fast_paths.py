@@ -288,3 +288,26 @@ def test_symmetric_parts_keep_exact_periods() -> None:
     assert s.n_states == 12 and s.period == pytest.approx(math.pi / 6, abs=1e-12)
     assert_allclose(np.diff(s.stable), math.pi / 6, atol=1e-12)
     assert_allclose(np.diff(d.minima), math.pi / 6, atol=1e-12)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("at", [(0, 0), (4, 1), (9, 0)])
+def test_small_arrays_refuse_non_finite_points_as_before(bad: float, at: tuple[int, int]) -> None:
+    pts = np.random.default_rng(0).uniform(size=(10, 2))
+    pts[at] = bad
+    with pytest.raises(PartError) as general:
+        polygon.as_points(pts)
+    with pytest.raises(PartError) as small:
+        Part.from_points(pts)
+    assert str(small.value) == str(general.value)
+
+
+def test_small_arrays_whose_sum_overflows_take_the_general_check() -> None:
+    pts = np.array([[1e308, 0.0], [1.5e308, 1.0], [1.6e308, -1.0]])  # finite; the sum is not
+    with pytest.raises(PartError, match="at most 1e\\+150 in absolute value"):
+        Part.from_points(pts)
+    big = np.array([[1e140, 0.0], [2e140, 1e140], [0.0, 3e140]])
+    part = Part.from_points(big)
+    assert_array_equal(part.outline, big)
+    assert not part.outline.flags.writeable
+    assert part.outline is not big  # a copy, as as_points makes

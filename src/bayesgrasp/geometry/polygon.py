@@ -278,7 +278,10 @@ def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
 
 
 def _hull_python(
-    pts: FloatArray, eps: float, coords: tuple[list[float], list[float]] | None = None
+    pts: FloatArray,
+    eps: float,
+    coords: tuple[list[float], list[float]] | None = None,
+    ordered: list[tuple[float, float]] | None = None,
 ) -> tuple[list[float], list[float], float, float, float]:
     """Hull, area and centroid of a few points in plain Python.
 
@@ -292,9 +295,9 @@ def _hull_python(
     area, cx, cy : float
         Area and centroid (area 0 when degenerate).
     """
-    px, py = coords if coords is not None else pts.T.tolist()
-    # Sorting the (x, y) pairs: the order of np.lexsort (equal pairs are the same point).
-    ordered = sorted(zip(px, py, strict=True))
+    if ordered is None:  # else the caller sorted them (and gives the list away)
+        px, py = coords if coords is not None else pts.T.tolist()
+        ordered = _sorted_pairs(px, py)
     lower = _chain_python(ordered)
     ordered.reverse()
     hull = lower[:-1] + _chain_python(ordered)[:-1]
@@ -340,6 +343,11 @@ def _hull_python(
         return xs, ys, 0.0, 0.0, 0.0
     unit = scale / (3.0 * twice)
     return xs, ys, 0.5 * twice * scale * scale, cx * unit + ox, cy * unit + oy
+
+
+def _sorted_pairs(px: list[float], py: list[float]) -> list[tuple[float, float]]:
+    """The (x, y) pairs sorted: the order of ``np.lexsort`` (equal pairs are the same point)."""
+    return sorted(zip(px, py, strict=True))
 
 
 def _chain_python(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -515,13 +523,18 @@ class ConvexPolygon:
         return cls._hull_of(as_points(points), tol)
 
     @classmethod
-    def _hull_of(cls, pts: FloatArray, tol: Tolerance) -> ConvexPolygon:
-        """:meth:`from_points` of points already checked by :func:`as_points`."""
-        coords = None
+    def _hull_of(
+        cls, pts: FloatArray, tol: Tolerance, coords: tuple[list[float], list[float]] | None = None
+    ) -> ConvexPolygon:
+        """:meth:`from_points` of points already checked by :func:`as_points`.
+
+        ``coords``: the points' x and y as Python floats, when the caller has them.
+        """
+        ordered = None
         if 3 <= len(pts) <= _SMALL:  # the extent and magnitude on Python floats (same values)
-            px, py = pts.T.tolist()
-            coords = (px, py)
-            x0, x1, y0, y1 = min(px), max(px), min(py), max(py)
+            px, py = coords if coords is not None else pts.T.tolist()
+            ordered = _sorted_pairs(px, py)  # by x first: the least and largest x at the ends
+            x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], min(py), max(py)
             extent = max(x1 - x0, y1 - y0)
             # The largest |coordinate| is the largest of max and -min.
             if max(x1, -x0, y1, -y0) > _MAX_COORD or 0.0 < extent < _MIN_EXTENT:
@@ -534,7 +547,7 @@ class ConvexPolygon:
         if len(pts) < 3 or extent == 0.0:
             hull = pts[:0]
         elif len(pts) <= _SMALL:
-            xs, ys, area, cx, cy = _hull_python(pts, eps, coords)
+            xs, ys, area, cx, cy = _hull_python(pts, eps, ordered=ordered)
             hull = np.array([xs, ys], dtype=np.float64).T.copy()
             centroid = np.array([cx, cy])
         else:
@@ -797,10 +810,25 @@ class Part:
         PartError
             Bad coordinates, or a centre of mass outside the hull.
         """
-        outline = as_points(points)  # a fresh array
+        coords = None
+        if (  # a few float64 points: the finite check on Python floats (a sum is finite
+            # only if every term is; else as_points decides and words its refusal)
+            type(points) is np.ndarray
+            and points.dtype == np.float64
+            and points.ndim == 2
+            and points.shape[1] == 2
+            and 3 <= len(points) <= _SMALL
+        ):
+            outline = points.copy()
+            px, py = outline.T.tolist()
+            coords = (px, py)
+            if not math.isfinite(sum(px) + sum(py)):
+                outline, coords = as_points(points), None
+        else:
+            outline = as_points(points)  # a fresh array
         if tol is not DEFAULT_TOLERANCE:
             _check_tolerance(tol)
-        hull = ConvexPolygon._hull_of(outline, tol)
+        hull = ConvexPolygon._hull_of(outline, tol, coords)
         com = None
         if center_of_mass is None:  # the hull's centroid: finite floats already
             c = hull.centroid

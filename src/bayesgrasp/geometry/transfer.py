@@ -26,6 +26,7 @@ import bisect
 import dataclasses
 import functools
 import math
+import operator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -256,9 +257,11 @@ def _period_count(
     """
     k = len(stable)
     first = stable[0]
-    for m in range(top, max(base, known), -1):
-        if k % m or m % base:
+    for m in _divisors(k):  # largest first
+        if m > top or m % base:
             continue
+        if m <= base or m <= known:
+            break
         step, t = k // m, TWO_PI / m
         # Cheap test on one point first: most m fail there.
         if abs((stable[step] - first - t + math.pi) % TWO_PI - math.pi) > tol:
@@ -266,6 +269,12 @@ def _period_count(
         if _shifts_onto_itself(stable, step, t, tol) and _shifts_onto_itself(bounds, step, t, tol):
             return m
     return max(base, known)
+
+
+@functools.cache
+def _divisors(k: int) -> tuple[int, ...]:
+    """The divisors of ``k``, largest first."""
+    return tuple(m for m in range(k, 0, -1) if k % m == 0)
 
 
 def _shifts_onto_itself(points: list[float], step: int, shift: float, tol: float) -> bool:
@@ -320,9 +329,16 @@ def _from_sorted(
     # The boundary above each stable orientation (wrapping past 2 pi). They alternate when
     # that index counts up by one: 0, 1, ..., K - 1 or 1, 2, ..., K.
     k0 = bisect.bisect_right(bounds, stable[0])
-    if k0 > 1 or list(map(functools.partial(bisect.bisect_right, bounds), stable)) != list(
-        range(k0, k0 + n)
-    ):
+    # Boundary k0 + i - 1 <= stable[i] < boundary k0 + i, for every i (bisect's counts).
+    if k0 == 0:
+        alternate = all(map(operator.lt, stable, bounds)) and all(
+            map(operator.le, bounds, stable[1:])
+        )
+    else:
+        alternate = all(map(operator.le, bounds, stable)) and all(
+            map(operator.lt, stable, bounds[1:])
+        )
+    if k0 > 1 or not alternate:
         raise BayesGraspError(  # pragma: no cover - a bug
             "internal error: extrema of the transfer function do not alternate"
         )
