@@ -123,7 +123,10 @@ class DiameterFunction:
         minima: list[float],
         maxima: list[float],
     ) -> DiameterFunction:
-        """From Python lists (the pieces, then the jaws' vertex indices), unchecked."""
+        """From the pieces as :func:`_pieces_python` (lists) or :func:`_pieces_numpy` gives them.
+
+        Unchecked; lists become read-only arrays on first use.
+        """
         breaks, lengths, phases, i_plus, i_minus = pieces
         return cls(polygon, breaks, lengths, phases, (i_plus, i_minus), minima, maxima)
 
