@@ -302,12 +302,12 @@ def test_arrays_are_read_only_and_frozen() -> None:
 def test_plain_python_and_numpy_pieces_agree(pts: np.ndarray) -> None:
     poly = ConvexPolygon.from_points(pts)
     a = diameter._pieces_numpy(poly.vertices, poly.tol.angle)
-    b = diameter._pieces_python(poly.vertices, poly.tol.angle)
-    for x, y in zip(a[:4], b[:4], strict=True):
-        assert x.shape == y.shape
+    b = diameter._pieces_python(*poly.vertices.T.tolist(), poly.tol.angle)
+    for x, y in zip(a[:5], b[:5], strict=True):
+        assert np.shape(x) == np.shape(y)
         # Chord lengths scale with the part; angles and indices do not.
         assert_allclose(x, y, atol=1e-13 * max(1.0, poly.size), rtol=0)
-    for x, y in zip(a[4], b[4], strict=True):
+    for x, y in zip(a[5], b[5], strict=True):
         assert_allclose(sorted(x), sorted(y), atol=1e-13 * max(1.0, poly.size), rtol=0)
 
 

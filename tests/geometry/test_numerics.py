@@ -237,16 +237,16 @@ def test_near_regular_12_gons_build_a_problem() -> None:
 def _check_paths(v: FloatArray, tol: float, period: float) -> None:
     """Both paths find alternating, paired extrema, and the same ones."""
     a = diameter._pieces_numpy(v, tol, period)
-    b = diameter._pieces_python(v, tol, period)
+    b = diameter._pieces_python(*v.T.tolist(), tol, period)
     scale = max(1.0, float(np.max(np.abs(v))))  # lengths scale with the part, angles do not
-    for x, y in zip(a[:4], b[:4], strict=True):
+    for x, y in zip(a[:5], b[:5], strict=True):
         assert_allclose(x, y, atol=1e-13 * scale, rtol=0)
-    for ext in (a[4], b[4]):
+    for ext in (a[5], b[5]):
         min_at, _, max_at, _ = ext
         lo = a[0][0]
         wrapped = [np.mod(np.asarray(x) - lo, period) for x in (min_at, max_at)]
         assert alternate(*wrapped), (len(min_at), len(max_at))
-    for x, y in zip(a[4], b[4], strict=True):
+    for x, y in zip(a[5], b[5], strict=True):
         assert len(x) == len(y)
         assert_allclose(sorted(x), sorted(y), atol=1e-12 * scale, rtol=0)
 
@@ -442,7 +442,8 @@ def test_symmetry_order_python_and_numpy_agree(n: int) -> None:
         poly = ConvexPolygon.from_points(near_regular(n, noise, rng))
         eps = poly.tol.symmetry_for(poly.size)
         orders = [r for r in range(2, n + 1) if n % r == 0][::-1]
-        expected = polygon._symmetry_order_python(poly.vertices, poly.centroid, orders, eps)
+        xs, ys = poly.vertices.T.tolist()
+        expected = polygon._symmetry_order_python(xs, ys, poly.centroid, orders, eps)
         assert poly.symmetry_order == expected
         # Asking for the orders from 3 up first, then for all, gives the same answers.
         fresh = ConvexPolygon.from_points(poly.vertices)

@@ -196,3 +196,29 @@ def test_action_classes_of_a_square() -> None:
     assert_allclose(np.degrees(cls.lo), [45.0, 135.0], atol=1e-9)
     assert_array_equal(cls.transfer[0], [3, 0, 1, 2])
     assert_array_equal(cls.transfer[1], [2, 3, 0, 1])
+
+
+def test_defaults_are_shared_and_equal_to_fresh_ones() -> None:
+    from bayesgrasp.model.prior import UniformPrior
+
+    part = Part.from_points([(0, 0), (2, 0), (2.2, 1), (0, 1.1)])
+    a, b = Problem.build(part), Problem.build(part)
+    assert a.cost is b.cost and a.cost == CostModel()
+    assert a.goal == Goal() and a.prior == UniformPrior()
+    assert a._cache is not b._cache  # each problem its own derived values
+    given = Problem.build(part, cost=CostModel(), goal=Goal(), prior=UniformPrior())
+    assert given.n_states == a.n_states and given.cost == a.cost
+    with pytest.raises(CostError):  # a given cost is still checked
+        Problem.build(part, cost=CostModel({"squeeze": 0.0}, verify=0.0))
+
+
+def test_action_kinds_are_made_once_and_follow_the_actions() -> None:
+    part = Part.from_points([(0, 0), (2, 0), (2.2, 1), (0, 1.1)])
+    pb = Problem.build(part, actions=("push-grasp", "squeeze"))
+    assert pb.action_kinds == ("push-grasp", "squeeze")
+    assert pb.action_kinds is pb.action_kinds
+    assert Problem.build(part, actions=["squeeze"]).action_kinds == ("squeeze",)
+    assert Problem.build(part, actions="squeeze").action_kinds == ("squeeze",)
+    assert pb.goal_group == 1 and Problem.build(part, goal=Goal("symmetry")).goal_group == 1
+    rect = Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])
+    assert Problem.build(rect, goal=Goal("symmetry")).goal_group == 2

@@ -116,3 +116,19 @@ def test_cli_study_table_and_bad_input(capsys: pytest.CaptureFixture[str]) -> No
     assert "bfs planner" in out and "breadth-first over 1000 nodes" in out
     assert main(["study", "--polygons", "0"]) == 2
     assert "--polygons" in capsys.readouterr().err
+
+
+def test_block_draws_are_random_polygons_draws(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The study draws several polygons' points per call: the same polygons, any block size."""
+    from bayesgrasp.paper import study
+
+    rng = np.random.default_rng(3)
+    sides = [random_polygon(rng).hull.n_sides for _ in range(23)]
+    whole = run_study(23, seed=3)
+    assert sum(k * v for k, v in whole.sides_histogram.items()) == sum(sides)
+    monkeypatch.setattr(study, "_DRAW", 5)  # blocks of 5 (the last one of 3)
+    blocks = run_study(23, seed=3)
+    assert whole.sides_histogram == blocks.sides_histogram
+    assert whole.shorter_plan_better == blocks.shorter_plan_better
+    assert whole.plan_length_histogram == blocks.plan_length_histogram
+    assert whole.bayes_length_histogram == blocks.bayes_length_histogram

@@ -37,9 +37,9 @@ pieces stay those of the polygon itself: ``d(theta)`` is the part's own width.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import heapq
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -55,13 +55,14 @@ FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 
 
-@dataclass(frozen=True, slots=True, eq=False)
 class DiameterFunction:
     """Piecewise-sinusoidal diameter function over one period ``[0, pi)``.
 
     Piece ``k`` covers ``[breaks[k], breaks[k + 1])`` (the last ends at ``breaks[0] + pi``);
     on it ``d(theta) = lengths[k] * cos(theta - phases[k])``, with ``phases[k]`` within
-    ``pi / 2`` of every angle of the piece. All arrays are read-only.
+    ``pi / 2`` of every angle of the piece. A frozen value: all arrays are read-only, and
+    made on first use when the function was built on Python floats (a polygon of a few
+    vertices; :attr:`extrema` gives the extrema as floats).
 
     Attributes
     ----------
@@ -88,15 +89,116 @@ class DiameterFunction:
     >>> d = diameter_function(ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
     >>> np.degrees(d.minima).round(6).tolist(), d([0.0, np.pi / 2]).round(12).tolist()
     ([0.0, 90.0], [2.0, 1.0])
+    >>> d.extrema == (tuple(d.minima.tolist()), tuple(d.maxima.tolist()))
+    True
     """
 
+    __slots__ = ("_arrays", "_data", "polygon")
+
     polygon: ConvexPolygon
-    breaks: FloatArray
-    lengths: FloatArray
-    phases: FloatArray
-    pairs: IntArray
-    minima: FloatArray
-    maxima: FloatArray
+    # breaks, lengths, phases, pairs, minima, maxima: arrays, or (pairs: two) float tuples
+    _data: tuple[object, ...]
+    _arrays: tuple[NDArray[np.generic], ...] | None
+
+    def __init__(
+        self,
+        polygon: ConvexPolygon,
+        breaks: ArrayLike,
+        lengths: ArrayLike,
+        phases: ArrayLike,
+        pairs: ArrayLike,
+        minima: ArrayLike,
+        maxima: ArrayLike,
+    ) -> None:
+        put = object.__setattr__
+        put(self, "polygon", polygon)
+        put(self, "_data", (breaks, lengths, phases, pairs, minima, maxima))
+        put(self, "_arrays", None)
+
+    @classmethod
+    def _of_floats(
+        cls,
+        polygon: ConvexPolygon,
+        pieces: tuple[list[float], list[float], list[float], list[int], list[int]],
+        minima: list[float],
+        maxima: list[float],
+    ) -> DiameterFunction:
+        """From the pieces as :func:`_pieces_python` (lists) or :func:`_pieces_numpy` gives them.
+
+        Unchecked; lists become read-only arrays on first use.
+        """
+        breaks, lengths, phases, i_plus, i_minus = pieces
+        return cls(polygon, breaks, lengths, phases, (i_plus, i_minus), minima, maxima)
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (DiameterFunction, (self.polygon, *self._columns()))
+
+    def __repr__(self) -> str:
+        names = ("breaks", "lengths", "phases", "pairs", "minima", "maxima")
+        cols = ", ".join(f"{k}={v!r}" for k, v in zip(names, self._columns(), strict=True))
+        return f"DiameterFunction(polygon={self.polygon!r}, {cols})"
+
+    def _columns(self) -> tuple[NDArray[np.generic], ...]:
+        arrays = self._arrays
+        if arrays is None:
+            out: list[NDArray[np.generic]] = []
+            for k, col in enumerate(self._data):
+                if type(col) is np.ndarray:
+                    arr = col
+                elif k == 3:  # the jaws' vertex indices, as two columns
+                    arr = np.array(col, dtype=np.intp).reshape(2, -1).T.copy()
+                else:
+                    arr = np.array(col, dtype=np.float64)
+                arr.setflags(write=False)
+                out.append(arr)
+            arrays = tuple(out)
+            object.__setattr__(self, "_arrays", arrays)
+        return arrays
+
+    @property
+    def extrema(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """``minima`` and ``maxima`` as tuples of Python floats (what the squeeze needs)."""
+        lows, highs = self._data[4], self._data[5]
+        return (
+            tuple(lows.tolist() if isinstance(lows, np.ndarray) else lows),  # type: ignore[arg-type]
+            tuple(highs.tolist() if isinstance(highs, np.ndarray) else highs),  # type: ignore[arg-type]
+        )
+
+    @property
+    def breaks(self) -> FloatArray:
+        """Edge-alignment angles in ``[0, pi)``, increasing (read-only)."""
+        return self._columns()[0]  # type: ignore[return-value]
+
+    @property
+    def lengths(self) -> FloatArray:
+        """Length of the chord touching both jaws on each piece (read-only)."""
+        return self._columns()[1]  # type: ignore[return-value]
+
+    @property
+    def phases(self) -> FloatArray:
+        """Orientation at which each piece's chord lies along the squeeze axis (read-only)."""
+        return self._columns()[2]  # type: ignore[return-value]
+
+    @property
+    def pairs(self) -> IntArray:
+        """Vertices touching the +x and -x jaws on each piece, shape (P, 2) (read-only)."""
+        return self._columns()[3]  # type: ignore[return-value]
+
+    @property
+    def minima(self) -> FloatArray:
+        """Local minima in ``[0, pi)`` (read-only)."""
+        return self._columns()[4]  # type: ignore[return-value]
+
+    @property
+    def maxima(self) -> FloatArray:
+        """Local maxima in ``[0, pi)`` (read-only)."""
+        return self._columns()[5]  # type: ignore[return-value]
 
     def __call__(self, theta: ArrayLike) -> FloatArray:
         """Evaluate ``d`` at any angles (radians), vectorised.
@@ -154,10 +256,13 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     >>> len(d.minima), len(d.maxima)
     (3, 3)
     """
-    v = polygon.vertices
     tol = polygon.tol.angle
-    pieces = _pieces_python if len(v) <= _SMALL else _pieces_numpy
-    breaks, lengths, phases, pairs, extrema = pieces(v, tol, math.pi)
+    small = polygon.n_sides <= _SMALL
+    pieces: Pieces
+    if small:
+        pieces = _pieces_python(*polygon._coords(), tol, math.pi)
+    else:
+        pieces = _pieces_numpy(polygon.vertices, tol, math.pi)
     depth = polygon.tol.barrier_for(polygon.size)
     r = polygon.symmetry_order_from(3)  # a half turn changes nothing: d has the period pi
     periods = r * (1 + r % 2) // 2 if r > 1 else 1  # periods of d in [0, pi)
@@ -165,9 +270,13 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
         # One period of the exactly symmetric part, simplified as a periodic function and
         # repeated: the shallow pairs go in every period or in none.
         period = math.pi / periods
-        sym_breaks, _, _, _, one = pieces(polygon.symmetrized(), tol, period)
-        kept = _drop_shallow(_merged(one, float(sym_breaks[0]), period), depth)
-        origin = float(sym_breaks[0])
+        sym = polygon.symmetrized()
+        if small:
+            one = _pieces_python(sym[:, 0].tolist(), sym[:, 1].tolist(), tol, period)
+        else:
+            one = _pieces_numpy(sym, tol, period)
+        origin = float(one[0][0])
+        kept = _drop_shallow(_merged(one[5], origin, period), depth)
         minima, maxima = (
             np.sort(
                 np.array(
@@ -179,17 +288,14 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
                     ],
                     dtype=np.float64,
                 )
-            )
+            ).tolist()
             for is_max in (False, True)
         )
     else:
-        kept = _drop_shallow(_merged(extrema, 0.0, math.pi), depth)
-        minima = np.array([at for at, _, top in kept if not top], dtype=np.float64)
-        maxima = np.array([at for at, _, top in kept if top], dtype=np.float64)
-    arrays = (breaks, lengths, phases, pairs, minima, maxima)
-    for arr in arrays:
-        arr.setflags(write=False)
-    return DiameterFunction(polygon, *arrays)
+        kept = _drop_shallow(_merged(pieces[5], 0.0, math.pi), depth)
+        minima = [at for at, _, top in kept if not top]
+        maxima = [at for at, _, top in kept if top]
+    return DiameterFunction._of_floats(polygon, pieces[:5], minima, maxima)  # type: ignore[arg-type]
 
 
 # At or below this many vertices plain Python floats beat numpy's cost per call; both paths
@@ -198,6 +304,17 @@ _SMALL = SMALL
 
 Extrema = tuple[list[float], list[float], list[float], list[float]]
 """Angles and values of d at the minima, then angles and values at the maxima."""
+
+Pieces = tuple[
+    FloatArray | list[float],
+    FloatArray | list[float],
+    FloatArray | list[float],
+    IntArray | list[int],
+    IntArray | list[int],
+    Extrema,
+]
+"""``breaks``, ``lengths``, ``phases``, the vertices touching the +x and the -x jaw on each
+piece (arrays, or lists on the plain-Python path), and the extrema over one period."""
 
 # How the extrema are found (both paths). Each piece has a slope sign at its start and at
 # its end: the sign of (phase - angle), zero when the chord is within the angle tolerance of
@@ -213,9 +330,7 @@ Extrema = tuple[list[float], list[float], list[float], list[float]]
 # (i + 2) // 2 (d is flat to the angle tolerance across the zeros, so which break is moot).
 
 
-def _pieces_numpy(
-    v: FloatArray, tol: float, period: float = math.pi
-) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, Extrema]:
+def _pieces_numpy(v: FloatArray, tol: float, period: float = math.pi) -> Pieces:
     """Pieces over ``[0, pi)`` and extrema over one period, by array operations, O(n log n).
 
     ``period`` is ``pi`` or, for a symmetric polygon, ``pi / j``: the extrema are then those
@@ -273,24 +388,40 @@ def _pieces_numpy(
         phases[last[interior] // 2].tolist() + breaks[at[kink_max]].tolist(),
         lengths[last[interior] // 2].tolist() + at_break[at[kink_max]].tolist(),
     )
-    return breaks, lengths, phases, np.stack([i_plus, i_minus], axis=1), extrema
+    return breaks, lengths, phases, i_plus, i_minus, extrema
 
 
-def _pieces_python(
-    v: FloatArray, tol: float, period: float = math.pi
-) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, Extrema]:
-    """The same as :func:`_pieces_numpy`, step for step, in plain Python (small polygons)."""
-    pi = math.pi
-    xs, ys = v[:, 0].tolist(), v[:, 1].tolist()
+def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float = math.pi) -> Pieces:
+    """The same as :func:`_pieces_numpy`, step for step, in plain Python (small polygons).
+
+    ``xs`` and ``ys`` are the vertices' coordinates; the pieces are lists.
+    """
+    pi, two_pi, quarter = math.pi, TWO_PI, math.pi / 2
+    atan2, hypot, cos, find = math.atan2, math.hypot, math.cos, bisect.bisect_left
     n = len(xs)
-    normals = [
-        _wrap1(math.atan2(ys[(i + 1) % n] - ys[i], xs[(i + 1) % n] - xs[i]) - pi / 2, TWO_PI)
-        for i in range(n)
-    ]
+    normals = []
+    for dy, dx in zip(
+        [b - a for a, b in zip(ys, [*ys[1:], ys[0]], strict=True)],
+        [b - a for a, b in zip(xs, [*xs[1:], xs[0]], strict=True)],
+        strict=True,
+    ):
+        x = (atan2(dy, dx) - quarter) % two_pi  # _wrap1(..., 2 pi)
+        normals.append(0.0 if x >= two_pi else x)
     order = sorted(range(n), key=normals.__getitem__)
     normals_sorted = [normals[i] for i in order]
-    b = sorted(_wrap1(-x, pi) for x in normals)
-    breaks = [x for i, x in enumerate(b) if x - (b[i - 1] if i else b[-1] - pi) > tol] or b[:1]
+    b = []
+    for x in normals:
+        x = -x % pi  # _wrap1(-x, pi)
+        b.append(0.0 if x >= pi else x)
+    b.sort()
+    prev = b[-1] - pi
+    breaks = []
+    for x in b:
+        if x - prev > tol:
+            breaks.append(x)
+        prev = x
+    if not breaks:
+        breaks = b[:1]
     ends = [*breaks[1:], breaks[0] + pi]
     w = _window(breaks, period, tol)
     lengths, phases, i_plus, i_minus = [], [], [], []
@@ -299,11 +430,13 @@ def _pieces_python(
     at_break = []
     for k, (lo, hi) in enumerate(zip(breaks, ends, strict=True)):
         mid = 0.5 * (lo + hi)
-        a = order[bisect.bisect_left(normals_sorted, _wrap1(-mid, TWO_PI)) % n]
-        c = order[bisect.bisect_left(normals_sorted, _wrap1(pi - mid, TWO_PI)) % n]
+        u = -mid % two_pi  # _wrap1(-mid, 2 pi)
+        a = order[find(normals_sorted, 0.0 if u >= two_pi else u) % n]
+        u = (pi - mid) % two_pi
+        c = order[find(normals_sorted, 0.0 if u >= two_pi else u) % n]
         cx, cy = xs[a] - xs[c], ys[a] - ys[c]
-        length = math.hypot(cx, cy)
-        phase = mid - ((mid + math.atan2(cy, cx) + pi) % TWO_PI - pi)
+        length = hypot(cx, cy)
+        phase = mid - ((mid + atan2(cy, cx) + pi) % two_pi - pi)
         i_plus.append(a)
         i_minus.append(c)
         lengths.append(length)
@@ -312,27 +445,30 @@ def _pieces_python(
             to_start, to_end = phase - lo, phase - hi
             starts.append((to_start > tol) - (to_start < -tol))
             stops.append((to_end > tol) - (to_end < -tol))
-            at_break.append(length * math.cos(to_start))
+            at_break.append(length * cos(to_start))
     min_at, min_d, max_at, max_d, kmax_at, kmax_d = [], [], [], [], [], []
     if 0 not in starts and 0 not in stops:
         # Most parts: no zeros, so each change is between neighbouring entries: at a break
         # (the entry before is the end of the previous piece) or inside a piece.
+        before = stops[-1]
         for k in range(w):
-            if stops[k - 1] != starts[k]:
-                if stops[k - 1] < 0:
+            start, stop = starts[k], stops[k]
+            if before != start:
+                if before < 0:
                     min_at.append(breaks[k])
                     min_d.append(at_break[k])
                 else:
                     kmax_at.append(breaks[k])
                     kmax_d.append(at_break[k])
-            if starts[k] != stops[k]:
-                if starts[k] > 0:
+            if start != stop:
+                if start > 0:
                     max_at.append(phases[k])
                     max_d.append(lengths[k])
                 else:
                     at = (k + 1) % w
                     min_at.append(breaks[at])
                     min_d.append(at_break[at])
+            before = stop
     else:
         signs = [x for pair in zip(starts, stops, strict=True) for x in pair]
         nonzero = [i for i, x in enumerate(signs) if x]
@@ -350,12 +486,12 @@ def _pieces_python(
             else:
                 kmax_at.append(breaks[at])
                 kmax_d.append(at_break[at])
-    pairs = np.array([i_plus, i_minus], dtype=np.intp).T.copy()
     return (
-        np.array(breaks),
-        np.array(lengths),
-        np.array(phases),
-        pairs,
+        breaks,
+        lengths,
+        phases,
+        i_plus,
+        i_minus,
         (min_at, min_d, max_at + kmax_at, max_d + kmax_d),
     )
 
@@ -391,9 +527,12 @@ def _merged(extrema: Extrema, origin: float, period: float) -> list[Extremum]:
         raise BayesGraspError(
             f"internal error: {len(min_at)} minima and {len(max_at)} maxima of the diameter"
         )
+    at = [(x - origin) % period for x in min_at + max_at]
+    if period in at:  # _wrap1: % can round a tiny negative up to the period
+        at = [0.0 if x >= period else x for x in at]
     return sorted(
         zip(
-            [_wrap1(x - origin, period) for x in min_at + max_at],
+            at,
             min_d + max_d,
             [False] * len(min_at) + [True] * len(max_at),
             strict=True,

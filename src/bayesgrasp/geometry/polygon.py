@@ -278,7 +278,10 @@ def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
 
 
 def _hull_python(
-    pts: FloatArray, eps: float, coords: tuple[list[float], list[float]] | None = None
+    pts: FloatArray,
+    eps: float,
+    coords: tuple[list[float], list[float]] | None = None,
+    ordered: list[tuple[float, float]] | None = None,
 ) -> tuple[list[float], list[float], float, float, float]:
     """Hull, area and centroid of a few points in plain Python.
 
@@ -292,22 +295,23 @@ def _hull_python(
     area, cx, cy : float
         Area and centroid (area 0 when degenerate).
     """
-    px, py = coords if coords is not None else (pts[:, 0].tolist(), pts[:, 1].tolist())
-    order = sorted(
-        range(len(px)), key=list(zip(px, py, strict=True)).__getitem__
-    )  # stable: np.lexsort
-    sx, sy = [px[i] for i in order], [py[i] for i in order]
-    chain = _monotone_chain(sx, sy)
-    xs, ys = [sx[i] for i in chain], [sy[i] for i in chain]
+    if ordered is None:  # else the caller sorted them (and gives the list away)
+        px, py = coords if coords is not None else pts.T.tolist()
+        ordered = _sorted_pairs(px, py)
+    lower = _chain_python(ordered)
+    ordered.reverse()
+    hull = lower[:-1] + _chain_python(ordered)[:-1]
+    xs, ys = [p[0] for p in hull], [p[1] for p in hull]
+    hypot = math.hypot
     while len(xs) > 3:  # _drop_near_collinear, step for step
         n = len(xs)
         bad = []
-        for i in range(n):
-            ax, ay, bx, by = xs[i - 1], ys[i - 1], xs[(i + 1) % n], ys[(i + 1) % n]
+        ax, ay = xs[-1], ys[-1]
+        for x, y, bx, by in zip(xs, ys, [*xs[1:], xs[0]], [*ys[1:], ys[0]], strict=True):
             ux, uy = bx - ax, by - ay
-            cross = ux * (ys[i] - ay) - uy * (xs[i] - ax)
-            bad.append(abs(cross) <= eps * math.hypot(ux, uy))
-        if not any(bad):
+            bad.append(abs(ux * (y - ay) - uy * (x - ax)) <= eps * hypot(ux, uy))
+            ax, ay = x, y
+        if True not in bad:
             break
         drop, run_start = [], 0
         for i in range(n):
@@ -325,22 +329,41 @@ def _hull_python(
     if len(xs) < 3:
         return xs, ys, 0.0, 0.0, 0.0
     ox, oy = xs[0], ys[0]
-    scale = max(max(abs(x - ox) for x in xs), max(abs(y - oy) for y in ys))
+    scale = max(max([abs(x - ox) for x in xs]), max([abs(y - oy) for y in ys]))
     if not 0.0 < scale < math.inf:
         return xs, ys, 0.0, 0.0, 0.0
     qx, qy = [(x - ox) / scale for x in xs], [(y - oy) / scale for y in ys]
-    n = len(qx)
     twice, cx, cy = 0.0, 0.0, 0.0
-    for i in range(n):
-        j = (i + 1) % n
-        c = qx[i] * qy[j] - qx[j] * qy[i]
+    for x0, y0, x1, y1 in zip(qx, qy, [*qx[1:], qx[0]], [*qy[1:], qy[0]], strict=True):
+        c = x0 * y1 - x1 * y0
         twice += c
-        cx += (qx[i] + qx[j]) * c
-        cy += (qy[i] + qy[j]) * c
+        cx += (x0 + x1) * c
+        cy += (y0 + y1) * c
     if twice == 0.0:
         return xs, ys, 0.0, 0.0, 0.0
     unit = scale / (3.0 * twice)
     return xs, ys, 0.5 * twice * scale * scale, cx * unit + ox, cy * unit + oy
+
+
+def _sorted_pairs(px: list[float], py: list[float]) -> list[tuple[float, float]]:
+    """The (x, y) pairs sorted: the order of ``np.lexsort`` (equal pairs are the same point)."""
+    return sorted(zip(px, py, strict=True))
+
+
+def _chain_python(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """One half of :func:`_monotone_chain` on sorted points (the same cross products)."""
+    chain: list[tuple[float, float]] = []
+    pop = chain.pop
+    for p in points:
+        x, y = p
+        while len(chain) >= 2:
+            ax, ay = chain[-2]
+            bx, by = chain[-1]
+            if (bx - ax) * (y - ay) - (by - ay) * (x - ax) > 0:
+                break
+            pop()
+        chain.append(p)
+    return chain
 
 
 def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
@@ -400,6 +423,8 @@ class ConvexPolygon:
     size: float = field(init=False)
     # symmetry_order once known; -k when only known to be below k; 0 before any test.
     _symmetry: int = field(init=False, repr=False)
+    # The vertices' x and y as Python floats (for the plain-Python paths), once asked for.
+    _xy: tuple[list[float], list[float]] | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         _check_tolerance(self.tol)
@@ -433,6 +458,16 @@ class ConvexPolygon:
         object.__setattr__(self, "centroid", centroid)
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "_symmetry", 0)
+        object.__setattr__(self, "_xy", None)
+
+    def _coords(self) -> tuple[list[float], list[float]]:
+        """The vertices' x and y coordinates as lists of Python floats (made once)."""
+        xy = self._xy
+        if xy is None:
+            xs, ys = self.vertices.T.tolist()
+            xy = (xs, ys)
+            object.__setattr__(self, "_xy", xy)
+        return xy
 
     @classmethod
     def _trusted(
@@ -442,14 +477,20 @@ class ConvexPolygon:
         area: float,
         centroid: FloatArray,
         size: float | None = None,
+        xy: tuple[list[float], list[float]] | None = None,
     ) -> ConvexPolygon:
-        """A polygon known to be convex and counter-clockwise (from a hull or a rotation)."""
+        """A polygon known to be convex and counter-clockwise (from a hull or a rotation).
+
+        ``xy``: the vertices' coordinates as Python floats, when the caller has them.
+        """
         poly = object.__new__(cls)
         object.__setattr__(poly, "tol", tol)
         if size is None:
             d = v - centroid
             size = math.sqrt(float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2)))
         poly._set(v, area, centroid, size)
+        if xy is not None:
+            object.__setattr__(poly, "_xy", xy)
         return poly
 
     @classmethod
@@ -482,13 +523,21 @@ class ConvexPolygon:
         return cls._hull_of(as_points(points), tol)
 
     @classmethod
-    def _hull_of(cls, pts: FloatArray, tol: Tolerance) -> ConvexPolygon:
-        """:meth:`from_points` of points already checked by :func:`as_points`."""
-        coords = None
+    def _hull_of(
+        cls, pts: FloatArray, tol: Tolerance, coords: tuple[list[float], list[float]] | None = None
+    ) -> ConvexPolygon:
+        """:meth:`from_points` of points already checked by :func:`as_points`.
+
+        ``coords``: the points' x and y as Python floats, when the caller has them.
+        """
+        ordered = None
         if 3 <= len(pts) <= _SMALL:  # the extent and magnitude on Python floats (same values)
-            coords = px, py = pts[:, 0].tolist(), pts[:, 1].tolist()
-            extent = max(max(px) - min(px), max(py) - min(py))
-            if max(max(map(abs, px)), max(map(abs, py))) > _MAX_COORD or 0.0 < extent < _MIN_EXTENT:
+            px, py = coords if coords is not None else pts.T.tolist()
+            ordered = _sorted_pairs(px, py)  # by x first: the least and largest x at the ends
+            x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], min(py), max(py)
+            extent = max(x1 - x0, y1 - y0)
+            # The largest |coordinate| is the largest of max and -min.
+            if max(x1, -x0, y1, -y0) > _MAX_COORD or 0.0 < extent < _MIN_EXTENT:
                 _check_magnitude(pts, extent)
         else:
             extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
@@ -498,7 +547,7 @@ class ConvexPolygon:
         if len(pts) < 3 or extent == 0.0:
             hull = pts[:0]
         elif len(pts) <= _SMALL:
-            xs, ys, area, cx, cy = _hull_python(pts, eps, coords)
+            xs, ys, area, cx, cy = _hull_python(pts, eps, ordered=ordered)
             hull = np.array([xs, ys], dtype=np.float64).T.copy()
             centroid = np.array([cx, cy])
         else:
@@ -521,9 +570,9 @@ class ConvexPolygon:
             raise PartError("the part's points are all collinear; a part needs a non-zero area")
         if len(pts) <= _SMALL:
             size = math.sqrt(
-                max((x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True))
+                max([(x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True)])
             )
-            return cls._trusted(hull, tol, area, centroid, size)
+            return cls._trusted(hull, tol, area, centroid, size, (xs, ys))
         return cls._trusted(hull, tol, area, centroid)
 
     @property
@@ -594,7 +643,7 @@ class ConvexPolygon:
         n = len(self.vertices)
         eps = self.tol.symmetry_for(self.size)
         if n <= _SMALL:
-            return _symmetry_order_python(self.vertices, self.centroid, orders, eps)
+            return _symmetry_order_python(*self._coords(), self.centroid, orders, eps)
         if not orders:
             return 1
         # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r, at the same
@@ -677,15 +726,15 @@ def _orders(n: int) -> list[int]:
 
 
 def _symmetry_order_python(
-    vertices: FloatArray, centroid: FloatArray, orders: list[int], eps: float
+    xs: list[float], ys: list[float], centroid: FloatArray, orders: list[int], eps: float
 ) -> int:
     """:meth:`ConvexPolygon.symmetry_order` for a few vertices, in plain Python (faster).
 
     The same tests in the same order; the distance of vertex ``step`` from the centroid,
     compared with vertex 0's, rejects most orders of most parts before any other work.
+    ``xs`` and ``ys`` are the vertices' coordinates.
     """
     cx, cy = float(centroid[0]), float(centroid[1])
-    xs, ys = vertices[:, 0].tolist(), vertices[:, 1].tolist()
     n = len(xs)
     r0 = math.hypot(xs[0] - cx, ys[0] - cy)
     radii: list[float] = []
@@ -761,13 +810,29 @@ class Part:
         PartError
             Bad coordinates, or a centre of mass outside the hull.
         """
-        outline = as_points(points)  # a fresh array
-        _check_tolerance(tol)
-        hull = ConvexPolygon._hull_of(outline, tol)
+        coords = None
+        if (  # a few float64 points: the finite check on Python floats (a sum is finite
+            # only if every term is; else as_points decides and words its refusal)
+            type(points) is np.ndarray
+            and points.dtype == np.float64
+            and points.ndim == 2
+            and points.shape[1] == 2
+            and 3 <= len(points) <= _SMALL
+        ):
+            outline = points.copy()
+            px, py = outline.T.tolist()
+            coords = (px, py)
+            if not math.isfinite(sum(px) + sum(py)):
+                outline, coords = as_points(points), None
+        else:
+            outline = as_points(points)  # a fresh array
+        if tol is not DEFAULT_TOLERANCE:
+            _check_tolerance(tol)
+        hull = ConvexPolygon._hull_of(outline, tol, coords)
         com = None
         if center_of_mass is None:  # the hull's centroid: finite floats already
             c = hull.centroid
-            if math.isfinite(c[0]) and math.isfinite(c[1]) and hull_contains(hull, c):
+            if math.isfinite(c[0]) and math.isfinite(c[1]) and _holds_centroid(hull):
                 com = np.array(c, dtype=np.float64)
         if com is None:
             com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
@@ -888,6 +953,27 @@ def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
     if not hull_contains(hull, com):
         raise PartError(f"`center_of_mass` {com.tolist()} must lie inside the part's convex hull")
     return np.array(com, dtype=np.float64)
+
+
+# Rounding allowance of _holds_centroid: far more than the error of the computed distances.
+_CENTROID_SLACK = 1e-12
+
+
+def _holds_centroid(hull: ConvexPolygon) -> bool:
+    """``hull_contains(hull, hull.centroid)``, without the test when it cannot fail.
+
+    The centroid of a convex polygon lies at least a third of the polygon's width from each
+    edge's line (Minkowski and Radon), and the width is at least ``area / (2 size)`` (the
+    polygon lies within ``size`` of its centroid): so when ``area / (6 size)`` exceeds the
+    margin by far more than the rounding of the distances, every edge passes the test. Only
+    thin polygons are tested edge by edge.
+    """
+    c = hull.centroid
+    margin = hull.tol.length_for(hull.size)
+    slack = _CENTROID_SLACK * (abs(float(c[0])) + abs(float(c[1])) + hull.size)
+    if hull.area > 6.0 * hull.size * (2.0 * margin + slack):
+        return True
+    return hull_contains(hull, c)
 
 
 def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:

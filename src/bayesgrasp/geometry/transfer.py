@@ -23,8 +23,10 @@ symmetric within that tolerance has the period pi, however nearly periodic its e
 from __future__ import annotations
 
 import bisect
+import dataclasses
+import functools
 import math
-from dataclasses import dataclass
+import operator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,13 +41,14 @@ __all__ = ["TransferFunction", "detect_period", "squeeze_function", "transfer_fr
 FloatArray = NDArray[np.float64]
 
 
-@dataclass(frozen=True, slots=True, eq=False)
 class TransferFunction:
     """A monotone step function on the circle: stable orientations and their basins.
 
     State ``i`` is the stable orientation ``stable[i]`` in ``[0, 2 pi)`` (increasing); its
     basin is the open arc ``(basin_lo[i], basin_hi[i])`` around it (``basin_lo[0]`` may be
-    negative and ``basin_hi[-1]`` may pass ``2 pi``). Basins tile the circle.
+    negative and ``basin_hi[-1]`` may pass ``2 pi``). Basins tile the circle. A frozen value:
+    the arrays are read-only, and made on first use when the function was built from Python
+    floats (a squeeze function of a few states: see :attr:`values`).
 
     Attributes
     ----------
@@ -65,14 +68,121 @@ class TransferFunction:
     ([0.0, 90.0, 180.0, 270.0], 90.0)
     >>> float(np.degrees(s(np.radians(30.0))))
     0.0
+    >>> s.values[0] == tuple(s.stable.tolist())
+    True
     """
 
+    __slots__ = ("_arrays", "_values", "angle_tol", "kind", "period")
+
     kind: str
-    stable: FloatArray
-    basin_lo: FloatArray
-    basin_hi: FloatArray
     period: float
     angle_tol: float
+    _values: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] | None
+    _arrays: tuple[FloatArray, FloatArray, FloatArray] | None
+
+    def __init__(
+        self,
+        kind: str,
+        stable: ArrayLike,
+        basin_lo: ArrayLike,
+        basin_hi: ArrayLike,
+        period: float,
+        angle_tol: float,
+    ) -> None:
+        cols = (stable, basin_lo, basin_hi)
+        put = object.__setattr__
+        put(self, "kind", kind)
+        put(self, "period", period)
+        put(self, "angle_tol", angle_tol)
+        if all(type(c) is np.ndarray for c in cols):  # kept as given (push.py: read-only)
+            put(self, "_values", None)
+            put(self, "_arrays", cols)
+        else:
+            floats = (tuple(np.asarray(c, dtype=np.float64).tolist()) for c in cols)
+            put(self, "_values", tuple(floats))
+            put(self, "_arrays", None)
+
+    @classmethod
+    def _of_floats(
+        cls,
+        kind: str,
+        values: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]],
+        period: float,
+        angle_tol: float,
+    ) -> TransferFunction:
+        """From tuples of Python floats, unchecked; the arrays are made on first use."""
+        f = object.__new__(cls)
+        put = object.__setattr__
+        put(f, "kind", kind)
+        put(f, "period", period)
+        put(f, "angle_tol", angle_tol)
+        put(f, "_values", values)
+        put(f, "_arrays", None)
+        return f
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (TransferFunction, (self.kind, *self._columns(), self.period, self.angle_tol))
+
+    def __repr__(self) -> str:
+        st, lo, hi = self._columns()
+        return (
+            f"TransferFunction(kind={self.kind!r}, stable={st!r}, basin_lo={lo!r}, "
+            f"basin_hi={hi!r}, period={self.period!r}, angle_tol={self.angle_tol!r})"
+        )
+
+    def renamed(self, kind: str) -> TransferFunction:
+        """The same function under another ``kind`` (an action named after its own motion)."""
+        f = object.__new__(TransferFunction)
+        for name in TransferFunction.__slots__:
+            object.__setattr__(f, name, getattr(self, name))
+        object.__setattr__(f, "kind", kind)
+        return f
+
+    def _columns(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        arrays = self._arrays
+        if arrays is None:
+            assert self._values is not None
+            arrays = tuple(np.array(c, dtype=np.float64) for c in self._values)  # type: ignore[assignment]
+            assert arrays is not None
+            for arr in arrays:
+                arr.setflags(write=False)
+            object.__setattr__(self, "_arrays", arrays)
+        return arrays
+
+    @property
+    def values(self) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+        """``stable``, ``basin_lo`` and ``basin_hi`` as tuples of Python floats.
+
+        For loops over a few states, where numpy's cost per call is most of the work.
+        """
+        values = self._values
+        if values is None:
+            assert self._arrays is not None
+            values = tuple(tuple(a.tolist()) for a in self._arrays)  # type: ignore[assignment]
+            assert values is not None
+            object.__setattr__(self, "_values", values)
+        return values
+
+    @property
+    def stable(self) -> FloatArray:
+        """Stable orientations in ``[0, 2 pi)``, increasing (read-only)."""
+        return self._columns()[0]
+
+    @property
+    def basin_lo(self) -> FloatArray:
+        """Start of each stable orientation's basin (read-only)."""
+        return self._columns()[1]
+
+    @property
+    def basin_hi(self) -> FloatArray:
+        """End of each stable orientation's basin (read-only)."""
+        return self._columns()[2]
 
     def __call__(self, theta: ArrayLike) -> FloatArray:
         """Final orientation in ``[0, 2 pi)`` for each initial orientation (vectorised).
@@ -103,7 +213,8 @@ class TransferFunction:
     @property
     def n_states(self) -> int:
         """Number of stable orientations over ``[0, 2 pi)``."""
-        return len(self.stable)
+        values = self._values
+        return len(values[0]) if values is not None else len(self.stable)
 
     @property
     def boundaries(self) -> FloatArray:
@@ -133,24 +244,37 @@ def detect_period(stable: FloatArray, boundaries: FloatArray, tol: float) -> flo
     return TWO_PI / _period_count(st, bd, len(st), 1, tol)
 
 
-def _period_count(stable: list[float], bounds: list[float], top: int, base: int, tol: float) -> int:
+def _period_count(
+    stable: list[float], bounds: list[float], top: int, base: int, tol: float, known: int = 1
+) -> int:
     """Largest ``m <= top``, a multiple of ``base`` dividing ``K``, whose shift maps both lists.
 
-    Returns ``base`` when no larger ``m`` works. Plain Python: ``K`` is small, and numpy's
-    cost per call would be most of the work.
+    Returns ``base`` when no larger ``m`` works. ``known`` is a count whose shift is known
+    to map both lists to within ``tol`` (a squeeze function's half turn: 2); counts from
+    ``known`` down are then not tested and ``known`` is returned in their place, which is
+    what their test would give. Plain Python: ``K`` is small, and numpy's cost per call
+    would be most of the work.
     """
     k = len(stable)
     first = stable[0]
-    for m in range(top, base, -1):
-        if k % m or m % base:
+    for m in _divisors(k):  # largest first
+        if m > top or m % base:
             continue
+        if m <= base or m <= known:
+            break
         step, t = k // m, TWO_PI / m
         # Cheap test on one point first: most m fail there.
         if abs((stable[step] - first - t + math.pi) % TWO_PI - math.pi) > tol:
             continue
         if _shifts_onto_itself(stable, step, t, tol) and _shifts_onto_itself(bounds, step, t, tol):
             return m
-    return base
+    return max(base, known)
+
+
+@functools.cache
+def _divisors(k: int) -> tuple[int, ...]:
+    """The divisors of ``k``, largest first."""
+    return tuple(m for m in range(k, 0, -1) if k % m == 0)
 
 
 def _shifts_onto_itself(points: list[float], step: int, shift: float, tol: float) -> bool:
@@ -187,30 +311,51 @@ def transfer_from_extrema(
 
 
 def _from_sorted(
-    kind: str, stable: list[float], bounds: list[float], angle_tol: float, period_tol: float
+    kind: str,
+    stable: list[float],
+    bounds: list[float],
+    angle_tol: float,
+    period_tol: float,
+    known: int = 1,
 ) -> TransferFunction:
-    """:func:`transfer_from_extrema` for sorted lists in ``[0, 2 pi)``."""
+    """:func:`transfer_from_extrema` for sorted lists in ``[0, 2 pi)``.
+
+    ``known``: a count of equal shifts known to map both lists onto themselves (see
+    :func:`_period_count`).
+    """
     n = len(stable)
     if n != len(bounds) or n == 0:  # pragma: no cover - a bug
         raise BayesGraspError("internal error: stable orientations and boundaries differ")
     # The boundary above each stable orientation (wrapping past 2 pi). They alternate when
     # that index counts up by one: 0, 1, ..., K - 1 or 1, 2, ..., K.
     k0 = bisect.bisect_right(bounds, stable[0])
-    if k0 > 1 or any(bisect.bisect_right(bounds, x) != k0 + i for i, x in enumerate(stable)):
+    # Boundary k0 + i - 1 <= stable[i] < boundary k0 + i, for every i (bisect's counts).
+    if k0 == 0:
+        alternate = all(map(operator.lt, stable, bounds)) and all(
+            map(operator.le, bounds, stable[1:])
+        )
+    else:
+        alternate = all(map(operator.le, bounds, stable)) and all(
+            map(operator.lt, stable, bounds[1:])
+        )
+    if k0 > 1 or not alternate:
         raise BayesGraspError(  # pragma: no cover - a bug
             "internal error: extrema of the transfer function do not alternate"
         )
     if k0 == 0:  # stable[i] lies between bounds[i - 1] and bounds[i]
-        lo = [bounds[-1] - TWO_PI, *bounds[:-1]]
-        hi = bounds
+        lo = (bounds[-1] - TWO_PI, *bounds[:-1])
+        hi = tuple(bounds)
     else:  # stable[i] lies between bounds[i] and bounds[i + 1]
-        lo = bounds
-        hi = [*bounds[1:], bounds[0] + TWO_PI]
-    arrays = [np.array(x, dtype=np.float64) for x in (stable, lo, hi)]
-    for arr in arrays:
-        arr.setflags(write=False)
-    period = TWO_PI / _period_count(stable, bounds, n, 1, period_tol)
-    return TransferFunction(kind, arrays[0], arrays[1], arrays[2], period, angle_tol)
+        lo = tuple(bounds)
+        hi = (*bounds[1:], bounds[0] + TWO_PI)
+    period = TWO_PI / _period_count(stable, bounds, n, 1, period_tol, known)
+    return TransferFunction._of_floats(kind, (tuple(stable), lo, hi), period, angle_tol)
+
+
+# A half turn maps a squeeze function's lists onto themselves to within a few rounding errors
+# of 2 pi (they are the extrema over [0, pi) and the same plus pi): below this tolerance the
+# half turn is tested like any other shift.
+_HALF_TURN_TOL = 1e-12
 
 
 def squeeze_function(
@@ -242,9 +387,11 @@ def squeeze_function(
     (6, 60.0, 1.047197551)
     """
     d = part if isinstance(part, DiameterFunction) else diameter_function(part)
-    poly = d.polygon
-    half = d.minima.tolist(), d.maxima.tolist()  # in [0, pi)
-    stable, bounds = ([*x, *(_wrap(a + math.pi) for a in x)] for x in half)
+    tol = d.polygon.tol.angle
+    pi = math.pi
+    # x in [0, pi): a + pi is no tiny negative, so % needs none of _wrap's care.
+    stable, bounds = ([*x, *[(a + pi) % TWO_PI for a in x]] for x in d.extrema)
     stable.sort()
     bounds.sort()
-    return _from_sorted("squeeze", stable, bounds, poly.tol.angle, poly.tol.angle)
+    half_turn = 2 if tol >= _HALF_TURN_TOL else 1
+    return _from_sorted("squeeze", stable, bounds, tol, tol, half_turn)

@@ -26,7 +26,6 @@ computed on first use inside it; callers never prepare anything.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -125,6 +124,15 @@ def action_classes(
     return ActionClasses(action.kind, lo, hi, mid, transfer)
 
 
+# The defaults of Problem.build, made once: they are frozen values (the study builds 2000
+# problems with them). The default cost's verification costs 1, so no plan of any actions
+# costs nothing under it (CostModel.check_positive).
+_DEFAULT_ACTIONS = parse_actions(("squeeze",))
+_DEFAULT_COST = CostModel()
+_DEFAULT_PRIOR = UniformPrior()
+_DEFAULT_GOAL = Goal()
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Problem:
     """A planning problem: states, prior, actions and their transfers, cost and goal.
@@ -220,7 +228,10 @@ class Problem:
             raise PlanningError(
                 f"`accuracy` must be a finite number of radians >= 0; got {accuracy!r}"
             )
-        acts = parse_actions(actions)
+        if type(actions) is tuple and actions == ("squeeze",):
+            acts = _DEFAULT_ACTIONS
+        else:
+            acts = parse_actions(actions)
         if not isinstance(part, Part):
             raise PlanningError(f"`part` must be a Part; got {type(part).__name__}")
         if prior is not None and not isinstance(prior, Prior):
@@ -234,25 +245,31 @@ class Problem:
         for a in acts:
             f = a.build(part, states)
             # A transfer function is named by its action (two actions may move alike).
-            transfers[a.name] = f if f.kind == a.name else dataclasses.replace(f, kind=a.name)
-        cost = cost or CostModel()
-        cost.check_positive(a.name for a in acts)
+            transfers[a.name] = f if f.kind == a.name else f.renamed(a.name)
+        if cost is None:
+            cost = _DEFAULT_COST
+        else:
+            cost.check_positive(a.name for a in acts)
         return cls(
             part,
             states,
             d,
-            prior or UniformPrior(),
+            prior or _DEFAULT_PRIOR,
             acts,
             MappingProxyType(transfers),
             cost,
-            goal or Goal(),
+            goal or _DEFAULT_GOAL,
             float(accuracy),
+            {},
         )
 
     @property
     def action_kinds(self) -> tuple[str, ...]:
         """Names of the available actions, in order."""
-        return tuple(a.name for a in self.actions)
+        kinds: tuple[str, ...] | None = self._cache.get("kinds")
+        if kinds is None:  # planners ask often: made once
+            kinds = self._cache["kinds"] = tuple(a.name for a in self.actions)
+        return kinds
 
     def action(self, name: str | Action) -> Action:
         """The action of that name: the problem's own first, else the registry's."""
@@ -288,11 +305,12 @@ class Problem:
     @property
     def goal_group(self) -> int:
         """Number of orientations the goal counts as one (the part's symmetry only if asked)."""
-        if "goal_group" not in self._cache:
+        group: int | None = self._cache.get("goal_group")
+        if group is None:
             # The symmetry test only when the goal counts symmetric orientations as one.
             order = self.part.hull.symmetry_order if self.goal.kind == "symmetry" else 1
-            self._cache["goal_group"] = self.goal.group_order(order)
-        return int(self._cache["goal_group"])
+            group = self._cache["goal_group"] = int(self.goal.group_order(order))
+        return group
 
     def success_states(self, final_orientation: float) -> NDArray[np.bool_]:
         """Which states succeed when a plan ends at ``final_orientation`` (see :class:`Goal`)."""

@@ -61,6 +61,11 @@ def random_polygon(rng: np.random.Generator | int | None = None, points: int = 1
     return Part.from_points(g.uniform(size=(points, 2)), name="random")
 
 
+# Polygons whose points run_study draws in one call (the same numbers as one call each:
+# the generator's doubles come one after the other).
+_DRAW = 500
+
+
 @dataclass(frozen=True, slots=True)
 class BfsNodeStats:
     """Node counts of the breadth-first baseline over the study's polygons.
@@ -195,8 +200,11 @@ def run_study(
     bfs_nodes: list[int] = []
     over = fb_max = fb_reached = agree = tree_over = tree_max = max_done = 0
     limit = int(PAPER["node_limit"])
+    draws = np.empty((0, 10, 2))
     for i in range(polygons):
-        part = random_polygon(rng)
+        if i % _DRAW == 0:  # the points of the next polygons, as random_polygon draws them
+            draws = rng.uniform(size=(min(_DRAW, polygons - i), 10, 2))
+        part = Part.from_points(draws[i % _DRAW], name="random")
         problem = Problem.build(part)
         sides.append(part.hull.n_sides)
         exact = None
