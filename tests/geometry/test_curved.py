@@ -308,6 +308,7 @@ def cog(pieces: int = 400, seed: int = 3) -> CurvedRing:
     return CurvedRing(np.column_stack([r * np.cos(t), r * np.sin(t)]), bulges)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [1])
 def test_pruned_hull_of_a_detailed_outline_matches_a_dense_sampling(seed: int) -> None:
     from scipy.spatial import ConvexHull
@@ -321,6 +322,7 @@ def test_pruned_hull_of_a_detailed_outline_matches_a_dense_sampling(seed: int) -
     assert_allclose(hull.support(phi), brute, rtol=0, atol=1e-9 * 50)
 
 
+@pytest.mark.slow
 def test_push_of_a_half_disc() -> None:
     from bayesgrasp.geometry.curved import curved_push, curved_push_grasp, curved_radius
 
