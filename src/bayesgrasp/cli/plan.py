@@ -267,7 +267,8 @@ def _many(
     """Plan each part in turn, one JSON document a line; errors stay in their line."""
     code = 0
     inputs = run_inputs(part, spec)
-    encode = json.JSONEncoder(allow_nan=False).encode  # json.dumps(doc, allow_nan=False)
+    # json.dumps(doc, allow_nan=False); documents are trees, so no test for cycles
+    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
     build = _builder(spec)
     for label, load in _batch_parts(part, more, batch):

@@ -40,6 +40,7 @@ Examples
 
 from __future__ import annotations
 
+import array
 import hashlib
 import json
 import math
@@ -58,6 +59,7 @@ from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
 from ..model.problem import Problem
 from ..planning.guaranteed import GuaranteedPlan
 from ..planning.result import PlanOption, PlanReport, PlanStep
+from ..sizes import SMALL
 
 __all__ = [
     "PLAN_SCHEMA",
@@ -125,10 +127,34 @@ def part_id(part: Part) -> str:
     (True, False)
     """
     q = _grid(part.hull)
-    ints = np.rint((part.hull.vertices - part.center_of_mass) / q).astype(np.int64)  # (N, 2)
-    start = min(range(len(ints)), key=lambda i: (int(ints[i, 0]), int(ints[i, 1])))
-    ints = np.roll(ints, -start, axis=0)
-    return "sha256:" + hashlib.sha256(ints.tobytes()).hexdigest()[:16]
+    data = _small_id_bytes(part, q) if len(part.hull.vertices) <= SMALL else None
+    if data is None:
+        ints = np.rint((part.hull.vertices - part.center_of_mass) / q).astype(np.int64)  # (N, 2)
+        start = min(range(len(ints)), key=lambda i: (int(ints[i, 0]), int(ints[i, 1])))
+        data = np.roll(ints, -start, axis=0).tobytes()
+    return "sha256:" + hashlib.sha256(data).hexdigest()[:16]
+
+
+# Rounded coordinates at most this large fit an int64 whichever way they are converted.
+_ID_LIMIT = 2.0**62
+
+
+def _small_id_bytes(part: Part, q: float) -> bytes | None:
+    """The bytes :func:`part_id` hashes, on Python floats (a hull of at most ``SMALL`` vertices).
+
+    The same subtraction and division as numpy's, then ``round`` (halves to even, as
+    ``np.rint``), and the int64 values in the machine's byte order as ``ndarray.tobytes``.
+    ``None`` (numpy decides) for values beyond :data:`_ID_LIMIT` or not finite.
+    """
+    cx, cy = part.center_of_mass.tolist()
+    pts = []
+    for x, y in part.hull.vertices.tolist():
+        u, v = (x - cx) / q, (y - cy) / q
+        if not (abs(u) < _ID_LIMIT and abs(v) < _ID_LIMIT):  # NaN fails too
+            return None
+        pts.append((round(u), round(v)))
+    start = pts.index(min(pts))  # the first lexicographically least, as numpy's path
+    return array.array("q", [c for p in pts[start:] + pts[:start] for c in p]).tobytes()
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
@@ -175,11 +201,12 @@ def part_document(part: Part) -> dict[str, Any]:
         out["units"] = part.units
     out["center_of_mass"] = part.center_of_mass.tolist()
     out["id"] = part_id(part)
-    from ..report_curved import curved_document
+    if type(part) is not Part:  # a polygon has no curved member (and needs no import)
+        from ..report_curved import curved_document
 
-    curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts only)
-    if curved is not None:
-        out["curved"] = curved
+        curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts)
+        if curved is not None:
+            out["curved"] = curved
     return out
 
 
@@ -264,11 +291,12 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
 
 def option_document(option: PlanOption) -> dict[str, Any]:
     """One plan as an option object (the plan/2 form, which holds the plan/1 fields)."""
+    steps = option.steps  # (the fields of n_actions, alphas and first_angle, read once)
     return {
-        "squeezes": option.n_actions,
-        "actions_rad": list(option.alphas),
-        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in option.steps],
-        "first_squeeze_rad": option.first_angle,
+        "squeezes": len(steps),
+        "actions_rad": [s.alpha for s in steps[1:]],
+        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in steps],
+        "first_squeeze_rad": steps[0].alpha,
         "final_orientation_rad": option.final_orientation,
         "success_probability": option.success_probability,
         "expected_cost": json_float(option.expected_cost),
