@@ -264,16 +264,34 @@ def _many(
     guaranteed: bool,
     best_only: bool,
 ) -> None:
-    """Plan each part in turn, one JSON document a line; errors stay in their line."""
+    """Plan each part in turn, one JSON document a line; errors stay in their line.
+
+    Each line is what ``plan PART --json`` prints for the part, as ``json.dumps`` writes it
+    on one line. Everything made once per batch is made before the loop: the problem's
+    inputs, the planner, the encoder.
+    """
+    from ..errors import BayesGraspError
+    from ..io.plans import plan_document
+
     code = 0
     inputs = run_inputs(part, spec)
     # json.dumps(doc, allow_nan=False); documents are trees, so no test for cycles
     encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
-    build = _builder(spec)
+    build, plan = _builder(spec), spec.planner(best_only)
     for label, load in _batch_parts(part, more, batch):
-        doc, status = _one_document(label, load, spec, guaranteed, best_only, inputs, build)
-        code = max(code, status)
+        try:
+            pb = build(load())
+            result = plan(pb)
+            found = guaranteed_plan(pb) if guaranteed else None
+        except BayesGraspError as exc:
+            doc: dict[str, Any] = {"part": label, "error": str(exc), "exit_code": 2}
+            code = 2
+        else:
+            sure, missing = (None, found) if isinstance(found, str) else (found, None)
+            doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+            if missing is not None:
+                code = max(code, 1)
         out.write(encode(doc) + "\n")  # a line at a time, as typer.echo
         out.flush()
     if code:
@@ -341,27 +359,3 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
                 )
 
             yield label, load
-
-
-def _one_document(
-    label: str,
-    load: Any,
-    spec: ProblemSpec,
-    guaranteed: bool,
-    best_only: bool,
-    inputs: dict[str, Any],
-    build: Any = None,
-) -> tuple[dict[str, Any], int]:
-    """The plan document of one part (as ``plan --json``) and its exit code, or its error."""
-    from ..errors import BayesGraspError
-    from ..io.plans import plan_document
-
-    try:
-        pb = (build or spec.build)(load())
-        result = spec.plan(pb, best_only=best_only)
-        found = guaranteed_plan(pb) if guaranteed else None
-    except BayesGraspError as exc:
-        return {"part": label, "error": str(exc), "exit_code": 2}, 2
-    sure, missing = (None, found) if isinstance(found, str) else (found, None)
-    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
-    return doc, 1 if missing is not None else 0

@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import enum
+import functools
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
@@ -151,11 +152,19 @@ class ProblemSpec:
 
         ``best_only``: only the Bayes and the most certain plans.
         """
+        return self.planner(best_only)(problem)
+
+    def planner(self, best_only: bool = False) -> Callable[[Problem], PlanReport]:
+        """:meth:`plan` as a function of the problem (a batch looks the planner up once)."""
         from ..planning import plan_bfs, plan_exact
 
         if self.method is Method.bfs:
-            found = plan_bfs(problem, max_actions=self.max_actions)
-            return found.best_only() if best_only else found
-        return plan_exact(
-            problem, max_actions=self.max_actions, report="best" if best_only else "all"
-        )
+            max_actions = self.max_actions
+
+            def bfs(problem: Problem) -> PlanReport:
+                found = plan_bfs(problem, max_actions=max_actions)
+                return found.best_only() if best_only else found
+
+            return bfs
+        report: Literal["all", "best"] = "best" if best_only else "all"
+        return functools.partial(plan_exact, max_actions=self.max_actions, report=report)
