@@ -48,7 +48,7 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -56,10 +56,12 @@ from ..errors import BayesGraspError, SimulationError
 from ..geometry.polygon import ConvexPolygon, Part
 from ..model.actions import ACTIONS, SQUEEZE
 from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
-from ..model.problem import Problem
-from ..planning.guaranteed import GuaranteedPlan
-from ..planning.result import PlanOption, PlanReport, PlanStep
 from ..sizes import SMALL
+
+if TYPE_CHECKING:  # the planners are imported by what reads plans, not by every document
+    from ..model.problem import Problem
+    from ..planning.guaranteed import GuaranteedPlan
+    from ..planning.result import PlanOption, PlanReport, PlanStep
 
 __all__ = [
     "PLAN_SCHEMA",
@@ -449,6 +451,7 @@ def read_plan(
     Examples
     --------
     >>> rect = Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)], name="rectangle")
+    >>> from bayesgrasp.model.problem import Problem
     >>> from bayesgrasp.planning import plan_exact
     >>> src = read_plan(plan_document(plan_exact(Problem.build(rect))))
     >>> same_part(src.part, rect), src.provenance["goal"], src.prior.name
@@ -512,6 +515,8 @@ def _read(doc: Any, which: str) -> PlanOption:
 
 def _read_option(doc: Any) -> PlanOption:
     """One option object: ``steps`` (plan/2) or ``first_squeeze_rad`` and ``actions_rad``."""
+    from ..planning.result import PlanOption, PlanStep
+
     if not isinstance(doc, Mapping):
         raise SimulationError(f"a plan must be a JSON object; got {type(doc).__name__}")
     steps: list[PlanStep] = []
