@@ -279,6 +279,7 @@ def _many(
     encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
     build, plan = _builder(spec), spec.planner(best_only)
+    memo: dict[str, Any] = {}  # what the documents share (the provenance)
     for label, load in _batch_parts(part, more, batch):
         try:
             pb = build(load())
@@ -289,7 +290,9 @@ def _many(
             code = 2
         else:
             sure, missing = (None, found) if isinstance(found, str) else (found, None)
-            doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+            doc = plan_document(
+                result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs, memo=memo
+            )
             if missing is not None:
                 code = max(code, 1)
         out.write(encode(doc) + "\n")  # a line at a time, as typer.echo

@@ -325,6 +325,7 @@ def plan_document(
     guaranteed: GuaranteedPlan | None = None,
     guaranteed_missing: str | None = None,
     inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The plan document of a planner's result (top-level fields follow the Bayes plan).
 
@@ -342,6 +343,11 @@ def plan_document(
         is ``null`` and ``"guaranteed_missing"`` the reason.
     inputs : mapping, optional
         More of how the plans were made, added to ``"provenance"`` (:func:`provenance`).
+    memo : dict, optional
+        Kept by the caller across the documents of one run (``plan --batch``): problems
+        made with the same prior, cost model, goal and ``inputs`` (the same objects), and
+        the same actions, accuracy, planner and curve error, share one ``"provenance"``
+        object, made once (so it must not be changed).
 
     Returns
     -------
@@ -374,8 +380,25 @@ def plan_document(
     elif guaranteed_missing is not None:
         out["guaranteed"] = None
         out["guaranteed_missing"] = guaranteed_missing
-    out["provenance"] = provenance(pb, result.method, **dict(inputs or {}))
+    out["provenance"] = _shared_provenance(pb, result.method, inputs, memo)
     return out
+
+
+def _shared_provenance(
+    pb: Problem, method: str, inputs: Mapping[str, Any] | None, memo: dict[str, Any] | None
+) -> dict[str, Any]:
+    """:func:`provenance` of the problem, the memo's when it was made for the same inputs."""
+    if memo is None:
+        return provenance(pb, method, **dict(inputs or {}))
+    same = (pb.prior, pb.cost, pb.goal, inputs)  # frozen values: compared as objects
+    alike = (pb.actions, pb.accuracy, method, getattr(pb.part, "curve_error", 0.0))
+    last = memo.get("provenance")
+    if last is not None and all(a is b for a, b in zip(last[0], same, strict=True)):
+        if last[1] == alike:
+            return last[2]  # type: ignore[no-any-return]
+    doc = provenance(pb, method, **dict(inputs or {}))
+    memo["provenance"] = (same, alike, doc)
+    return doc
 
 
 def read_plan_document(
