@@ -162,3 +162,19 @@ def test_several_parts_with_sense_are_recognition(capsys: pytest.CaptureFixture[
     a = run(capsys, "plan", "rectangle", "triangle", "--sense", "width", "--json")
     b = run(capsys, "plan", "rectangle", "--also", "triangle", "--sense", "width", "--json")
     assert a[0] == 0 and a == b
+
+
+def test_batch_lines_are_json_dumps_of_each_document(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Byte for byte: a batch line is ``json.dumps`` of the document ``plan PART --json``
+    prints (its floats read back exactly), the provenance shared between lines included."""
+    lever = Path(__file__).resolve().parents[2] / "examples" / "lever.svg"  # a curved part
+    parts = ["key", "triangle", str(lever)]
+    batch = tmp_path / "parts.jsonl"
+    batch.write_text("\n".join(json.dumps(p) for p in parts) + "\n")
+    for options in ([], ["--actions", "squeeze,push-grasp", "--guaranteed"]):
+        code, out, err = run(capsys, "plan", "--batch", str(batch), *options)
+        assert (code, err) == (0, "")
+        expected = [json.dumps(single(capsys, p, *options), allow_nan=False) for p in parts]
+        assert out.splitlines() == expected
