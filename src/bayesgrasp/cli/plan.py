@@ -23,16 +23,20 @@ from .common import (
     save_figure,
 )
 from .options import (
+    AlsoOpt,
     ContactNoiseOpt,
     ForceOpt,
     JsonOpt,
+    MaxActionsOpt,
+    PartPriorOpt,
     PayoffOpt,
+    SenseOpt,
     TurnNoiseOpt,
     command_app,
     part_options,
     problem_options,
 )
-from .specs import PartSpec, ProblemSpec
+from .specs import PartSpec, ProblemSpec, SenseSpec
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
@@ -54,33 +58,6 @@ GuaranteedOpt = Annotated[
         help="Also give the shortest plan that orients every initial orientation "
         "(up to the transfer functions' period).",
     ),
-]
-SenseOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--sense",
-        metavar="width[:SIGMA,RES]",
-        help="Plan a policy that branches on the jaw width read after each action: exact "
-        "readings (width), or read as RES * round((d + e) / RES), e ~ Normal(0, SIGMA^2), in "
-        "the part's units.",
-    ),
-]
-AlsoOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--also",
-        metavar="PART",
-        help="With --sense: another candidate part (repeat it); the policy also tells them apart.",
-    ),
-]
-PartPriorOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--part-prior", metavar="W1,W2,...", help="With --sense: weights of PART and each --also."
-    ),
-]
-MaxActionsOpt = Annotated[
-    int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
 ]
 PlotOpt = Annotated[
     Path | None,
@@ -179,8 +156,10 @@ def plan(
     if sense is not None:
         if part.part is None or batch is not None:
             raise typer.BadParameter("--sense needs PART and takes no --batch")
-        more = [*(more_parts or []), *(also or [])]
-        _policy(part, spec, sense, more, part_prior, max_actions, as_json)
+        from .sensing import plan_policy_command
+
+        more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
+        plan_policy_command(part, spec, SenseSpec(sense, more, part_prior, max_actions), as_json)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
@@ -221,39 +200,6 @@ def plan(
         typer.echo(f"bayesgrasp: wrote {export}", err=True)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)
-
-
-def _policy(
-    part: PartSpec,
-    spec: ProblemSpec,
-    sense: str,
-    also: list[str],
-    part_prior: str | None,
-    max_actions: int,
-    as_json: bool,
-) -> None:
-    """Plan and print a sensing policy over PART and the --also parts."""
-    import dataclasses
-
-    from ..io.policies import policy_document
-    from ..planning.policy import plan_policy, policy_text
-
-    parts = [part.load(), *(dataclasses.replace(part, part=p).load() for p in also)]
-    problems = [spec.build(p) for p in parts]
-    pol = plan_policy(problems, sensor=sense, max_actions=max_actions, part_prior=part_prior)
-    if as_json:
-        emit_json(policy_document(pol))
-    else:
-        typer.echo(policy_text(pol, units=parts[0].units))
-        entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
-        blind = pol.sensorless_cost
-        versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
-        typer.echo(
-            f"expected cost {pol.expected_cost:.4f}{versus}, "
-            f"success {pol.success_probability:.4f} a cycle, "
-            f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
-            f"(bits): {entropy}"
-        )
 
 
 def _many(

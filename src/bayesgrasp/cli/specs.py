@@ -13,6 +13,8 @@ if TYPE_CHECKING:
     from ..geometry.polygon import Part
     from ..model.prior import Prior
     from ..model.problem import Problem
+    from ..model.sensing import WidthSensor
+    from ..planning.policy import Policy
     from ..planning.result import PlanReport
 
 
@@ -168,3 +170,36 @@ class ProblemSpec:
             return bfs
         report: Literal["all", "best"] = "best" if best_only else "all"
         return functools.partial(plan_exact, max_actions=self.max_actions, report=report)
+
+
+@dataclass(frozen=True, slots=True)
+class SenseSpec:
+    """``--sense`` and the options of a sensing policy (plan, simulate and plot --sense)."""
+
+    sense: str
+    """The sensor (``width[:SIGMA,RES]``)."""
+    also: tuple[str, ...] = ()
+    """The other candidate parts (``--also``; ``plan`` adds its further PARTs)."""
+    part_prior: str | None = None
+    max_actions: int = 3
+
+    def parts(self, part: PartSpec) -> list[Part]:
+        """PART, then each candidate part, read with the same part-file options."""
+        import dataclasses
+
+        return [part.load(), *(dataclasses.replace(part, part=p).load() for p in self.also)]
+
+    def policy(
+        self, parts: list[Part], spec: ProblemSpec, sensor: WidthSensor | None = None
+    ) -> tuple[list[Problem], Policy]:
+        """The candidates' problems and their Bayes policy (``sensor`` replaces ``sense``)."""
+        from ..planning.policy import plan_policy
+
+        problems = [spec.build(p) for p in parts]
+        pol = plan_policy(
+            problems,
+            sensor=self.sense if sensor is None else sensor,
+            max_actions=self.max_actions,
+            part_prior=self.part_prior,
+        )
+        return problems, pol
