@@ -226,6 +226,7 @@ def _many(
     out = sys.stdout
     build, plan = _builder(spec), spec.planner(best_only)
     memo: dict[str, Any] = {}  # what the documents share (the provenance)
+    texts: dict[str, Any] = {}  # and its text
     for label, load in _batch_parts(part, more, batch):
         try:
             pb = build(load())
@@ -241,10 +242,25 @@ def _many(
             )
             if missing is not None:
                 code = max(code, 1)
-        out.write(encode(doc) + "\n")  # a line at a time, as typer.echo
+        out.write(_line(doc, encode, texts) + "\n")  # a line at a time, as typer.echo
         out.flush()
     if code:
         raise typer.Exit(code)
+
+
+def _line(doc: dict[str, Any], encode: Any, texts: dict[str, Any]) -> str:
+    """``encode(doc)``, the provenance shared with the previous line encoded once.
+
+    The encoder writes an object as ``{"key": value, ...}`` (``", "`` and ``": "``), and the
+    provenance is a plan document's last member, so its text can be appended. (``doc`` loses
+    its provenance: it is written and dropped.)
+    """
+    if len(doc) < 2 or next(reversed(doc)) != "provenance":
+        return str(encode(doc))
+    shared = doc.pop("provenance")
+    if texts.get("of") is not shared:
+        texts["of"], texts["text"] = shared, encode(shared)
+    return f'{encode(doc)[:-1]}, "provenance": {texts["text"]}}}'
 
 
 def _builder(spec: ProblemSpec) -> Any:
