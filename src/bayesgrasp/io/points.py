@@ -359,8 +359,9 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
     return _json_document_part(load_json(path, decode_text(path, data)), path, options)
 
 
-# load_json's parser (numbers too large refused), made once.
+# load_json's parser (numbers too large refused) and the default options, made once.
 _DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
+_DEFAULTS = ReadOptions()  # frozen
 
 
 def json_line_part(text: str, name: str) -> Part | None:
@@ -389,7 +390,7 @@ def json_line_part(text: str, name: str) -> Part | None:
     # Nesting deeper than MAX_NESTING needs more brackets than that (counted in C).
     if text.count("[") + text.count("{") > MAX_NESTING and nesting_depth(doc) > MAX_NESTING:
         return None
-    return _json_document_part(doc, Path(name), ReadOptions())
+    return _json_document_part(doc, Path(name), _DEFAULTS)
 
 
 def _json_document_part(doc: Any, path: Path, options: ReadOptions) -> Part:
