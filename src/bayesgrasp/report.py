@@ -31,10 +31,10 @@ from .io.plans import (
 )
 from .model.actions import ACTIONS, SQUEEZE, Action, get_action
 from .model.prior import Prior, UniformPrior
-from .planning.guaranteed import GuaranteedPlan
-from .planning.result import PlanOption, PlanReport
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # ``squeeze`` and ``push`` print tables without importing the planners
+    from .planning.guaranteed import GuaranteedPlan
+    from .planning.result import PlanOption, PlanReport
     from .sim.kinematic import SimulationResult
 
 __all__ = [

@@ -162,3 +162,41 @@ def test_several_parts_with_sense_are_recognition(capsys: pytest.CaptureFixture[
     a = run(capsys, "plan", "rectangle", "triangle", "--sense", "width", "--json")
     b = run(capsys, "plan", "rectangle", "--also", "triangle", "--sense", "width", "--json")
     assert a[0] == 0 and a == b
+
+
+def test_batch_lines_are_json_dumps_of_each_document(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Byte for byte: a batch line is ``json.dumps`` of the document ``plan PART --json``
+    prints (its floats read back exactly), the provenance shared between lines included."""
+    lever = Path(__file__).resolve().parents[2] / "examples" / "lever.svg"  # a curved part
+    parts = ["key", "triangle", str(lever)]
+    batch = tmp_path / "parts.jsonl"
+    batch.write_text("\n".join(json.dumps(p) for p in parts) + "\n")
+    for options in ([], ["--actions", "squeeze,push-grasp", "--guaranteed"]):
+        code, out, err = run(capsys, "plan", "--batch", str(batch), *options)
+        assert (code, err) == (0, "")
+        expected = [json.dumps(single(capsys, p, *options), allow_nan=False) for p in parts]
+        assert out.splitlines() == expected
+
+
+def test_a_line_appends_the_shared_provenance_text() -> None:
+    """``_line`` is ``json.dumps`` whatever the document, its provenance encoded once."""
+    from bayesgrasp.cli.plan import _line
+
+    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
+    shared = {"version": "0", "prior": {"kind": "uniform"}, "accuracy_rad": 0.0}
+    other = {**shared, "flatten_tolerance": 0.01}
+    docs: list[dict[str, Any]] = [
+        {"schema": "s", "bayes": 1, "provenance": shared},
+        {"schema": "s", "options": [{"a": 0.1}], "provenance": shared},
+        {"schema": "s", "provenance": other},
+        {"part": "b.jsonl:3", "error": "bad", "exit_code": 2},  # no provenance
+        {"provenance": shared},  # alone
+        {"provenance": shared, "schema": "s"},  # not last
+        {"schema": "s", "provenance": shared},
+    ]
+    texts: dict[str, Any] = {}
+    for doc in docs:
+        expected = json.dumps(doc, allow_nan=False)
+        assert _line(dict(doc), encode, texts) == expected

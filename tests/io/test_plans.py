@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from pathlib import Path
@@ -187,3 +188,34 @@ def test_any_option_round_trips(
     assert back.steps == o.steps and back.final_orientation == final
     assert back.success_probability == p and back.tolerance == tol
     assert back.expected_cost == cost or (math.isinf(cost) and math.isnan(back.expected_cost))
+
+
+def test_a_memo_shares_the_provenance_only_of_alike_problems() -> None:
+    """``memo`` (plan --batch): the same document, the provenance made once per run of alike
+    problems; another prior, goal, accuracy or inputs makes a new one."""
+    from bayesgrasp.model.cost import CostModel
+    from bayesgrasp.model.prior import UniformPrior, von_mises
+
+    shared = {"prior": UniformPrior(), "cost": CostModel(), "goal": Goal()}
+    inputs = {"max_actions": None, "format": "json"}
+    other = {**inputs, "format": None}
+    runs = [
+        ("triangle", shared, inputs),
+        ("key", shared, inputs),  # alike: shared
+        ("key", {**shared, "prior": von_mises(0.3, 2.0)}, inputs),
+        ("key", {**shared, "prior": von_mises(0.3, 2.0)}, inputs),  # an equal, new prior
+        ("key", {**shared, "goal": Goal("symmetry")}, inputs),
+        ("key", {**shared, "accuracy": 0.01}, inputs),
+        ("key", {**shared, "actions": MIXED}, inputs),
+        ("key", shared, other),
+        ("house", shared, other),
+    ]
+    memo: dict[str, Any] = {}
+    seen: list[object] = []
+    for name, kw, extra in runs:
+        result = plan_exact(Problem.build(load(name), **kw))
+        doc = plan_document(result, inputs=extra, memo=memo)
+        assert doc == plan_document(result, inputs=extra)
+        seen.append(doc["provenance"])
+    shared_with_previous = [a is b for a, b in itertools.pairwise(seen)]
+    assert shared_with_previous == [True, False, False, False, False, False, False, True]

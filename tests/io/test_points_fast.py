@@ -129,3 +129,81 @@ def test_json_line_part_reads_as_parse_json(line: str) -> None:
     assert (fast is None) == general_path
     if fast is not None:
         assert fast == general
+
+
+def _star(n: int, step: int, radius: float = 1.0, centre: tuple[float, float] = (0.0, 0.0)):
+    """The regular star polygon {n/step} (a convex n-gon for step 1)."""
+    t = 2 * np.pi * step * np.arange(n) / n
+    return np.column_stack([centre[0] + radius * np.cos(t), centre[1] + radius * np.sin(t)])
+
+
+def _decisions(pts: list[list[float]]) -> tuple[bool, bool | None, bool]:
+    """(firmly convex, simple, convex) of the plain-Python tests, on the cleaned ring."""
+    small = points_module._small_floats(pts)
+    assert small is not None
+    ring = points_module._small_ring(small)
+    turns = points_module._turns(ring)
+    simple = points_module._small_is_simple(ring, turns)
+    convex = points_module._small_is_convex(ring, turns) if simple else None
+    return points_module._convex_once(ring, turns), simple, bool(convex)
+
+
+@pytest.mark.parametrize(
+    "pts",
+    [
+        _star(5, 2).tolist(),  # a pentagram: turns one way, winds twice
+        _star(10, 3).tolist(),  # {10/3}: winds three times
+        _star(7, 1).tolist(),
+        _star(64, 1, 1e6, (1e7, -3e7)).tolist(),  # tiny turns far from the origin
+        _star(60, 1, 1.0, (1e9, 1e9)).tolist(),  # far from the origin: firm all the same
+        [[0, 0], [1, 0], [2, 1e-13], [2, 1], [0, 1]],  # a nearly straight vertex
+        [[0, 0], [1e6, 0], [1e6, 1e-6], [0, 1e-6]],  # very thin
+        [[0, 0], [1, 0], [1, 1], [0, 1]][::-1],  # clockwise
+        [[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]],  # an L: not convex
+    ],
+)
+def test_firmly_convex_implies_simple_and_convex(
+    pts: list[list[float]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    firm, simple, convex = _decisions(pts)
+    if firm:
+        assert simple and convex
+    fast, general = _both(pts, monkeypatch)
+    assert fast == general
+
+
+def test_stars_and_tiny_turns_are_not_firm() -> None:
+    assert not _decisions(_star(5, 2).tolist())[0]
+    assert not _decisions([[0, 0], [1, 0], [2, 1e-13], [2, 1], [0, 1]])[0]
+    assert _decisions(_star(7, 1).tolist())[0]
+    assert _decisions(_star(60, 1, 1.0, (1e9, 1e9)).tolist())[0]  # rounding relative to D
+
+
+# Convex polygons (random points on a circle, in order, either way round), near-degenerate
+# ones (points nearly on a line or huge offsets) and stars.
+@settings(max_examples=300, deadline=None)
+@given(
+    angles=st.lists(st.floats(0.0, 2 * np.pi, exclude_max=True), min_size=3, max_size=40),
+    radius=st.sampled_from([1e-6, 1.0, 1e6]),
+    offset=st.sampled_from([0.0, 1.0, 1e8, -1e12]),
+    squash=st.sampled_from([1.0, 1e-6, 1e-12]),
+    step=st.integers(1, 4),
+    reverse=st.booleans(),
+)
+def test_firm_convexity_against_the_pair_test(
+    angles: list[float], radius: float, offset: float, squash: float, step: int, reverse: bool
+) -> None:
+    t = np.sort(np.asarray(angles))
+    order = np.concatenate([np.arange(k, len(t), step) for k in range(step)])  # wind `step` x
+    pts = np.column_stack([offset + radius * np.cos(t[order]), squash * radius * np.sin(t[order])])
+    pts_list = (pts[::-1] if reverse else pts).tolist()
+    if points_module._small_floats(pts_list) is None:
+        return
+    if len(points_module._small_ring(points_module._small_floats(pts_list) or [])) < 3:
+        return
+    firm, simple, convex = _decisions(pts_list)
+    if firm:
+        assert simple and convex
+    with pytest.MonkeyPatch.context() as mp:
+        fast, general = _both(pts_list, mp)
+    assert fast == general

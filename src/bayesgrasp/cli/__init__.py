@@ -62,6 +62,18 @@ class LazyCommands(TyperGroup):
         with formatter.section("Commands"):
             formatter.write_dl([(name, summary) for name, (_, summary) in COMMANDS.items()])
 
+    def get_help_option(self, ctx: Any) -> Any:
+        """The ``--help`` flag, ``False`` when not given.
+
+        Typer coerces a parameter whose value is not a bool through pydantic (imported on
+        first use, about a third of ``bayesgrasp plan --help``); an absent flag is ``None``
+        unless it has a default.
+        """
+        option = super().get_help_option(ctx)
+        if option is not None and option.default is None:
+            option.default = False
+        return option
+
 
 app = typer.Typer(
     cls=LazyCommands,

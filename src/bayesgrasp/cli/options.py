@@ -111,6 +111,36 @@ PayoffOpt = Annotated[
 ]
 
 
+SenseOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--sense",
+        metavar="width[:SIGMA,RES]",
+        help="Plan a policy that branches on the jaw width read after each action: exact "
+        "readings (width), or read as RES * round((d + e) / RES), e ~ Normal(0, SIGMA^2), in "
+        "the part's units.",
+    ),
+]
+AlsoOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--also",
+        metavar="PART",
+        help="With --sense: another candidate part (repeat it); the policy also tells them apart.",
+    ),
+]
+PartPriorOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--part-prior", metavar="W1,W2,...", help="With --sense: weights of PART and each --also."
+    ),
+]
+MaxActionsOpt = Annotated[
+    int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
+]
+"""The options of a sensing policy (plan, simulate and plot --sense): a :class:`SenseSpec`."""
+
+
 def command_app() -> typer.Typer:
     """The typer app of one command module (settings as the main app's)."""
     return typer.Typer(add_completion=False, pretty_exceptions_enable=False, rich_markup_mode=None)

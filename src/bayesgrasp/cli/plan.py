@@ -23,16 +23,20 @@ from .common import (
     save_figure,
 )
 from .options import (
+    AlsoOpt,
     ContactNoiseOpt,
     ForceOpt,
     JsonOpt,
+    MaxActionsOpt,
+    PartPriorOpt,
     PayoffOpt,
+    SenseOpt,
     TurnNoiseOpt,
     command_app,
     part_options,
     problem_options,
 )
-from .specs import PartSpec, ProblemSpec
+from .specs import PartSpec, ProblemSpec, SenseSpec
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
@@ -54,33 +58,6 @@ GuaranteedOpt = Annotated[
         help="Also give the shortest plan that orients every initial orientation "
         "(up to the transfer functions' period).",
     ),
-]
-SenseOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--sense",
-        metavar="width[:SIGMA,RES]",
-        help="Plan a policy that branches on the jaw width read after each action: exact "
-        "readings (width), or read as RES * round((d + e) / RES), e ~ Normal(0, SIGMA^2), in "
-        "the part's units.",
-    ),
-]
-AlsoOpt = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--also",
-        metavar="PART",
-        help="With --sense: another candidate part (repeat it); the policy also tells them apart.",
-    ),
-]
-PartPriorOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--part-prior", metavar="W1,W2,...", help="With --sense: weights of PART and each --also."
-    ),
-]
-MaxActionsOpt = Annotated[
-    int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
 ]
 PlotOpt = Annotated[
     Path | None,
@@ -179,8 +156,10 @@ def plan(
     if sense is not None:
         if part.part is None or batch is not None:
             raise typer.BadParameter("--sense needs PART and takes no --batch")
-        more = [*(more_parts or []), *(also or [])]
-        _policy(part, spec, sense, more, part_prior, max_actions, as_json)
+        from .sensing import plan_policy_command
+
+        more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
+        plan_policy_command(part, spec, SenseSpec(sense, more, part_prior, max_actions), as_json)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
@@ -223,39 +202,6 @@ def plan(
         raise typer.Exit(1)
 
 
-def _policy(
-    part: PartSpec,
-    spec: ProblemSpec,
-    sense: str,
-    also: list[str],
-    part_prior: str | None,
-    max_actions: int,
-    as_json: bool,
-) -> None:
-    """Plan and print a sensing policy over PART and the --also parts."""
-    import dataclasses
-
-    from ..io.policies import policy_document
-    from ..planning.policy import plan_policy, policy_text
-
-    parts = [part.load(), *(dataclasses.replace(part, part=p).load() for p in also)]
-    problems = [spec.build(p) for p in parts]
-    pol = plan_policy(problems, sensor=sense, max_actions=max_actions, part_prior=part_prior)
-    if as_json:
-        emit_json(policy_document(pol))
-    else:
-        typer.echo(policy_text(pol, units=parts[0].units))
-        entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
-        blind = pol.sensorless_cost
-        versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
-        typer.echo(
-            f"expected cost {pol.expected_cost:.4f}{versus}, "
-            f"success {pol.success_probability:.4f} a cycle, "
-            f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
-            f"(bits): {entropy}"
-        )
-
-
 def _many(
     part: PartSpec,
     more: list[str],
@@ -264,19 +210,57 @@ def _many(
     guaranteed: bool,
     best_only: bool,
 ) -> None:
-    """Plan each part in turn, one JSON document a line; errors stay in their line."""
+    """Plan each part in turn, one JSON document a line; errors stay in their line.
+
+    Each line is what ``plan PART --json`` prints for the part, as ``json.dumps`` writes it
+    on one line. Everything made once per batch is made before the loop: the problem's
+    inputs, the planner, the encoder.
+    """
+    from ..errors import BayesGraspError
+    from ..io.plans import plan_document
+
     code = 0
     inputs = run_inputs(part, spec)
-    encode = json.JSONEncoder(allow_nan=False).encode  # json.dumps(doc, allow_nan=False)
+    # json.dumps(doc, allow_nan=False); documents are trees, so no test for cycles
+    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
-    build = _builder(spec)
+    build, plan = _builder(spec), spec.planner(best_only)
+    memo: dict[str, Any] = {}  # what the documents share (the provenance)
+    texts: dict[str, Any] = {}  # and its text
     for label, load in _batch_parts(part, more, batch):
-        doc, status = _one_document(label, load, spec, guaranteed, best_only, inputs, build)
-        code = max(code, status)
-        out.write(encode(doc) + "\n")  # a line at a time, as typer.echo
+        try:
+            pb = build(load())
+            result = plan(pb)
+            found = guaranteed_plan(pb) if guaranteed else None
+        except BayesGraspError as exc:
+            doc: dict[str, Any] = {"part": label, "error": str(exc), "exit_code": 2}
+            code = 2
+        else:
+            sure, missing = (None, found) if isinstance(found, str) else (found, None)
+            doc = plan_document(
+                result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs, memo=memo
+            )
+            if missing is not None:
+                code = max(code, 1)
+        out.write(_line(doc, encode, texts) + "\n")  # a line at a time, as typer.echo
         out.flush()
     if code:
         raise typer.Exit(code)
+
+
+def _line(doc: dict[str, Any], encode: Any, texts: dict[str, Any]) -> str:
+    """``encode(doc)``, the provenance shared with the previous line encoded once.
+
+    The encoder writes an object as ``{"key": value, ...}`` (``", "`` and ``": "``), and the
+    provenance is a plan document's last member, so its text can be appended. (``doc`` loses
+    its provenance: it is written and dropped.)
+    """
+    if len(doc) < 2 or next(reversed(doc)) != "provenance":
+        return str(encode(doc))
+    shared = doc.pop("provenance")
+    if texts.get("of") is not shared:
+        texts["of"], texts["text"] = shared, encode(shared)
+    return f'{encode(doc)[:-1]}, "provenance": {texts["text"]}}}'
 
 
 def _builder(spec: ProblemSpec) -> Any:
@@ -340,27 +324,3 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
                 )
 
             yield label, load
-
-
-def _one_document(
-    label: str,
-    load: Any,
-    spec: ProblemSpec,
-    guaranteed: bool,
-    best_only: bool,
-    inputs: dict[str, Any],
-    build: Any = None,
-) -> tuple[dict[str, Any], int]:
-    """The plan document of one part (as ``plan --json``) and its exit code, or its error."""
-    from ..errors import BayesGraspError
-    from ..io.plans import plan_document
-
-    try:
-        pb = (build or spec.build)(load())
-        result = spec.plan(pb, best_only=best_only)
-        found = guaranteed_plan(pb) if guaranteed else None
-    except BayesGraspError as exc:
-        return {"part": label, "error": str(exc), "exit_code": 2}, 2
-    sure, missing = (None, found) if isinstance(found, str) else (found, None)
-    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
-    return doc, 1 if missing is not None else 0

@@ -15,9 +15,18 @@ from .common import (
     list_files,
     write_failed,
 )
-from .options import JsonOpt, PlanChoiceOpt, command_app, part_options, problem_options
-from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
-from .specs import PartSpec, ProblemSpec
+from .options import (
+    AlsoOpt,
+    JsonOpt,
+    MaxActionsOpt,
+    PartPriorOpt,
+    PlanChoiceOpt,
+    SenseOpt,
+    command_app,
+    part_options,
+    problem_options,
+)
+from .specs import PartSpec, ProblemSpec, SenseSpec
 
 app = command_app()
 
@@ -91,9 +100,8 @@ def plot(
         from .sensing import plot_policy_command
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
-        plot_policy_command(
-            part, spec, sense, also or [], part_prior, max_actions, out, formats, as_json
-        )
+        sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
+        plot_policy_command(part, spec, sensing, out, formats, as_json)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")

@@ -1,24 +1,48 @@
-"""``simulate --sense`` and ``plot --sense``: run a sensing policy's cycles, draw its tree."""
+"""``plan``, ``simulate`` and ``plot --sense``: plan a sensing policy, run its cycles, draw it.
+
+Each command's --sense options arrive as one :class:`~.specs.SenseSpec`, which reads the
+candidate parts and plans their policy.
+"""
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 from typing import Any
 
 import typer
 
 from .common import emit_json, list_files, with_progress, write_failed
-from .specs import Engine, PartSpec, ProblemSpec
+from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
+
+
+def plan_policy_command(
+    part: PartSpec, spec: ProblemSpec, sensing: SenseSpec, as_json: bool
+) -> None:
+    """Plan and print a sensing policy over PART and the candidate parts."""
+    from ..io.policies import policy_document
+    from ..planning.policy import policy_text
+
+    parts = sensing.parts(part)
+    _, pol = sensing.policy(parts, spec)
+    if as_json:
+        emit_json(policy_document(pol))
+        return
+    typer.echo(policy_text(pol, units=parts[0].units))
+    entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
+    blind = pol.sensorless_cost
+    versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
+    typer.echo(
+        f"expected cost {pol.expected_cost:.4f}{versus}, "
+        f"success {pol.success_probability:.4f} a cycle, "
+        f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
+        f"(bits): {entropy}"
+    )
 
 
 def simulate_policy_command(
     part: PartSpec,
     spec: ProblemSpec,
-    sense: str,
-    also: list[str],
-    part_prior: str | None,
-    max_actions: int,
+    sensing: SenseSpec,
     engine: Engine,
     cycles: int | None,
     workers: int,
@@ -35,7 +59,6 @@ def simulate_policy_command(
     for MuJoCo's default reading error (:func:`bayesgrasp.sim.policy.mujoco_sensor`).
     """
     from ..model.sensing import parse_sensor
-    from ..planning.policy import plan_policy
     from ..sim.policy import (
         mujoco_sensor,
         policy_simulation_json,
@@ -45,13 +68,12 @@ def simulate_policy_command(
     )
     from ..sim.scene import units_scale
 
-    sensor = parse_sensor(sense)
-    parts = [part.load(), *(dataclasses.replace(part, part=p).load() for p in also)]
+    sensor = parse_sensor(sensing.sense)
+    parts = sensing.parts(part)
     scale = units_scale(units) if units is not None else None
     if engine is Engine.mujoco and sensor.kind == "exact":
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))
-    problems = [spec.build(p) for p in parts]
-    pol = plan_policy(problems, sensor=sensor, max_actions=max_actions, part_prior=part_prior)
+    problems, pol = sensing.policy(parts, spec, sensor)
     n = cycles or (200_000 if engine is Engine.kinematic else 200)
 
     def run(progress: Any) -> Any:
@@ -75,29 +97,22 @@ def simulate_policy_command(
         emit_json(policy_simulation_json(res))
         return
     names = " or ".join(pol.parts)
-    typer.echo(
-        policy_simulation_text(res, f"{names}: Bayes policy of at most {max_actions} actions; ")
-    )
+    most = sensing.max_actions
+    typer.echo(policy_simulation_text(res, f"{names}: Bayes policy of at most {most} actions; "))
 
 
 def plot_policy_command(
     part: PartSpec,
     spec: ProblemSpec,
-    sense: str,
-    also: list[str],
-    part_prior: str | None,
-    max_actions: int,
+    sensing: SenseSpec,
     out: Path,
     formats: list[str],
     as_json: bool,
 ) -> None:
     """Plan the Bayes policy and draw its tree into ``out/policy.FORMAT``."""
     from ..figures.policy import policy_figure
-    from ..planning.policy import plan_policy
 
-    parts = [part.load(), *(dataclasses.replace(part, part=p).load() for p in also)]
-    problems = [spec.build(p) for p in parts]
-    pol = plan_policy(problems, sensor=sense, max_actions=max_actions, part_prior=part_prior)
+    problems, pol = sensing.policy(sensing.parts(part), spec)
     fig = policy_figure(problems, pol)
     files = []
     try:

@@ -10,15 +10,18 @@ import typer
 
 from .common import chosen_plan, emit_json, run_inputs, simulate_inputs, with_progress
 from .options import (
+    AlsoOpt,
     JsonOpt,
+    MaxActionsOpt,
+    PartPriorOpt,
     PlanChoiceOpt,
+    SenseOpt,
     TurnNoiseOpt,
     command_app,
     part_options,
     problem_options,
 )
-from .plan import AlsoOpt, MaxActionsOpt, PartPriorOpt, SenseOpt
-from .specs import Engine, PartSpec, ProblemSpec
+from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
 
 app = command_app()
 
@@ -163,9 +166,10 @@ def simulate(
 
         if turn_noise is not None:
             raise typer.BadParameter("does not apply to --sense yet", param_hint="--turn-noise")
+        sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
         simulate_policy_command(
-            part, spec, sense, also or [], part_prior, max_actions, engine, trials, workers,
-            offset, err, seed, units, sensor_error, as_json,
+            part, spec, sensing, engine, trials, workers, offset, err, seed, units,
+            sensor_error, as_json,
         )  # fmt: skip
         return
     if also or part_prior is not None or sensor_error:

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import enum
+import functools
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
     from ..model.prior import Prior
     from ..model.problem import Problem
+    from ..model.sensing import WidthSensor
+    from ..planning.policy import Policy
     from ..planning.result import PlanReport
 
 
@@ -151,11 +154,52 @@ class ProblemSpec:
 
         ``best_only``: only the Bayes and the most certain plans.
         """
+        return self.planner(best_only)(problem)
+
+    def planner(self, best_only: bool = False) -> Callable[[Problem], PlanReport]:
+        """:meth:`plan` as a function of the problem (a batch looks the planner up once)."""
         from ..planning import plan_bfs, plan_exact
 
         if self.method is Method.bfs:
-            found = plan_bfs(problem, max_actions=self.max_actions)
-            return found.best_only() if best_only else found
-        return plan_exact(
-            problem, max_actions=self.max_actions, report="best" if best_only else "all"
+            max_actions = self.max_actions
+
+            def bfs(problem: Problem) -> PlanReport:
+                found = plan_bfs(problem, max_actions=max_actions)
+                return found.best_only() if best_only else found
+
+            return bfs
+        report: Literal["all", "best"] = "best" if best_only else "all"
+        return functools.partial(plan_exact, max_actions=self.max_actions, report=report)
+
+
+@dataclass(frozen=True, slots=True)
+class SenseSpec:
+    """``--sense`` and the options of a sensing policy (plan, simulate and plot --sense)."""
+
+    sense: str
+    """The sensor (``width[:SIGMA,RES]``)."""
+    also: tuple[str, ...] = ()
+    """The other candidate parts (``--also``; ``plan`` adds its further PARTs)."""
+    part_prior: str | None = None
+    max_actions: int = 3
+
+    def parts(self, part: PartSpec) -> list[Part]:
+        """PART, then each candidate part, read with the same part-file options."""
+        import dataclasses
+
+        return [part.load(), *(dataclasses.replace(part, part=p).load() for p in self.also)]
+
+    def policy(
+        self, parts: list[Part], spec: ProblemSpec, sensor: WidthSensor | None = None
+    ) -> tuple[list[Problem], Policy]:
+        """The candidates' problems and their Bayes policy (``sensor`` replaces ``sense``)."""
+        from ..planning.policy import plan_policy
+
+        problems = [spec.build(p) for p in parts]
+        pol = plan_policy(
+            problems,
+            sensor=self.sense if sensor is None else sensor,
+            max_actions=self.max_actions,
+            part_prior=self.part_prior,
         )
+        return problems, pol

@@ -40,6 +40,7 @@ Examples
 
 from __future__ import annotations
 
+import array
 import hashlib
 import json
 import math
@@ -47,7 +48,7 @@ import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -55,9 +56,12 @@ from ..errors import BayesGraspError, SimulationError
 from ..geometry.polygon import ConvexPolygon, Part
 from ..model.actions import ACTIONS, SQUEEZE
 from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
-from ..model.problem import Problem
-from ..planning.guaranteed import GuaranteedPlan
-from ..planning.result import PlanOption, PlanReport, PlanStep
+from ..sizes import SMALL
+
+if TYPE_CHECKING:  # the planners are imported by what reads plans, not by every document
+    from ..model.problem import Problem
+    from ..planning.guaranteed import GuaranteedPlan
+    from ..planning.result import PlanOption, PlanReport, PlanStep
 
 __all__ = [
     "PLAN_SCHEMA",
@@ -125,10 +129,34 @@ def part_id(part: Part) -> str:
     (True, False)
     """
     q = _grid(part.hull)
-    ints = np.rint((part.hull.vertices - part.center_of_mass) / q).astype(np.int64)  # (N, 2)
-    start = min(range(len(ints)), key=lambda i: (int(ints[i, 0]), int(ints[i, 1])))
-    ints = np.roll(ints, -start, axis=0)
-    return "sha256:" + hashlib.sha256(ints.tobytes()).hexdigest()[:16]
+    data = _small_id_bytes(part, q) if len(part.hull.vertices) <= SMALL else None
+    if data is None:
+        ints = np.rint((part.hull.vertices - part.center_of_mass) / q).astype(np.int64)  # (N, 2)
+        start = min(range(len(ints)), key=lambda i: (int(ints[i, 0]), int(ints[i, 1])))
+        data = np.roll(ints, -start, axis=0).tobytes()
+    return "sha256:" + hashlib.sha256(data).hexdigest()[:16]
+
+
+# Rounded coordinates at most this large fit an int64 whichever way they are converted.
+_ID_LIMIT = 2.0**62
+
+
+def _small_id_bytes(part: Part, q: float) -> bytes | None:
+    """The bytes :func:`part_id` hashes, on Python floats (a hull of at most ``SMALL`` vertices).
+
+    The same subtraction and division as numpy's, then ``round`` (halves to even, as
+    ``np.rint``), and the int64 values in the machine's byte order as ``ndarray.tobytes``.
+    ``None`` (numpy decides) for values beyond :data:`_ID_LIMIT` or not finite.
+    """
+    cx, cy = part.center_of_mass.tolist()
+    pts = []
+    for x, y in part.hull.vertices.tolist():
+        u, v = (x - cx) / q, (y - cy) / q
+        if not (abs(u) < _ID_LIMIT and abs(v) < _ID_LIMIT):  # NaN fails too
+            return None
+        pts.append((round(u), round(v)))
+    start = pts.index(min(pts))  # the first lexicographically least, as numpy's path
+    return array.array("q", [c for p in pts[start:] + pts[:start] for c in p]).tobytes()
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
@@ -175,11 +203,12 @@ def part_document(part: Part) -> dict[str, Any]:
         out["units"] = part.units
     out["center_of_mass"] = part.center_of_mass.tolist()
     out["id"] = part_id(part)
-    from ..report_curved import curved_document
+    if type(part) is not Part:  # a polygon has no curved member (and needs no import)
+        from ..report_curved import curved_document
 
-    curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts only)
-    if curved is not None:
-        out["curved"] = curved
+        curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts)
+        if curved is not None:
+            out["curved"] = curved
     return out
 
 
@@ -264,11 +293,12 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
 
 def option_document(option: PlanOption) -> dict[str, Any]:
     """One plan as an option object (the plan/2 form, which holds the plan/1 fields)."""
+    steps = option.steps  # (the fields of n_actions, alphas and first_angle, read once)
     return {
-        "squeezes": option.n_actions,
-        "actions_rad": list(option.alphas),
-        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in option.steps],
-        "first_squeeze_rad": option.first_angle,
+        "squeezes": len(steps),
+        "actions_rad": [s.alpha for s in steps[1:]],
+        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in steps],
+        "first_squeeze_rad": steps[0].alpha,
         "final_orientation_rad": option.final_orientation,
         "success_probability": option.success_probability,
         "expected_cost": json_float(option.expected_cost),
@@ -295,6 +325,7 @@ def plan_document(
     guaranteed: GuaranteedPlan | None = None,
     guaranteed_missing: str | None = None,
     inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The plan document of a planner's result (top-level fields follow the Bayes plan).
 
@@ -312,6 +343,11 @@ def plan_document(
         is ``null`` and ``"guaranteed_missing"`` the reason.
     inputs : mapping, optional
         More of how the plans were made, added to ``"provenance"`` (:func:`provenance`).
+    memo : dict, optional
+        Kept by the caller across the documents of one run (``plan --batch``): problems
+        made with the same prior, cost model, goal and ``inputs`` (the same objects), and
+        the same actions, accuracy, planner and curve error, share one ``"provenance"``
+        object, made once (so it must not be changed).
 
     Returns
     -------
@@ -344,8 +380,25 @@ def plan_document(
     elif guaranteed_missing is not None:
         out["guaranteed"] = None
         out["guaranteed_missing"] = guaranteed_missing
-    out["provenance"] = provenance(pb, result.method, **dict(inputs or {}))
+    out["provenance"] = _shared_provenance(pb, result.method, inputs, memo)
     return out
+
+
+def _shared_provenance(
+    pb: Problem, method: str, inputs: Mapping[str, Any] | None, memo: dict[str, Any] | None
+) -> dict[str, Any]:
+    """:func:`provenance` of the problem, the memo's when it was made for the same inputs."""
+    if memo is None:
+        return provenance(pb, method, **dict(inputs or {}))
+    same = (pb.prior, pb.cost, pb.goal, inputs)  # frozen values: compared as objects
+    alike = (pb.actions, pb.accuracy, method, getattr(pb.part, "curve_error", 0.0))
+    last = memo.get("provenance")
+    if last is not None and all(a is b for a, b in zip(last[0], same, strict=True)):
+        if last[1] == alike:
+            return last[2]  # type: ignore[no-any-return]
+    doc = provenance(pb, method, **dict(inputs or {}))
+    memo["provenance"] = (same, alike, doc)
+    return doc
 
 
 def read_plan_document(
@@ -421,6 +474,7 @@ def read_plan(
     Examples
     --------
     >>> rect = Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)], name="rectangle")
+    >>> from bayesgrasp.model.problem import Problem
     >>> from bayesgrasp.planning import plan_exact
     >>> src = read_plan(plan_document(plan_exact(Problem.build(rect))))
     >>> same_part(src.part, rect), src.provenance["goal"], src.prior.name
@@ -484,6 +538,8 @@ def _read(doc: Any, which: str) -> PlanOption:
 
 def _read_option(doc: Any) -> PlanOption:
     """One option object: ``steps`` (plan/2) or ``first_squeeze_rad`` and ``actions_rad``."""
+    from ..planning.result import PlanOption, PlanStep
+
     if not isinstance(doc, Mapping):
         raise SimulationError(f"a plan must be a JSON object; got {type(doc).__name__}")
     steps: list[PlanStep] = []

@@ -225,6 +225,39 @@ def _small_is_convex(
     return left or right
 
 
+# A turn whose cross product exceeds this fraction of the squared bounding-box diagonal is
+# far beyond every threshold and rounding error of the tests below (see _convex_once).
+_FIRM = 2e-12
+
+
+def _convex_once(ring: list[tuple[float, float]], turns: list[tuple[float, float, float]]) -> bool:
+    """Whether the ring is firmly convex: every turn one way, by a margin, winding once.
+
+    Then :func:`_small_is_simple` and :func:`_small_is_convex` both return True, found in
+    O(N) rather than their O(N^2) pairs of edges; ``False`` means only "not shown here".
+
+    Why: a ring that turns one way at every vertex and once in all (exterior angles in
+    (0, pi) summing to 2 pi) is a convex polygon. Every vertex R off an edge PQ then lies at
+    least as far from PQ's line as the vertex after Q or the one before P (distance to a line
+    is unimodal around a convex polygon), so the exact orientation ``PQ x PR`` is at least
+    the smaller of the cross products at P and Q. Each orientation computed in floats is
+    within ``4 u D^2`` of its exact value (``u`` the unit roundoff, ``D`` the bounding-box
+    diagonal: differences, products, one subtraction). A cross product above
+    ``_FIRM * D^2`` (about 10^4 times that) therefore leaves every orientation the
+    crossing test computes strictly on one side, and it is also above twice the fold-back and
+    convexity thresholds (``_STRAIGHT * |u| |w|``, with ``|u| |w| <= D^2``), outside their
+    bands.
+    """
+    xs = [p[0] for p in ring]
+    ys = [p[1] for p in ring]
+    firm = _FIRM * ((max(xs) - min(xs)) ** 2 + (max(ys) - min(ys)) ** 2)
+    crosses = [t[0] for t in turns]
+    if not (min(crosses) > firm or max(crosses) < -firm):
+        return False
+    winding = sum(math.atan2(abs(cross), dot) for cross, dot, _ in turns)
+    return winding < 3 * math.pi  # 2 pi once, 4 pi or more for a star
+
+
 def point_list_part(
     path: Path,
     points: Any,
@@ -261,8 +294,11 @@ def point_list_part(
         pts = np.array(small, dtype=np.float64)
         sring = _small_ring(small)
         turns = _turns(sring) if len(sring) >= 3 else []
-        simple = len(sring) >= 3 and _small_is_simple(sring, turns)
-        concave = simple and not _small_is_convex(sring, turns)
+        if turns and _convex_once(sring, turns):  # most files: the answer in O(N)
+            simple, concave = True, False
+        else:
+            simple = len(sring) >= 3 and _small_is_simple(sring, turns)
+            concave = simple and not _small_is_convex(sring, turns)
         ring = np.array(sring, dtype=np.float64) if concave else pts
     else:
         try:
@@ -323,8 +359,9 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
     return _json_document_part(load_json(path, decode_text(path, data)), path, options)
 
 
-# load_json's parser (numbers too large refused), made once.
+# load_json's parser (numbers too large refused) and the default options, made once.
 _DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
+_DEFAULTS = ReadOptions()  # frozen
 
 
 def json_line_part(text: str, name: str) -> Part | None:
@@ -353,7 +390,7 @@ def json_line_part(text: str, name: str) -> Part | None:
     # Nesting deeper than MAX_NESTING needs more brackets than that (counted in C).
     if text.count("[") + text.count("{") > MAX_NESTING and nesting_depth(doc) > MAX_NESTING:
         return None
-    return _json_document_part(doc, Path(name), ReadOptions())
+    return _json_document_part(doc, Path(name), _DEFAULTS)
 
 
 def _json_document_part(doc: Any, path: Path, options: ReadOptions) -> Part:

@@ -26,8 +26,9 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import TYPE_CHECKING
 
-from ..angles import TWO_PI
 from ..errors import PlanningError
+
+TWO_PI = math.tau  # bayesgrasp.angles.TWO_PI (2 pi, the same float) without importing numpy
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..geometry.polygon import Part
