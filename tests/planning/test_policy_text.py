@@ -73,3 +73,15 @@ def test_candidate_parts_in_different_units_are_refused() -> None:
     with pytest.raises(PlanningError, match=r"mm \(a\), in \(b\)"):
         plan_policy([mm, inch], "width", 1)
     assert StateSpace.build([mm, bare]).n_parts == 2  # unknown units are not a conflict
+
+
+def test_plan_sense_folds_the_printed_tree(capsys: pytest.CaptureFixture[str]) -> None:
+    from bayesgrasp.cli import main
+
+    pol = plan_policy(Problem.build(shapes.load("house")), "width:0.5,0.1", 2)
+    argv = ["plan", "house", "--sense", "width:0.5,0.1", "--max-actions", "2"]
+    for given, t in (([], 0.01), (["--fold-below", "0"], 0.0), (["--fold-below", "0.2"], 0.2)):
+        assert main([*argv, *given]) == 0
+        tree = capsys.readouterr().out.rsplit("\n", 2)[0]  # without the figures' line
+        assert tree == policy_text(pol, min_probability=t)
+    assert main([*argv, "--fold-below", "1.5"]) == 2

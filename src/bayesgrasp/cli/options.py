@@ -139,6 +139,18 @@ MaxActionsOpt = Annotated[
     int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
 ]
 """The options of a sensing policy (plan, simulate and plot --sense): a :class:`SenseSpec`."""
+FoldOpt = Annotated[
+    float,
+    typer.Option(
+        "--fold-below",
+        min=0.0,
+        max=1.0,
+        metavar="P",
+        help="With --sense: the printed tree leaves out the branches whose probability at "
+        "their node is below P, counted on one line (0 prints every branch; --json keeps "
+        "every branch).",
+    ),
+]
 
 
 def command_app() -> typer.Typer:

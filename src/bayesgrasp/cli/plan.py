@@ -25,6 +25,7 @@ from .common import (
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
+    FoldOpt,
     ForceOpt,
     JsonOpt,
     MaxActionsOpt,
@@ -123,6 +124,7 @@ def plan(
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
     max_actions: MaxActionsOpt = 3,
+    fold_below: FoldOpt = 0.01,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
     payoff: PayoffOpt = None,
@@ -159,7 +161,8 @@ def plan(
         from .sensing import plan_policy_command
 
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
-        plan_policy_command(part, spec, SenseSpec(sense, more, part_prior, max_actions), as_json)
+        sensing = SenseSpec(sense, more, part_prior, max_actions)
+        plan_policy_command(part, spec, sensing, as_json, fold_below)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")

@@ -16,9 +16,12 @@ from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
 
 
 def plan_policy_command(
-    part: PartSpec, spec: ProblemSpec, sensing: SenseSpec, as_json: bool
+    part: PartSpec, spec: ProblemSpec, sensing: SenseSpec, as_json: bool, fold_below: float = 0.0
 ) -> None:
-    """Plan and print a sensing policy over PART and the candidate parts."""
+    """Plan and print a sensing policy over PART and the candidate parts.
+
+    The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
+    """
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
 
@@ -27,7 +30,7 @@ def plan_policy_command(
     if as_json:
         emit_json(policy_document(pol))
         return
-    typer.echo(policy_text(pol, units=parts[0].units))
+    typer.echo(policy_text(pol, units=parts[0].units, min_probability=fold_below))
     entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
     blind = pol.sensorless_cost
     versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
