@@ -90,7 +90,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -99,7 +99,6 @@ from numpy.typing import NDArray
 from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
-from ..model.actions import Action
 from ..model.problem import Problem
 from ..sizes import SMALL
 from .result import PlanOption, plan_actions, short_turns
@@ -1098,7 +1097,7 @@ def small_options(
         wide = bisect.bisect_left(f.width_list, length - tol)  # arcs wide..end
         if k == 1:
             at = wide + next(n for n, x in enumerate(f.span_list[wide:]) if x <= 0.0)
-            chain, tolerance = [at], None
+            tolerance = None
         else:
             for m in range(k - 1, 0, -1):  # the staircases of kinds[m:], the last first
                 suffix = kinds[m:]
@@ -1111,27 +1110,25 @@ def small_options(
             if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
                 raise PlanningError("internal error: no witness chain for a plan the lengths allow")
             at = wide + next(n for n, v in enumerate(values) if v >= best - tol)
-            chain, tolerance = [at], best
-            for m in range(1, k):
-                s = f.s_first_list[at]
-                x = (s + f.span_list[at]) - s  # Arc.span of the previous witness
-                idx, rest, width, c = stairs[kinds[m:]]
-                at = idx[_pick(c, rest, width, x)]
-                chain.append(at)
-                f = fronts[kinds[m]]
-        lo, hi, first, last = [], [], [], []
-        for t, n in zip(kinds, chain, strict=True):
-            g = fronts[t]
-            a, s = g.lo_list[n], g.s_first_list[n]
-            lo.append(a)
-            hi.append(a + g.width_list[n])
-            first.append(s)
-            last.append(s + g.span_list[n])
-        _, start = prior.max_arc_mass(min(length, cap), group, prefer=lo[0])
-        acts = [actions[t] for t in kinds]
-        out.append(
-            _chain_plan(acts, start, lo, hi, first, last, (tolerance, p, cost, hi[0] - lo[0]))
-        )
+            tolerance = best
+        # chain_option, witness by witness: the first placed by the prior, each later one
+        # picked by its staircase for the span of the one before (Arc.span: s_last - s),
+        # the turn centring that image in it.
+        lo = f.lo_list[at]
+        _, start = prior.max_arc_mass(min(length, cap), group, prefer=lo)
+        angles = [start - lo]
+        arc = (lo + f.width_list[at]) - lo  # Arc.width
+        for m in range(1, k):
+            s = f.s_first_list[at]
+            s_last = s + f.span_list[at]
+            idx, rest, width, c = stairs[kinds[m:]]
+            at = idx[_pick(c, rest, width, s_last - s)]
+            f = fronts[kinds[m]]
+            lo = f.lo_list[at]
+            angles.append(0.5 * (s + s_last) - 0.5 * (lo + (lo + f.width_list[at])))
+        steps, turned = short_turns([actions[t] for t in kinds], angles)
+        final = math.fmod(f.s_first_list[at] + turned + TWO_PI, TWO_PI)
+        out.append(PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
     return out
 
 
@@ -1152,36 +1149,10 @@ def chain_option(
     ``tolerance``, ``p`` and ``cost`` are reported as given.
     """
     _, start = problem.prior.max_arc_mass(placed, problem.goal_group, prefer=chain[0].lo)
-    return _chain_plan(
-        plan_actions(problem, [a.kind for a in chain]),
-        start,
-        [a.lo for a in chain],
-        [a.hi for a in chain],
-        [a.s_first for a in chain],
-        [a.s_last for a in chain],
-        (tolerance, p, cost, arc),
-    )
-
-
-def _chain_plan(
-    actions: Sequence[Action],
-    start: float,
-    lo: list[float],
-    hi: list[float],
-    first: list[float],
-    last: list[float],
-    rest: tuple[float | None, float, float, float],
-) -> PlanOption:
-    """:func:`chain_option` of the witnesses ``(lo, hi)`` with images ``[first, last]``.
-
-    ``start`` is the world orientation the first witness starts at; ``rest`` is the
-    tolerance, probability, cost and success-arc length reported.
-    """
-    angles = [start - lo[0]]
-    for m in range(1, len(lo)):
-        # Centre the image [first, last] of the previous arc inside this witness.
-        angles.append(0.5 * (first[m - 1] + last[m - 1]) - 0.5 * (lo[m] + hi[m]))
-    steps, turned = short_turns(actions, angles)
-    final = math.fmod(first[-1] + turned + TWO_PI, TWO_PI)
-    tolerance, p, cost, arc = rest
+    angles = [start - chain[0].lo]
+    for prev, w in itertools.pairwise(chain):
+        # Centre the image [s_first, s_last] of the previous arc inside this witness.
+        angles.append(0.5 * (prev.s_first + prev.s_last) - 0.5 * (w.lo + w.hi))
+    steps, turned = short_turns(plan_actions(problem, [a.kind for a in chain]), angles)
+    final = math.fmod(chain[-1].s_first + turned + TWO_PI, TWO_PI)
     return PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + arc))

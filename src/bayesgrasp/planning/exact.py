@@ -33,6 +33,7 @@ each reported plan for its witnesses (F arcs on the front).
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Callable
 from typing import Literal
 
@@ -145,27 +146,70 @@ _Scored = tuple[float, float, tuple[str, ...], float]
 def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -> PlanResult:
     """:func:`plan_exact` for one action type of at most :data:`~bayesgrasp.sizes.SMALL` states.
 
-    The same steps without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`: the front
-    (its plain-Python path), the widest reachable arc
-    (:func:`~bayesgrasp.planning.arcs.widest_reachable`), the plan of each length
-    (:func:`_search_one`) and the angles on the front's lists
-    (:func:`~bayesgrasp.planning.arcs.small_options`). The same plans, bit for bit (the
-    tests run both).
+    The same steps on plain lists, without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`:
+    the front (its plain-Python path); the widths ``W_k`` of each length, which for one
+    action type are one sequence, ``W_1`` the widest single basin and ``W_k`` the front's
+    widest under ``W_{k-1}`` less twice the margin
+    (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the search to
+    the first length that reaches its probability, as :func:`_search_one`); the attempt
+    costs as :meth:`CostModel.attempt_cost` sums them (left to right); and the angles on
+    the front's lists (:func:`~bayesgrasp.planning.arcs.small_options`). The same plans,
+    bit for bit (the tests run both).
     """
-    (kind,) = problem.action_kinds
+    (action,) = problem.actions
+    kind = action.name
     f = problem.transfers[kind]
     tol = problem.states.angle_tol
     cap = min(f.period, TWO_PI / problem.goal_group)  # ArcPlanner.period
     front = arcs.arc_front(f, f.period + tol)  # ArcPlanner.max_span
+    spans, widths = front.span_list, front.width_list
+    left = bisect.bisect_left
+    margin2 = 2.0 * max(tol, problem.accuracy)
     limit_hard = max_plan_length(problem)
-    mass = _masses(problem.prior, problem.goal_group, cap)
-    margin = max(tol, problem.accuracy)
-    p_best = mass(arcs.widest_reachable([front], tol, margin, cap, limit_hard))
+    prior, group, cost = problem.prior, problem.goal_group, problem.cost
+
+    n = left(spans, tol) - 1
+    grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
+    width = grown[0]
+    for _ in range(limit_hard - 1):  # widest_reachable
+        if width >= cap:
+            break
+        n = left(spans, width - margin2) - 1
+        wider = widths[n] if n >= 0 else 0.0
+        grown.append(wider)
+        if wider <= width + tol:
+            break
+        width = wider
+    masses: dict[float, float] = {}
+
+    def mass(width: float) -> float:
+        x = min(width, cap)
+        if x not in masses:
+            masses[x] = prior.max_arc_mass(x, group)[0]
+        return masses[x]
+
+    p_best = mass(width)
     p_tol = problem.part.hull.tol.probability
-    attempt = _attempts(problem.cost)
-    args = (problem, tol, mass, attempt, p_best, p_tol, max_actions, limit_hard)
-    options, bayes, most = _choose(_search_one(kind, front.widest, *args), p_tol, report)
-    if len(options[-1][2]) * len(front) > arcs.STAIR_CELLS:  # pragma: no cover - few states
+    step = cost.action_cost(kind)
+    run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
+    options: list[_Scored] = []
+    k = 0
+    while True:
+        k += 1
+        if k > 1:
+            run = run + step
+        if k > len(grown):  # pragma: no cover - the widths reach p_best within `grown`
+            n = left(spans, grown[-1] - margin2) - 1
+            grown.append(widths[n] if n >= 0 else 0.0)
+        width = grown[k - 1]
+        p = mass(width)
+        options.append((p, cost.expected_from_attempt(cost.verify + run, p), (kind,) * k, width))
+        if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
+            break
+        if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
+            raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
+    options, bayes, most = _choose(options, p_tol, report)
+    if k * len(front) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
         plans = ArcPlanner.for_problem(problem).plan_options(options)
     else:
         plans = arcs.small_options(problem, {kind: front}, tol, options)
