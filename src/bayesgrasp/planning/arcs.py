@@ -101,7 +101,7 @@ from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.problem import Problem
 from ..sizes import SMALL
-from .result import PlanOption, plan_actions, short_turns
+from .result import PlanOption, new_option, plan_actions, short_turns
 
 __all__ = [
     "ARC_CHUNK",
@@ -310,43 +310,59 @@ def _front_lists(
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Span, width, first stable orientation and start of the front's arcs, step for step.
 
-    The same candidates in the same order as :func:`arc_front` (first basin, then last),
-    the same float operations and the same Pareto rule (:func:`pareto_front`: by span, a
-    stable sort, widths strictly increasing, the last of equal spans): the same front, bit
-    for bit.
+    The front of :func:`arc_front`, bit for bit: the same candidates, the same float
+    operations and the same Pareto rule (:func:`pareto_front`: a stable sort by span, widths
+    strictly increasing, of equal spans the last kept; so of an equal span and width the
+    arc of the first basin). Done in the order that costs least on Python floats:
+
+    - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
+    - then the arcs of two or more basins, row by row; one no wider than the widest basin
+      never joins the front (the front's widths only increase), so it is not kept;
+    - sorted as ``(span, width, i)``: the stable sort by span, except that arcs of one span
+      come by width (then first basin), which leaves the same arc of each span on the front.
+
+    (On this interpreter a comprehension or a call of ``min`` or ``max`` costs as much as
+    several loop steps; the loops below avoid them.)
     """
     k = len(stable)
     s2 = stable + [x + TWO_PI for x in stable]
     hi2 = hi + [x + TWO_PI for x in hi]
-    spans: list[float] = []
-    widths: list[float] = []
-    starts: list[int] = []  # where the arcs of each first basin begin, in (i, j) order
+    widest = -math.inf
+    first = 0
+    for i in range(k):
+        w = hi[i] - lo[i]
+        if w > widest:
+            widest, first = w, i
+    cand: list[tuple[float, float, int]] = []
+    add = cand.append
     left = bisect.bisect_left
     for i in range(k):
         si, li = stable[i], lo[i]
-        # Arcs (i, j) for i <= j < end: the image spans less than max_span (one basin at
-        # least, K at most).
-        end = min(max(left(s2, si + max_span), i + 1), i + k)
-        starts.append(len(spans))
-        spans += [x - si for x in s2[i:end]]
-        widths += [x - li for x in hi2[i:end]]
-    span_kept: list[float] = []
-    width_kept: list[float] = []
-    at: list[int] = []
-    best = -math.inf
-    for c in sorted(range(len(spans)), key=spans.__getitem__):  # stable: (i, j) order kept
-        w = widths[c]
+        # Arcs (i, j) for i <= j < end: the image spans less than max_span (K basins at most).
+        end = left(s2, si + max_span)
+        if end > i + k:
+            end = i + k
+        for j in range(i + 1, end):
+            w = hi2[j] - li
+            if w > widest:
+                add((s2[j] - si, w, i))
+    cand.sort()
+    spans, widths, rows = [0.0], [widest], [first]
+    best = widest
+    for x, w, i in cand:
         if w > best:
             best = w
-            x = spans[c]
-            if span_kept and span_kept[-1] == x:  # of equal spans only the last stays
-                width_kept[-1], at[-1] = w, c
+            if spans[-1] == x:  # of equal spans only the widest stays
+                widths[-1], rows[-1] = w, i
             else:
-                span_kept.append(x)
-                width_kept.append(w)
-                at.append(c)
-    first = [bisect.bisect_right(starts, c) - 1 for c in at]
-    return span_kept, width_kept, [stable[i] for i in first], [lo[i] for i in first]
+                spans.append(x)
+                widths.append(w)
+                rows.append(i)
+    firsts, los = [], []
+    for i in rows:
+        firsts.append(stable[i])
+        los.append(lo[i])
+    return spans, widths, firsts, los
 
 
 PRUNE_STATES = 256
@@ -624,17 +640,24 @@ def _tau(
     accuracy: float,
     xs: list[float],
 ) -> list[float]:
-    """:meth:`Staircase.tau` of the staircase ``(c, rest, width)`` on plain Python floats."""
+    """:meth:`Staircase.tau` of the staircase ``(c, rest, width)`` on plain Python floats.
+
+    With ``r`` the first entry with ``c >= x``: the larger of ``rest[r]`` (``-inf`` past
+    the last) and ``(width[r - 1] - x) / 2`` (``-inf`` before the first), then ``-inf``
+    unless above ``tol`` and at least ``accuracy`` (less the rounding slack).
+    """
+    inf = math.inf
     n = len(c)
     floor = accuracy - _ROUNDING
     left = bisect.bisect_left
-    out = []
+    out: list[float] = []
+    add = out.append
     for x in xs:
         r = left(c, x)
-        at = rest[r] if r < n else -math.inf
-        before = 0.5 * (width[r - 1] - x) if r > 0 else -math.inf
+        at = rest[r] if r < n else -inf
+        before = 0.5 * (width[r - 1] - x) if r > 0 else -inf
         value = at if at >= before else before
-        out.append(value if value > tol and value >= floor else -math.inf)
+        add(value if value > tol and value >= floor else -inf)
     return out
 
 
@@ -714,25 +737,32 @@ def _stair_lists(
     keeps, ``pareto_front(-rest, width)`` of the arcs with ``rest > tol``: since the front's
     widths increase with the index, that is every arc whose rest exceeds the rest of each
     wider arc, found by one scan from the widest down, and already in the front's order
-    (rest decreasing, widths increasing).
+    (rest decreasing, widths increasing). For the last action every single basin has rest
+    ``inf``: the widest of them (the front's spans increase from 0, so they come first).
     """
     if values is None:
-        index = [n for n, x in enumerate(spans) if x <= 0.0]
-        rest = [math.inf] * len(index)
-    else:
-        index = [n for n, v in enumerate(values) if v > tol]
-        rest = [values[n] for n in index]
-    kept: list[int] = []
+        n = bisect.bisect_right(spans, 0.0)  # the arcs of span <= 0: single basins
+        if n == 0:
+            return [], [], [], []
+        return [n - 1], [math.inf], [widths[n - 1]], [widths[n - 1] - 2.0 * math.inf]
+    idx: list[int] = []
+    rest: list[float] = []
     best = -math.inf
-    for o in range(len(index) - 1, -1, -1):
-        if rest[o] > best:
-            best = rest[o]
-            kept.append(o)
-    kept.reverse()
-    idx = [index[o] for o in kept]
-    rest_kept = [rest[o] for o in kept]
-    width = [widths[n] for n in idx]
-    return idx, rest_kept, width, [w - 2.0 * r for w, r in zip(width, rest_kept, strict=True)]
+    for n in range(len(values) - 1, -1, -1):
+        v = values[n]
+        if v > tol and v > best:
+            best = v
+            idx.append(n)
+            rest.append(v)
+    idx.reverse()
+    rest.reverse()
+    width: list[float] = []
+    c: list[float] = []
+    for n, r in zip(idx, rest, strict=True):
+        w = widths[n]
+        width.append(w)
+        c.append(w - 2.0 * r)
+    return idx, rest, width, c
 
 
 @dataclass(slots=True)
@@ -1067,69 +1097,102 @@ def small_options(
 ) -> list[PlanOption]:
     """:meth:`ArcPlanner.plan_options` on the fronts' lists: no :class:`Staircase` nor :class:`Arc`.
 
-    The staircase of each suffix of action types, and its ``tau`` at every arc of the front
-    of the action before it, are computed once for all the plans (a plan of ``k`` actions
-    needs the ``tau`` that makes the staircase of ``k`` actions); the witnesses are front
-    indices. Every float operation is the one of :meth:`ArcPlanner.witnesses`,
+    The staircase of each suffix of action types (keyed, as in :meth:`ArcPlanner.staircases`,
+    by its first action and the staircase after it), and its ``tau`` at every arc of the
+    front of the action before it, are computed once for all the plans (a plan of ``k``
+    actions needs the ``tau`` that makes the staircase of ``k`` actions); the witnesses are
+    front indices. Every float operation is the one of :meth:`ArcPlanner.witnesses`,
     :meth:`Staircase.pick` and :func:`chain_option`, so the options are the same, bit for bit
     (the planner checks that no chain would need more than :data:`STAIR_CELLS` entries).
     """
     accuracy = problem.accuracy
     prior, group = problem.prior, problem.goal_group
-    periods = [problem.transfers[t].period for t in problem.action_kinds]
-    cap = min(max(periods), TWO_PI / group)  # ArcPlanner.period
+    period = 0.0
+    for t in problem.action_kinds:
+        if problem.transfers[t].period > period:
+            period = problem.transfers[t].period
+    cap = TWO_PI / group
+    if period < cap:  # ArcPlanner.period: min(largest period, 2 pi / group)
+        cap = period
     actions = {a.name: a for a in problem.actions}
-    # Staircase of the actions `suffix`, as (front index, rest, width, c) lists.
-    stairs: dict[tuple[str, ...], tuple[list[int], list[float], list[float], list[float]]] = {}
-    taus: dict[tuple[str, ...], list[float]] = {}  # (kind, *suffix): tau at front(kind)
-
-    def tau_at(kind: str, suffix: tuple[str, ...]) -> list[float]:
-        key = (kind, *suffix)
-        if key not in taus:
-            _, rest, width, c = stairs[suffix]
-            taus[key] = _tau(c, rest, width, tol, accuracy, fronts[kind].span_list)
-        return taus[key]
+    inf = math.inf
+    # (kind, id of the staircase after it, or -1) -> (id, front index, rest, width, c)
+    stairs: dict[tuple[str, int], tuple[int, list[int], list[float], list[float], list[float]]]
+    stairs = {}
+    taus: dict[tuple[str, int], list[float]] = {}  # (kind, staircase id) -> tau at its front
 
     out = []
     for p, cost, kinds, length in plans:
         k = len(kinds)
+        chain_stairs = []  # the staircases of kinds[k-1:], kinds[k-2:], ..., kinds[1:]
+        after = None
+        for m in range(k - 1, 0, -1):
+            t = kinds[m]
+            key = (t, -1 if after is None else after[0])
+            st = stairs.get(key)
+            if st is None:
+                g = fronts[t]
+                later: list[float] | None = None
+                if after is not None:
+                    later = _tau_at(taus, t, g, after, tol, accuracy)
+                st = (len(stairs), *_stair_lists(g.span_list, g.width_list, later, tol))
+                stairs[key] = st
+            chain_stairs.append(st)
+            after = st
         f = fronts[kinds[0]]
-        wide = bisect.bisect_left(f.width_list, length - tol)  # arcs wide..end
-        if k == 1:
-            at = wide + next(n for n, x in enumerate(f.span_list[wide:]) if x <= 0.0)
+        spans = f.span_list
+        at = bisect.bisect_left(f.width_list, length - tol)  # the arcs at..end are wide enough
+        if after is None:  # one action: a single basin
             tolerance = None
+            while spans[at] > 0.0:
+                at += 1
         else:
-            for m in range(k - 1, 0, -1):  # the staircases of kinds[m:], the last first
-                suffix = kinds[m:]
-                if suffix not in stairs:
-                    g = fronts[kinds[m]]
-                    values = tau_at(kinds[m], suffix[1:]) if m < k - 1 else None
-                    stairs[suffix] = _stair_lists(g.span_list, g.width_list, values, tol)
-            values = tau_at(kinds[0], kinds[1:])[wide:]
-            best = max(values)
+            values = _tau_at(taus, kinds[0], f, after, tol, accuracy)
+            best = -inf
+            for n in range(at, len(values)):
+                if values[n] > best:
+                    best = values[n]
             if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
                 raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-            at = wide + next(n for n, v in enumerate(values) if v >= best - tol)
+            while values[at] < best - tol:
+                at += 1
             tolerance = best
         # chain_option, witness by witness: the first placed by the prior, each later one
         # picked by its staircase for the span of the one before (Arc.span: s_last - s),
         # the turn centring that image in it.
         lo = f.lo_list[at]
-        _, start = prior.max_arc_mass(min(length, cap), group, prefer=lo)
+        _, start = prior.max_arc_mass(length if length < cap else cap, group, prefer=lo)
         angles = [start - lo]
         arc = (lo + f.width_list[at]) - lo  # Arc.width
         for m in range(1, k):
             s = f.s_first_list[at]
             s_last = s + f.span_list[at]
-            idx, rest, width, c = stairs[kinds[m:]]
+            _, idx, rest, width, c = chain_stairs[k - 1 - m]
             at = idx[_pick(c, rest, width, s_last - s)]
             f = fronts[kinds[m]]
             lo = f.lo_list[at]
             angles.append(0.5 * (s + s_last) - 0.5 * (lo + (lo + f.width_list[at])))
         steps, turned = short_turns([actions[t] for t in kinds], angles)
         final = math.fmod(f.s_first_list[at] + turned + TWO_PI, TWO_PI)
-        out.append(PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
+        out.append(new_option(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
     return out
+
+
+def _tau_at(
+    taus: dict[tuple[str, int], list[float]],
+    kind: str,
+    front: ArcFront,
+    stair: tuple[int, list[int], list[float], list[float], list[float]],
+    tol: float,
+    accuracy: float,
+) -> list[float]:
+    """``tau`` of ``stair`` at every arc of ``front`` (of action ``kind``), memoised."""
+    key = (kind, stair[0])
+    values = taus.get(key)
+    if values is None:
+        _, _, rest, width, c = stair
+        values = taus[key] = _tau(c, rest, width, tol, accuracy, front.span_list)
+    return values
 
 
 def chain_option(

@@ -44,6 +44,7 @@ __all__ = [
     "choose_indices",
     "execute_plan",
     "max_plan_length",
+    "new_option",
     "plan_actions",
     "short_turns",
 ]
@@ -391,12 +392,50 @@ def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[lis
     """
     steps = []
     carry = 0.0  # how much further round the part lies in the current frame
+    step = _new_step
     for action, angle in zip(actions, angles, strict=True):
         a = wrap(angle + carry)
         short = wrap_period(a, action.gripper_period)
         carry = a - short  # 0, or +-pi for a period of pi
-        steps.append(PlanStep(action.name, short))
+        steps.append(step(action.name, short))
     return steps, carry
+
+
+# The planners make thousands of steps and options a second; a frozen dataclass's __init__
+# sets each field through object.__setattr__, about twice the cost of setting its slots
+# directly. These make the same objects (neither class has a __post_init__; a test checks
+# both against their constructors).
+_new = object.__new__
+_set_kind, _set_alpha = (vars(PlanStep)[name].__set__ for name in ("kind", "alpha"))
+_set_option = [vars(PlanOption)[name].__set__ for name in PlanOption.__slots__]
+
+
+def _new_step(kind: str, alpha: float) -> PlanStep:
+    """``PlanStep(kind, alpha)``."""
+    out = _new(PlanStep)
+    _set_kind(out, kind)
+    _set_alpha(out, alpha)
+    return out
+
+
+def new_option(
+    steps: tuple[PlanStep, ...],
+    final_orientation: float,
+    success_probability: float,
+    expected_cost: float,
+    tolerance: float | None,
+    success_arc: tuple[float, float],
+) -> PlanOption:
+    """``PlanOption(...)`` of these fields, made faster (for the planners' inner loops)."""
+    out = _new(PlanOption)
+    a, b, c, d, e, f = _set_option
+    a(out, steps)
+    b(out, final_orientation)
+    c(out, success_probability)
+    d(out, expected_cost)
+    e(out, tolerance)
+    f(out, success_arc)
+    return out
 
 
 def execute_plan(
