@@ -1065,7 +1065,10 @@ def few_states(transfers: Iterable[TransferFunction]) -> bool:
 
     The plain-list paths of the planners (:func:`small_options`) run for such problems.
     """
-    return all(f.n_states <= SMALL for f in transfers)
+    for f in transfers:
+        if len(f.stable) > SMALL:
+            return False
+    return True
 
 
 def widest_reachable(

@@ -44,7 +44,7 @@ from ..model.prior import Prior
 from ..model.problem import Problem
 from . import arcs
 from .arcs import ArcPlanner, Counts
-from .result import COST_RTOL, PlanResult, choose_among, max_plan_length
+from .result import COST_RTOL, PlanResult, choose_among, max_plan_length, new_result
 
 __all__ = ["Report", "plan_exact"]
 
@@ -118,10 +118,10 @@ def plan_exact(
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
     if report not in ("all", "best"):
         raise PlanningError(f"`report` must be 'all' or 'best'; got {report!r}")
+    if len(problem.actions) == 1 and arcs.FUSED and arcs.few_states(problem.transfers.values()):
+        return _plan_one_small(problem, max_actions, report)
     kinds = problem.action_kinds
     p_tol = problem.part.hull.tol.probability
-    if len(kinds) == 1 and arcs.FUSED and arcs.few_states(problem.transfers.values()):
-        return _plan_one_small(problem, max_actions, report)
     planner = ArcPlanner.for_problem(problem)
     cap = planner.period  # no plan orients beyond the period
     limit_hard = max_plan_length(problem)
@@ -160,13 +160,16 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     kind = action.name
     f = problem.transfers[kind]
     tol = problem.states.angle_tol
-    cap = min(f.period, TWO_PI / problem.goal_group)  # ArcPlanner.period
+    group = problem.goal_group
+    cap = TWO_PI / group  # ArcPlanner.period: min(period, 2 pi / group)
+    if f.period < cap:
+        cap = f.period
     front = arcs.arc_front(f, f.period + tol)  # ArcPlanner.max_span
     spans, widths = front.span_list, front.width_list
     left = bisect.bisect_left
-    margin2 = 2.0 * max(tol, problem.accuracy)
+    margin2 = 2.0 * (tol if tol >= problem.accuracy else problem.accuracy)  # max(tol, accuracy)
     limit_hard = max_plan_length(problem)
-    prior, group, cost = problem.prior, problem.goal_group, problem.cost
+    prior, cost = problem.prior, problem.cost
 
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
@@ -180,19 +183,16 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         if wider <= width + tol:
             break
         width = wider
-    masses: dict[float, float] = {}
-
-    def mass(width: float) -> float:
-        x = min(width, cap)
-        if x not in masses:
-            masses[x] = prior.max_arc_mass(x, group)[0]
-        return masses[x]
-
-    p_best = mass(width)
+    # The prior mass of the success arc, placed best (capped at the period; memoised).
+    masses = {}
+    x = width if width <= cap else cap  # min(width, cap)
+    p_best = masses[x] = prior.max_arc_mass(x, group)[0]
     p_tol = problem.part.hull.tol.probability
     step = cost.action_cost(kind)
     run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
     options: list[_Scored] = []
+    costs: list[float] = []
+    probs: list[float] = []
     k = 0
     while True:
         k += 1
@@ -202,23 +202,40 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             n = left(spans, grown[-1] - margin2) - 1
             grown.append(widths[n] if n >= 0 else 0.0)
         width = grown[k - 1]
-        p = mass(width)
-        options.append((p, cost.expected_from_attempt(cost.verify + run, p), (kind,) * k, width))
+        x = width if width <= cap else cap
+        p = masses.get(x)
+        if p is None:
+            p = masses[x] = prior.max_arc_mass(x, group)[0]
+        c = cost.expected_from_attempt(cost.verify + run, p)
+        options.append((p, c, (kind,) * k, width))
+        costs.append(c)
+        probs.append(p)
         if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
             break
         if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
             raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
-    options, bayes, most = _choose(options, p_tol, report)
+    options, bayes, most = _choose(options, p_tol, report, costs, probs)
     if k * len(front) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
         plans = ArcPlanner.for_problem(problem).plan_options(options)
     else:
         plans = arcs.small_options(problem, {kind: front}, tol, options)
-    return PlanResult(problem, tuple(plans), bayes, most, "exact")
+    return new_result(problem, tuple(plans), bayes, most, "exact")
 
 
-def _choose(options: list[_Scored], p_tol: float, report: Report) -> tuple[list[_Scored], int, int]:
-    """The options to report, and the indices of the Bayes and the most certain among them."""
-    bayes, most = choose_among([o[1] for o in options], [o[0] for o in options], p_tol)
+def _choose(
+    options: list[_Scored],
+    p_tol: float,
+    report: Report,
+    costs: list[float] | None = None,
+    probs: list[float] | None = None,
+) -> tuple[list[_Scored], int, int]:
+    """The options to report, and the indices of the Bayes and the most certain among them.
+
+    ``costs`` and ``probs`` are the options' expected costs and probabilities, if at hand.
+    """
+    if costs is None or probs is None:
+        costs, probs = [o[1] for o in options], [o[0] for o in options]
+    bayes, most = choose_among(costs, probs, p_tol)
     if report == "best":  # as PlanResult.best_only, before the angles are computed
         keep = sorted({bayes, most})
         return [options[i] for i in keep], keep.index(bayes), keep.index(most)
