@@ -194,3 +194,35 @@ def test_many_states_at_the_cut_off(n: int) -> None:
     assert res.ok
     res = three_ways(lambda: Problem.build(part, actions=("squeeze", "push-grasp")))
     assert res.ok
+
+
+def test_fast_constructors_make_the_same_objects() -> None:
+    """The planners' fast constructors set every field as the dataclasses' own do."""
+    from bayesgrasp.planning.result import (
+        PlanOption,
+        PlanStep,
+        _new_step,
+        new_option,
+        new_result,
+    )
+
+    for cls in (PlanStep, PlanOption, PlanResult):
+        assert not hasattr(cls, "__post_init__"), cls  # nothing the fast paths would skip
+    assert _new_step("squeeze", -0.5) == PlanStep("squeeze", -0.5)
+    steps = (PlanStep("squeeze", 0.25), PlanStep("push-grasp", -1.0))
+    fields = (steps, 1.5, 0.75, 4.0, None, (0.1, 2.0))
+    assert new_option(*fields) == PlanOption(*fields)
+    pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    opts = (PlanOption(*fields),)
+    fast, slow = new_result(pb, opts, 0, 0, "exact"), PlanResult(pb, opts, 0, 0, "exact")
+    for name in PlanResult.__slots__:
+        assert getattr(fast, name) == getattr(slow, name), name
+
+
+def test_choose_among_needs_plans() -> None:
+    from bayesgrasp.planning.result import choose_among
+
+    with pytest.raises(ValueError, match="no plans"):
+        choose_among([], [])
+    assert choose_among([math.inf, math.inf], [0.2, 0.2]) == (0, 0)
+    assert choose_among([6.0, 6.0 * (1 + 1e-13), 5.0], [0.1, 0.5, 0.5 - 1e-10]) == (2, 1)
