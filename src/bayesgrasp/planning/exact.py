@@ -28,7 +28,10 @@ this success arc.
 
 Cost: O(K^2) once per action type for the front (K stable orientations; usually far fewer
 arcs survive), then O(log K) per (count, type) for the lengths and O(F log F) per action of
-each reported plan for its witnesses (F arcs on the front).
+each reported plan for its witnesses (F arcs on the front). Parts whose every action has at
+most :data:`~bayesgrasp.sizes.SMALL` states (the seed's study: about 6) are planned on plain
+Python lists end to end (one action type: :func:`_plan_one_small`; the angles of any:
+:func:`~bayesgrasp.planning.arcs.small_options`), with the same plans bit for bit.
 """
 
 from __future__ import annotations
@@ -120,7 +123,6 @@ def plan_exact(
         raise PlanningError(f"`report` must be 'all' or 'best'; got {report!r}")
     if len(problem.actions) == 1 and arcs.FUSED and arcs.few_states(problem.transfers.values()):
         return _plan_one_small(problem, max_actions, report)
-    kinds = problem.action_kinds
     p_tol = problem.part.hull.tol.probability
     planner = ArcPlanner.for_problem(problem)
     cap = planner.period  # no plan orients beyond the period
@@ -131,10 +133,7 @@ def plan_exact(
     p_best = mass(planner.widest_reachable(cap, limit_hard))
     attempt = _attempts(problem.cost)
     args = (problem, planner.tol, mass, attempt, p_best, p_tol, max_actions, limit_hard)
-    if len(kinds) == 1 and arcs.FUSED:
-        options = _search_one(kinds[0], planner.front(kinds[0]).widest, *args)
-    else:
-        options = _search(planner, *args)
+    options = _search(planner, *args)
     options, bayes, most = _choose(options, p_tol, report)
     return PlanResult(problem, tuple(planner.plan_options(options)), bayes, most, "exact")
 
@@ -150,11 +149,11 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     the front (its plain-Python path); the widths ``W_k`` of each length, which for one
     action type are one sequence, ``W_1`` the widest single basin and ``W_k`` the front's
     widest under ``W_{k-1}`` less twice the margin
-    (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the search to
-    the first length that reaches its probability, as :func:`_search_one`); the attempt
-    costs as :meth:`CostModel.attempt_cost` sums them (left to right); and the angles on
-    the front's lists (:func:`~bayesgrasp.planning.arcs.small_options`). The same plans,
-    bit for bit (the tests run both).
+    (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the search
+    to the first length that reaches its probability, as :func:`_search` does with one
+    type); the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right);
+    and the angles on the front's lists (:func:`~bayesgrasp.planning.arcs.small_options`).
+    The same plans, bit for bit (the tests run both).
     """
     (action,) = problem.actions
     kind = action.name
@@ -273,44 +272,6 @@ def _attempts(cost: CostModel) -> Callable[[tuple[str, ...]], float]:
         return cost.verify + partial[len(order) - 1]
 
     return attempt
-
-
-def _search_one(
-    kind: str,
-    widest: Callable[[float], float],
-    problem: Problem,
-    tol: float,
-    mass: Callable[[float], float],
-    attempt: Callable[[tuple[str, ...]], float],
-    p_best: float,
-    p_tol: float,
-    max_actions: int | None,
-    limit_hard: int,
-) -> list[_Scored]:
-    """:func:`_search` for one action type: one plan of each length, ``k`` of that action.
-
-    ``widest`` is its front's :meth:`~bayesgrasp.planning.arcs.ArcFront.widest`. The widest
-    arc of ``k`` actions is the front's widest under the widest of ``k - 1`` less twice the
-    margin (:meth:`ArcPlanner.extend` with one counts a level); the search stops at the first
-    length that reaches ``p_best`` (or ``max_actions``), as :func:`_search` does with one
-    action type.
-    """
-    margin = max(tol, problem.accuracy)
-    cost = problem.cost
-    options: list[_Scored] = []
-    width = widest(tol)  # the last action leaves one stable orientation
-    k = 0
-    while True:
-        k += 1
-        if k > 1:
-            width = widest(width - 2.0 * margin)
-        p = mass(width)
-        order = (kind,) * k
-        options.append((p, cost.expected_from_attempt(attempt(order), p), order, width))
-        if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
-            return options
-        if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
-            raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
 
 
 def _search(
