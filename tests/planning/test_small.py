@@ -198,17 +198,13 @@ def test_many_states_at_the_cut_off(n: int) -> None:
 
 def test_fast_constructors_make_the_same_objects() -> None:
     """The planners' fast constructors set every field as the dataclasses' own do."""
-    from bayesgrasp.planning.result import (
-        PlanOption,
-        PlanStep,
-        _new_step,
-        new_option,
-        new_result,
-    )
+    from bayesgrasp.model.actions import SQUEEZE
+    from bayesgrasp.planning.result import PlanOption, PlanStep, new_option, new_result, short_turns
 
     for cls in (PlanStep, PlanOption, PlanResult):
         assert not hasattr(cls, "__post_init__"), cls  # nothing the fast paths would skip
-    assert _new_step("squeeze", -0.5) == PlanStep("squeeze", -0.5)
+    (step,), _ = short_turns([SQUEEZE], [-0.5])
+    assert step == PlanStep("squeeze", -0.5) and type(step) is PlanStep
     steps = (PlanStep("squeeze", 0.25), PlanStep("push-grasp", -1.0))
     fields = (steps, 1.5, 0.75, 4.0, None, (0.1, 2.0))
     assert new_option(*fields) == PlanOption(*fields)
@@ -226,3 +222,23 @@ def test_choose_among_needs_plans() -> None:
         choose_among([], [])
     assert choose_among([math.inf, math.inf], [0.2, 0.2]) == (0, 0)
     assert choose_among([6.0, 6.0 * (1 + 1e-13), 5.0], [0.1, 0.5, 0.5 - 1e-10]) == (2, 1)
+
+
+def test_short_turns_wrap_as_the_angle_helpers() -> None:
+    """short_turns (its wrapping inlined) against angles.wrap and wrap_period, edges too."""
+    from bayesgrasp.angles import wrap, wrap_period
+    from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
+    from bayesgrasp.planning.result import short_turns
+
+    edges = [q * math.pi / 2 + e for q in range(-9, 10) for e in (0.0, 1e-15, -1e-15, 1e-9)]
+    rng = np.random.default_rng(5)
+    angles = edges + rng.uniform(-20.0, 20.0, 200).tolist()
+    actions = [SQUEEZE if b else PUSH_GRASP for b in rng.integers(0, 2, len(angles))]
+    steps, carry = short_turns(actions, angles)
+    ref_carry = 0.0
+    for action, angle, step in zip(actions, angles, steps, strict=True):
+        a = wrap(angle + ref_carry)
+        short = wrap_period(a, action.gripper_period)
+        ref_carry = a - short
+        assert (step.kind, step.alpha.hex()) == (action.name, short.hex())
+    assert carry.hex() == ref_carry.hex()

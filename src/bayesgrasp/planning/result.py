@@ -26,7 +26,7 @@ from typing import Literal, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..angles import TWO_PI, wrap, wrap_period
+from ..angles import TWO_PI
 from ..errors import NoPlanError, PlanningError
 from ..model.actions import Action
 from ..model.problem import Problem
@@ -410,30 +410,31 @@ def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[lis
     """
     steps = []
     carry = 0.0  # how much further round the part lies in the current frame
-    step = _new_step
+    remainder, pi = math.remainder, math.pi
     for action, angle in zip(actions, angles, strict=True):
-        a = wrap(angle + carry)
-        short = wrap_period(a, action.gripper_period)
+        # wrap(angle + carry), then wrap_period(a, g) (angles.py), inlined: the planners
+        # make every step of every plan here.
+        r = remainder(angle + carry, TWO_PI)
+        a = pi if r == -pi else r
+        g = action.gripper_period
+        r = remainder(a, g)
+        short = g / 2.0 if r == -g / 2.0 else r
         carry = a - short  # 0, or +-pi for a period of pi
-        steps.append(step(action.name, short))
+        step = _new(PlanStep)
+        _set_kind(step, action.name)
+        _set_alpha(step, short)
+        steps.append(step)
     return steps, carry
 
 
-# The planners make thousands of steps and options a second; a frozen dataclass's __init__
-# sets each field through object.__setattr__, about twice the cost of setting its slots
-# directly. These make the same objects (neither class has a __post_init__; a test checks
-# both against their constructors).
+# The planners make thousands of steps, options and results a second; a frozen dataclass's
+# __init__ sets each field through object.__setattr__, about twice the cost of setting its
+# slots directly. short_turns, new_option and new_result make the same objects (none of the
+# classes has a __post_init__; tests/planning/test_small.py checks them against their
+# constructors).
 _new = object.__new__
 _set_kind, _set_alpha = (vars(PlanStep)[name].__set__ for name in ("kind", "alpha"))
 _set_option = [vars(PlanOption)[name].__set__ for name in PlanOption.__slots__]
-
-
-def _new_step(kind: str, alpha: float) -> PlanStep:
-    """``PlanStep(kind, alpha)``."""
-    out = _new(PlanStep)
-    _set_kind(out, kind)
-    _set_alpha(out, alpha)
-    return out
 
 
 def new_option(
