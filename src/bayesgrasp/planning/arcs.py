@@ -90,6 +90,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -100,7 +101,7 @@ from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.problem import Problem
 from ..sizes import SMALL
-from .result import PlanOption, plan_actions, short_turns
+from .result import PlanOption, new_option, plan_actions, short_turns
 
 __all__ = [
     "ARC_CHUNK",
@@ -110,17 +111,23 @@ __all__ = [
     "ArcFront",
     "ArcPlanner",
     "Counts",
+    "Plans",
     "Staircase",
     "arc_front",
     "chain_option",
+    "few_states",
     "pareto_front",
+    "small_options",
     "staircase",
     "widest_arc",
+    "widest_reachable",
 ]
 
 FloatArray = NDArray[np.float64]
 Counts = tuple[int, ...]
 """How many actions of each type, in ``problem.action_kinds`` order."""
+Plans = list[tuple[float, float, tuple[str, ...], float]]
+"""``(p, cost, action types, success-arc length)`` of each plan, as the exact planner finds it."""
 
 ARC_CHUNK = 1 << 20
 """Arcs :func:`arc_front` enumerates at once (bounds memory for parts with many states)."""
@@ -168,24 +175,58 @@ class ArcFront:
     Sorted by ``span`` (of the image) increasing, with ``width`` strictly increasing: an
     arc is dropped when another is at least as wide and spans no more. Arc ``n`` is the
     open arc ``(lo[n], lo[n] + width[n])`` with image ``[s_first[n], s_first[n] + span[n]]``.
-    The lists repeat the arrays for the scalar binary searches of the planners. Build it
-    with :func:`arc_front`.
+    The values are held as lists (the scalar binary searches of the planners, and the
+    plain-Python paths of few states); the arrays ``lo``, ``width``, ``s_first`` and ``span``
+    are made from them on first use (numpy's paths). Build it with :func:`arc_front`.
     """
 
     kind: str
-    lo: FloatArray
-    width: FloatArray
-    s_first: FloatArray
-    span: FloatArray
     span_list: list[float]
     width_list: list[float]
+    s_first_list: list[float]
+    lo_list: list[float]
+    _arrays: dict[str, FloatArray] = field(default_factory=dict, repr=False)
+
+    @classmethod
+    def from_arrays(
+        cls, kind: str, lo: FloatArray, width: FloatArray, s_first: FloatArray, span: FloatArray
+    ) -> ArcFront:
+        """The front of these arrays (kept, and repeated as lists)."""
+        out = cls(kind, span.tolist(), width.tolist(), s_first.tolist(), lo.tolist())
+        out._arrays.update(lo=lo, width=width, s_first=s_first, span=span)
+        return out
+
+    def _array(self, name: str, values: list[float]) -> FloatArray:
+        if name not in self._arrays:
+            self._arrays[name] = np.array(values, dtype=np.float64)
+        return self._arrays[name]
+
+    @property
+    def lo(self) -> FloatArray:
+        """Start of each arc."""
+        return self._array("lo", self.lo_list)
+
+    @property
+    def width(self) -> FloatArray:
+        """Length of each arc (increasing)."""
+        return self._array("width", self.width_list)
+
+    @property
+    def s_first(self) -> FloatArray:
+        """First stable orientation of each arc's image."""
+        return self._array("s_first", self.s_first_list)
+
+    @property
+    def span(self) -> FloatArray:
+        """Length of each arc's image (increasing)."""
+        return self._array("span", self.span_list)
 
     def __len__(self) -> int:
         return len(self.width_list)
 
     def arc(self, n: int) -> Arc:
         """Arc ``n`` as plain floats."""
-        lo, s = float(self.lo[n]), float(self.s_first[n])
+        lo, s = self.lo_list[n], self.s_first_list[n]
         return Arc(self.kind, lo, lo + self.width_list[n], s, s + self.span_list[n])
 
     def widest(self, max_span: float) -> float:
@@ -240,8 +281,7 @@ def arc_front(
     if cand is not None:
         lo, width, first, span = geo.arcs(*cand)
         keep = pareto_front(span, width)
-        lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
-        return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+        return ArcFront.from_arrays(f.kind, lo[keep], width[keep], first[keep], span[keep])
     k = geo.k
     i_all = np.arange(k)
     n_off = int(np.max(geo.last - i_all)) + 1
@@ -256,44 +296,73 @@ def arc_front(
         parts.append((lo[keep], width[keep], first[keep], span[keep]))
     lo, width, first, span = (np.concatenate(x) for x in zip(*parts, strict=True))
     keep = pareto_front(span, width)
-    lo, width, first, span = lo[keep], width[keep], first[keep], span[keep]
-    return ArcFront(f.kind, lo, width, first, span, span.tolist(), width.tolist())
+    return ArcFront.from_arrays(f.kind, lo[keep], width[keep], first[keep], span[keep])
 
 
 def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
-    """:func:`arc_front` in plain Python floats for a few states, step for step.
+    """:func:`arc_front` in plain Python floats for a few states (:func:`_front_lists`)."""
+    lists = _front_lists(f.stable.tolist(), f.basin_lo.tolist(), f.basin_hi.tolist(), max_span)
+    return ArcFront(f.kind, *lists)
 
-    The same candidates in the same order (first basin, then last), the same float
-    operations and the same Pareto rule (:func:`pareto_front`: by span, a stable sort,
-    widths strictly increasing, the last of equal spans): the same front, bit for bit.
+
+def _front_lists(
+    stable: list[float], lo: list[float], hi: list[float], max_span: float
+) -> tuple[list[float], list[float], list[float], list[float]]:
+    """Span, width, first stable orientation and start of the front's arcs, step for step.
+
+    The front of :func:`arc_front`, bit for bit: the same candidates, the same float
+    operations and the same Pareto rule (:func:`pareto_front`: a stable sort by span, widths
+    strictly increasing, of equal spans the last kept; so of an equal span and width the
+    arc of the first basin). Done in the order that costs least on Python floats:
+
+    - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
+    - then the arcs of two or more basins, row by row; one no wider than the widest basin
+      never joins the front (the front's widths only increase), so it is not kept;
+    - sorted as ``(span, width, i)``: the stable sort by span, except that arcs of one span
+      come by width (then first basin), which leaves the same arc of each span on the front.
+
+    (On this interpreter a comprehension or a call of ``min`` or ``max`` costs as much as
+    several loop steps; the loops below avoid them.)
     """
-    k = f.n_states
-    stable, lo, hi = f.stable.tolist(), f.basin_lo.tolist(), f.basin_hi.tolist()
+    k = len(stable)
     s2 = stable + [x + TWO_PI for x in stable]
     hi2 = hi + [x + TWO_PI for x in hi]
-    cand: list[tuple[float, float, int, int]] = []  # (span, width, i, j), in (i, j) order
+    widest = -math.inf
+    first = 0
     for i in range(k):
-        last = min(max(bisect.bisect_left(s2, stable[i] + max_span) - 1, i), i + k - 1)
+        w = hi[i] - lo[i]
+        if w > widest:
+            widest, first = w, i
+    cand: list[tuple[float, float, int]] = []
+    add = cand.append
+    left = bisect.bisect_left
+    for i in range(k):
         si, li = stable[i], lo[i]
-        cand.extend((s2[j] - si, hi2[j] - li, i, j) for j in range(i, last + 1))
-    cand.sort(key=lambda c: c[0])  # stable: equal spans keep the (i, j) order
-    kept: list[tuple[float, float, int, int]] = []
-    best = -math.inf
-    for c in cand:
-        if c[1] > best:
-            best = c[1]
-            if kept and kept[-1][0] == c[0]:
-                kept[-1] = c  # of equal spans only the last (the widest) stays
+        # Arcs (i, j) for i <= j < end: the image spans less than max_span (K basins at most).
+        end = left(s2, si + max_span)
+        if end > i + k:
+            end = i + k
+        for j in range(i + 1, end):
+            w = hi2[j] - li
+            if w > widest:
+                add((s2[j] - si, w, i))
+    cand.sort()
+    spans, widths, rows = [0.0], [widest], [first]
+    best = widest
+    for x, w, i in cand:
+        if w > best:
+            best = w
+            if spans[-1] == x:  # of equal spans only the widest stays
+                widths[-1], rows[-1] = w, i
             else:
-                kept.append(c)
-    span = [c[0] for c in kept]
-    width = [c[1] for c in kept]
-    first = [stable[c[2]] for c in kept]
-    lo_kept = [lo[c[2]] for c in kept]
-    lo_a, width_a, first_a, span_a = (
-        np.array(x, dtype=np.float64) for x in (lo_kept, width, first, span)
-    )
-    return ArcFront(f.kind, lo_a, width_a, first_a, span_a, span, width)
+                spans.append(x)
+                widths.append(w)
+                rows.append(i)
+    firsts, los = [], []
+    for i in rows:
+        firsts.append(stable[i])
+        los.append(lo[i])
+    return spans, widths, firsts, los
 
 
 PRUNE_STATES = 256
@@ -307,6 +376,10 @@ STAIR_CELLS = 2_000_000
 
 # Steps of the front filled by enumeration in one round; more, and the threshold is lowered.
 _MAX_STEPS = 16
+
+FUSED = True
+"""Run the plain-list paths of parts of few states (:meth:`ArcPlanner.plan_options`); the
+tests turn it off to compare them with the general paths."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -541,16 +614,7 @@ class Staircase:
 
     def tau_list(self, xs: list[float]) -> list[float]:
         """:meth:`tau` in plain Python floats (the same operations, for a few spans)."""
-        n, c, rest, width = len(self.c_list), self.c_list, self.rest_list, self.width_list
-        floor = self.accuracy - _ROUNDING
-        out = []
-        for x in xs:
-            r = bisect.bisect_left(c, x)
-            at = rest[r] if r < n else -math.inf
-            before = 0.5 * (width[r - 1] - x) if r > 0 else -math.inf
-            value = at if at >= before else before
-            out.append(value if value > self.tol and value >= floor else -math.inf)
-        return out
+        return _tau(self.c_list, self.rest_list, self.width_list, self.tol, self.accuracy, xs)
 
     def tau(self, x: FloatArray) -> FloatArray:
         """Best least margin for images of spans ``x`` (``-inf`` where none fits)."""
@@ -564,10 +628,45 @@ class Staircase:
 
     def pick(self, x: float) -> Arc:
         """The arc that attains ``tau(x)`` for one span ``x``."""
-        r = bisect.bisect_left(self.c_list, x)
-        at = self.rest_list[r] if r < len(self.c_list) else -math.inf
-        before = 0.5 * (self.width_list[r - 1] - x) if r > 0 else -math.inf
-        return self.front.arc(int(self.index[r if at >= before else r - 1]))
+        r = _pick(self.c_list, self.rest_list, self.width_list, x)
+        return self.front.arc(int(self.index[r]))
+
+
+def _tau(
+    c: list[float],
+    rest: list[float],
+    width: list[float],
+    tol: float,
+    accuracy: float,
+    xs: list[float],
+) -> list[float]:
+    """:meth:`Staircase.tau` of the staircase ``(c, rest, width)`` on plain Python floats.
+
+    With ``r`` the first entry with ``c >= x``: the larger of ``rest[r]`` (``-inf`` past
+    the last) and ``(width[r - 1] - x) / 2`` (``-inf`` before the first), then ``-inf``
+    unless above ``tol`` and at least ``accuracy`` (less the rounding slack).
+    """
+    inf = math.inf
+    n = len(c)
+    floor = accuracy - _ROUNDING
+    left = bisect.bisect_left
+    out: list[float] = []
+    add = out.append
+    for x in xs:
+        r = left(c, x)
+        at = rest[r] if r < n else -inf
+        before = 0.5 * (width[r - 1] - x) if r > 0 else -inf
+        value = at if at >= before else before
+        add(value if value > tol and value >= floor else -inf)
+    return out
+
+
+def _pick(c: list[float], rest: list[float], width: list[float], x: float) -> int:
+    """The entry of the staircase ``(c, rest, width)`` that attains ``tau(x)``."""
+    r = bisect.bisect_left(c, x)
+    at = rest[r] if r < len(c) else -math.inf
+    before = 0.5 * (width[r - 1] - x) if r > 0 else -math.inf
+    return r if at >= before else r - 1
 
 
 def staircase(
@@ -611,44 +710,59 @@ def staircase(
 def _staircase_python(
     front: ArcFront, after: Staircase | None, tol: float, accuracy: float
 ) -> Staircase:
-    """:func:`staircase` in plain Python floats for a small front, step for step."""
-    spans, widths = front.span_list, front.width_list
-    if after is None:
-        index = [n for n, x in enumerate(spans) if x <= 0.0]
-        rest = [math.inf] * len(index)
-    else:
-        values = after.tau_list(spans)
-        index = [n for n, v in enumerate(values) if v > tol]
-        rest = [values[n] for n in index]
-    # pareto_front(-rest, width): most rest first (a stable sort), widths strictly
-    # increasing, of equal rests the last kept.
-    neg = [-r for r in rest]
-    kept: list[int] = []
-    best = -math.inf
-    for o in sorted(range(len(neg)), key=neg.__getitem__):
-        w = widths[index[o]]
-        if w > best:
-            best = w
-            if kept and neg[kept[-1]] == neg[o]:
-                kept[-1] = o
-            else:
-                kept.append(o)
-    idx = [index[o] for o in kept]
-    rest_kept = [rest[o] for o in kept]
-    width = [widths[n] for n in idx]
-    c = [w - 2.0 * r for w, r in zip(width, rest_kept, strict=True)]
+    """:func:`staircase` in plain Python floats for a small front (:func:`_stair_lists`)."""
+    values = None if after is None else after.tau_list(front.span_list)
+    idx, rest, width, c = _stair_lists(front.span_list, front.width_list, values, tol)
     return Staircase(
         front,
         np.array(idx, dtype=np.intp),
-        np.array(rest_kept, dtype=np.float64),
+        np.array(rest, dtype=np.float64),
         np.array(width, dtype=np.float64),
         np.array(c, dtype=np.float64),
         c,
         tol,
         accuracy,
-        rest_kept,
+        rest,
         width,
     )
+
+
+def _stair_lists(
+    spans: list[float], widths: list[float], values: list[float] | None, tol: float
+) -> tuple[list[int], list[float], list[float], list[float]]:
+    """Front index, rest, width and ``c`` of a staircase's entries, step for step.
+
+    ``values`` is the next action's ``tau`` at each arc of the front (``None``: this is the
+    last action, and only single basins count). The entries are what :func:`staircase`
+    keeps, ``pareto_front(-rest, width)`` of the arcs with ``rest > tol``: since the front's
+    widths increase with the index, that is every arc whose rest exceeds the rest of each
+    wider arc, found by one scan from the widest down, and already in the front's order
+    (rest decreasing, widths increasing). For the last action every single basin has rest
+    ``inf``: the widest of them (the front's spans increase from 0, so they come first).
+    """
+    if values is None:
+        n = bisect.bisect_right(spans, 0.0)  # the arcs of span <= 0: single basins
+        if n == 0:
+            return [], [], [], []
+        return [n - 1], [math.inf], [widths[n - 1]], [widths[n - 1] - 2.0 * math.inf]
+    idx: list[int] = []
+    rest: list[float] = []
+    best = -math.inf
+    for n in range(len(values) - 1, -1, -1):
+        v = values[n]
+        if v > tol and v > best:
+            best = v
+            idx.append(n)
+            rest.append(v)
+    idx.reverse()
+    rest.reverse()
+    width: list[float] = []
+    c: list[float] = []
+    for n, r in zip(idx, rest, strict=True):
+        w = widths[n]
+        width.append(w)
+        c.append(w - 2.0 * r)
+    return idx, rest, width, c
 
 
 @dataclass(slots=True)
@@ -683,12 +797,15 @@ class ArcPlanner:
     margins: dict[tuple[tuple[str, ...], float], float] = field(default_factory=dict)
     index: dict[str, int] = field(init=False)  # position of each action type in a Counts
     period: float = field(init=False)
+    # Every action has at most SMALL states: plan_options works on the fronts' lists.
+    small: bool = field(init=False)
 
     def __post_init__(self) -> None:
         kinds = self.problem.action_kinds
         self.index = {t: i for i, t in enumerate(kinds)}
-        periods = [self.problem.transfers[t].period for t in kinds]
-        self.period = min(max(periods), TWO_PI / self.problem.goal_group)
+        transfers = [self.problem.transfers[t] for t in kinds]
+        self.period = min(max(f.period for f in transfers), TWO_PI / self.problem.goal_group)
+        self.small = few_states(transfers)
 
     @classmethod
     def for_problem(cls, problem: Problem) -> ArcPlanner:
@@ -732,23 +849,11 @@ class ArcPlanner:
     def widest_reachable(self, cap: float, max_actions: int) -> float:
         """The widest arc any plan collapses, up to ``cap`` (at most ``max_actions`` actions).
 
-        The widest arc of ``k + 1`` actions is ``G(W_k)``, with ``G(L)`` the widest arc of any
-        action type whose image fits an arc ``L`` wide (the best counts of each length keep
-        the widest arc, and ``G`` is non-decreasing). So the widths ``W_k`` are monotone from
-        the first step on: once ``W_{k+1} <= W_k`` no longer plan collapses more. Without
-        accuracy they grow to the period (Goldberg 1993); with it they may stop short.
+        See :func:`widest_reachable`.
         """
-        margin = max(self.tol, self.problem.accuracy)
         fronts = [self.front(t) for t in self.problem.action_kinds]
-        width = max(f.widest(self.tol) for f in fronts)
-        for _ in range(max_actions - 1):
-            if width >= cap:
-                break
-            wider = max(f.widest(width - 2.0 * margin) for f in fronts)
-            if wider <= width + self.tol:
-                break
-            width = wider
-        return width
+        margin = max(self.tol, self.problem.accuracy)
+        return widest_reachable(fronts, self.tol, margin, cap, max_actions)
 
     def order(self, counts: Counts, first: str) -> tuple[str, ...]:
         """Action types of a plan in order: ``first``, then the best order of the rest."""
@@ -824,6 +929,34 @@ class ArcPlanner:
         for (kinds, length), t, ok in zip(todo, lo.tolist(), start.tolist(), strict=True):
             if ok:
                 self.margins[(kinds, length)] = t
+
+    def plan_options(self, plans: Plans) -> list[PlanOption]:
+        """The plan options of ``(p, cost, action types, success-arc length)`` plans.
+
+        Each plan's witnesses (:meth:`witnesses`) turned into gripper angles
+        (:func:`chain_option`), the prior placed on the success arc capped at the period.
+        For parts of few states (:attr:`small`) the same steps run on the fronts' lists
+        (:func:`small_options`): the same options, bit for bit.
+        """
+        if self.small and FUSED:
+            longest = max(len(kinds) for _, _, kinds, _ in plans)
+            fronts = [self.front(t) for t in self.problem.action_kinds]
+            if longest * max(len(f) for f in fronts) <= STAIR_CELLS:
+                return small_options(
+                    self.problem,
+                    dict(zip(self.problem.action_kinds, fronts, strict=True)),
+                    self.tol,
+                    plans,
+                )
+        self.prepare_margins([(kinds, width) for _, _, kinds, width in plans])
+        out = []
+        for p, cost, kinds, width in plans:
+            chain, tolerance = self.witnesses(kinds, width)
+            placed = min(width, self.period)
+            out.append(
+                chain_option(self.problem, chain, tolerance, placed, p, cost, chain[0].width)
+            )
+        return out
 
     def staircases(self, kinds: tuple[str, ...]) -> list[Staircase]:
         """The staircase of ``kinds[m:]`` for each ``m``."""
@@ -925,6 +1058,144 @@ class ArcPlanner:
         chain.append(fronts[-1].arc(0))
         margin = min(0.5 * (b.width - a.span) for a, b in itertools.pairwise(chain))
         return chain, margin
+
+
+def few_states(transfers: Iterable[TransferFunction]) -> bool:
+    """Whether every transfer function has at most :data:`~bayesgrasp.sizes.SMALL` states.
+
+    The plain-list paths of the planners (:func:`small_options`) run for such problems.
+    """
+    for f in transfers:
+        if len(f.stable) > SMALL:
+            return False
+    return True
+
+
+def widest_reachable(
+    fronts: list[ArcFront], tol: float, margin: float, cap: float, max_actions: int
+) -> float:
+    """The widest arc any plan collapses, up to ``cap`` (at most ``max_actions`` actions).
+
+    ``fronts`` are those of the action types; each image must fit the next arc with
+    ``margin`` to spare on each side. The widest arc of ``k + 1`` actions is ``G(W_k)``,
+    with ``G(L)`` the widest arc of any action type whose image fits an arc ``L`` wide (the
+    best counts of each length keep the widest arc, and ``G`` is non-decreasing). So the
+    widths ``W_k`` are monotone from the first step on: once ``W_{k+1} <= W_k`` no longer
+    plan collapses more. Without accuracy they grow to the period (Goldberg 1993); with it
+    they may stop short.
+    """
+    width = max(f.widest(tol) for f in fronts)
+    for _ in range(max_actions - 1):
+        if width >= cap:
+            break
+        wider = max(f.widest(width - 2.0 * margin) for f in fronts)
+        if wider <= width + tol:
+            break
+        width = wider
+    return width
+
+
+def small_options(
+    problem: Problem, fronts: dict[str, ArcFront], tol: float, plans: Plans
+) -> list[PlanOption]:
+    """:meth:`ArcPlanner.plan_options` on the fronts' lists: no :class:`Staircase` nor :class:`Arc`.
+
+    The staircase of each suffix of action types (keyed, as in :meth:`ArcPlanner.staircases`,
+    by its first action and the staircase after it), and its ``tau`` at every arc of the
+    front of the action before it, are computed once for all the plans (a plan of ``k``
+    actions needs the ``tau`` that makes the staircase of ``k`` actions); the witnesses are
+    front indices. Every float operation is the one of :meth:`ArcPlanner.witnesses`,
+    :meth:`Staircase.pick` and :func:`chain_option`, so the options are the same, bit for bit
+    (the planner checks that no chain would need more than :data:`STAIR_CELLS` entries).
+    """
+    accuracy = problem.accuracy
+    prior, group = problem.prior, problem.goal_group
+    period = 0.0
+    for t in problem.action_kinds:
+        if problem.transfers[t].period > period:
+            period = problem.transfers[t].period
+    cap = TWO_PI / group
+    if period < cap:  # ArcPlanner.period: min(largest period, 2 pi / group)
+        cap = period
+    actions = {a.name: a for a in problem.actions}
+    inf = math.inf
+    # (kind, id of the staircase after it, or -1) -> (id, front index, rest, width, c)
+    stairs: dict[tuple[str, int], tuple[int, list[int], list[float], list[float], list[float]]]
+    stairs = {}
+    taus: dict[tuple[str, int], list[float]] = {}  # (kind, staircase id) -> tau at its front
+
+    out = []
+    for p, cost, kinds, length in plans:
+        k = len(kinds)
+        chain_stairs = []  # the staircases of kinds[k-1:], kinds[k-2:], ..., kinds[1:]
+        after = None
+        for m in range(k - 1, 0, -1):
+            t = kinds[m]
+            key = (t, -1 if after is None else after[0])
+            st = stairs.get(key)
+            if st is None:
+                g = fronts[t]
+                later: list[float] | None = None
+                if after is not None:
+                    later = _tau_at(taus, t, g, after, tol, accuracy)
+                st = (len(stairs), *_stair_lists(g.span_list, g.width_list, later, tol))
+                stairs[key] = st
+            chain_stairs.append(st)
+            after = st
+        f = fronts[kinds[0]]
+        spans = f.span_list
+        at = bisect.bisect_left(f.width_list, length - tol)  # the arcs at..end are wide enough
+        if after is None:  # one action: a single basin
+            tolerance = None
+            while spans[at] > 0.0:
+                at += 1
+        else:
+            values = _tau_at(taus, kinds[0], f, after, tol, accuracy)
+            best = -inf
+            for n in range(at, len(values)):
+                if values[n] > best:
+                    best = values[n]
+            if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
+                raise PlanningError("internal error: no witness chain for a plan the lengths allow")
+            while values[at] < best - tol:
+                at += 1
+            tolerance = best
+        # chain_option, witness by witness: the first placed by the prior, each later one
+        # picked by its staircase for the span of the one before (Arc.span: s_last - s),
+        # the turn centring that image in it.
+        lo = f.lo_list[at]
+        _, start = prior.max_arc_mass(length if length < cap else cap, group, prefer=lo)
+        angles = [start - lo]
+        arc = (lo + f.width_list[at]) - lo  # Arc.width
+        for m in range(1, k):
+            s = f.s_first_list[at]
+            s_last = s + f.span_list[at]
+            _, idx, rest, width, c = chain_stairs[k - 1 - m]
+            at = idx[_pick(c, rest, width, s_last - s)]
+            f = fronts[kinds[m]]
+            lo = f.lo_list[at]
+            angles.append(0.5 * (s + s_last) - 0.5 * (lo + (lo + f.width_list[at])))
+        steps, turned = short_turns([actions[t] for t in kinds], angles)
+        final = math.fmod(f.s_first_list[at] + turned + TWO_PI, TWO_PI)
+        out.append(new_option(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
+    return out
+
+
+def _tau_at(
+    taus: dict[tuple[str, int], list[float]],
+    kind: str,
+    front: ArcFront,
+    stair: tuple[int, list[int], list[float], list[float], list[float]],
+    tol: float,
+    accuracy: float,
+) -> list[float]:
+    """``tau`` of ``stair`` at every arc of ``front`` (of action ``kind``), memoised."""
+    key = (kind, stair[0])
+    values = taus.get(key)
+    if values is None:
+        _, _, rest, width, c = stair
+        values = taus[key] = _tau(c, rest, width, tol, accuracy, front.span_list)
+    return values
 
 
 def chain_option(

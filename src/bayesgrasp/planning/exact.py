@@ -28,17 +28,26 @@ this success arc.
 
 Cost: O(K^2) once per action type for the front (K stable orientations; usually far fewer
 arcs survive), then O(log K) per (count, type) for the lengths and O(F log F) per action of
-each reported plan for its witnesses (F arcs on the front).
+each reported plan for its witnesses (F arcs on the front). Parts whose every action has at
+most :data:`~bayesgrasp.sizes.SMALL` states (the seed's study: about 6) are planned on plain
+Python lists end to end (one action type: :func:`_plan_one_small`; the angles of any:
+:func:`~bayesgrasp.planning.arcs.small_options`), with the same plans bit for bit.
 """
 
 from __future__ import annotations
 
+import bisect
+from collections.abc import Callable
 from typing import Literal
 
+from ..angles import TWO_PI
 from ..errors import PlanningError
+from ..model.cost import CostModel
+from ..model.prior import Prior
 from ..model.problem import Problem
-from .arcs import ArcPlanner, Counts, chain_option
-from .result import COST_RTOL, PlanOption, PlanResult, choose_among, max_plan_length
+from . import arcs
+from .arcs import ArcPlanner, Counts
+from .result import COST_RTOL, PlanResult, choose_among, max_plan_length, new_result
 
 __all__ = ["Report", "plan_exact"]
 
@@ -112,38 +121,148 @@ def plan_exact(
         raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
     if report not in ("all", "best"):
         raise PlanningError(f"`report` must be 'all' or 'best'; got {report!r}")
-    group = problem.goal_group
-    prior = problem.prior
-    kinds = problem.action_kinds
+    if len(problem.actions) == 1 and arcs.FUSED and arcs.few_states(problem.transfers.values()):
+        return _plan_one_small(problem, max_actions, report)
     p_tol = problem.part.hull.tol.probability
     planner = ArcPlanner.for_problem(problem)
     cap = planner.period  # no plan orients beyond the period
     limit_hard = max_plan_length(problem)
+    mass = _masses(problem.prior, problem.goal_group, cap)
     # With an accuracy the widths may stop growing short of the period: the highest
     # attainable probability is that of the widest arc any plan collapses.
-    reach = planner.widest_reachable(cap, limit_hard)
-    p_best, _ = prior.max_arc_mass(min(reach, cap), group)
+    p_best = mass(planner.widest_reachable(cap, limit_hard))
+    attempt = _attempts(problem.cost)
+    args = (problem, planner.tol, mass, attempt, p_best, p_tol, max_actions, limit_hard)
+    options = _search(planner, *args)
+    options, bayes, most = _choose(options, p_tol, report)
+    return PlanResult(problem, tuple(planner.plan_options(options)), bayes, most, "exact")
 
-    # (p, cost, kinds, width) of the best plan of each length; angles come last.
-    options: list[tuple[float, float, tuple[str, ...], float]] = []
-    level: list[Counts] = [(0,) * len(kinds)]
-    first_kind = min(kinds, key=lambda t: problem.cost.action_cost(t, first=True))
-    next_kind = min(kinds, key=lambda t: problem.cost.action_cost(t))
 
-    def cheap_kinds(n: int) -> tuple[str, ...]:
-        """The action types of the cheapest attempt of ``n`` actions."""
-        return (first_kind,) + (next_kind,) * (n - 1)
+# (p, cost, action types, width) of the best plan of a length; angles come last.
+_Scored = tuple[float, float, tuple[str, ...], float]
 
-    cost = problem.cost
+
+def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -> PlanResult:
+    """:func:`plan_exact` for one action type of at most :data:`~bayesgrasp.sizes.SMALL` states.
+
+    The same steps on plain lists, without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`:
+    the front (its plain-Python path); the widths ``W_k`` of each length, which for one
+    action type are one sequence, ``W_1`` the widest single basin and ``W_k`` the front's
+    widest under ``W_{k-1}`` less twice the margin
+    (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the search
+    to the first length that reaches its probability, as :func:`_search` does with one
+    type); the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right);
+    and the angles on the front's lists (:func:`~bayesgrasp.planning.arcs.small_options`).
+    The same plans, bit for bit (the tests run both).
+    """
+    (action,) = problem.actions
+    kind = action.name
+    f = problem.transfers[kind]
+    tol = problem.states.angle_tol
+    group = problem.goal_group
+    cap = TWO_PI / group  # ArcPlanner.period: min(period, 2 pi / group)
+    if f.period < cap:
+        cap = f.period
+    front = arcs.arc_front(f, f.period + tol)  # ArcPlanner.max_span
+    spans, widths = front.span_list, front.width_list
+    left = bisect.bisect_left
+    margin2 = 2.0 * (tol if tol >= problem.accuracy else problem.accuracy)  # max(tol, accuracy)
+    limit_hard = max_plan_length(problem)
+    prior, cost = problem.prior, problem.cost
+
+    n = left(spans, tol) - 1
+    grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
+    width = grown[0]
+    for _ in range(limit_hard - 1):  # widest_reachable
+        if width >= cap:
+            break
+        n = left(spans, width - margin2) - 1
+        wider = widths[n] if n >= 0 else 0.0
+        grown.append(wider)
+        if wider <= width + tol:
+            break
+        width = wider
+    # The prior mass of the success arc, placed best (capped at the period; memoised).
+    masses = {}
+    x = width if width <= cap else cap  # min(width, cap)
+    p_best = masses[x] = prior.max_arc_mass(x, group)[0]
+    p_tol = problem.part.hull.tol.probability
+    step = cost.action_cost(kind)
+    run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
+    options: list[_Scored] = []
+    costs: list[float] = []
+    probs: list[float] = []
+    k = 0
+    while True:
+        k += 1
+        if k > 1:
+            run = run + step
+        if k > len(grown):  # pragma: no cover - the widths reach p_best within `grown`
+            n = left(spans, grown[-1] - margin2) - 1
+            grown.append(widths[n] if n >= 0 else 0.0)
+        width = grown[k - 1]
+        x = width if width <= cap else cap
+        p = masses.get(x)
+        if p is None:
+            p = masses[x] = prior.max_arc_mass(x, group)[0]
+        c = cost.expected_from_attempt(cost.verify + run, p)
+        options.append((p, c, (kind,) * k, width))
+        costs.append(c)
+        probs.append(p)
+        if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
+            break
+        if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
+            raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
+    options, bayes, most = _choose(options, p_tol, report, costs, probs)
+    if k * len(front) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
+        plans = ArcPlanner.for_problem(problem).plan_options(options)
+    else:
+        plans = arcs.small_options(problem, {kind: front}, tol, options)
+    return new_result(problem, tuple(plans), bayes, most, "exact")
+
+
+def _choose(
+    options: list[_Scored],
+    p_tol: float,
+    report: Report,
+    costs: list[float] | None = None,
+    probs: list[float] | None = None,
+) -> tuple[list[_Scored], int, int]:
+    """The options to report, and the indices of the Bayes and the most certain among them.
+
+    ``costs`` and ``probs`` are the options' expected costs and probabilities, if at hand.
+    """
+    if costs is None or probs is None:
+        costs, probs = [o[1] for o in options], [o[0] for o in options]
+    bayes, most = choose_among(costs, probs, p_tol)
+    if report == "best":  # as PlanResult.best_only, before the angles are computed
+        keep = sorted({bayes, most})
+        return [options[i] for i in keep], keep.index(bayes), keep.index(most)
+    return options, bayes, most
+
+
+def _masses(prior: Prior, group: int, cap: float) -> Callable[[float], float]:
+    """The prior mass of the best placed arc of a width capped at ``cap`` (memoised)."""
+    masses: dict[float, float] = {}
+
+    def mass(width: float) -> float:
+        x = min(width, cap)
+        if x not in masses:
+            masses[x] = prior.max_arc_mass(x, group)[0]
+        return masses[x]
+
+    return mass
+
+
+def _attempts(cost: CostModel) -> Callable[[tuple[str, ...]], float]:
+    """``cost.attempt_cost``, in O(1) amortised for plans of one repeated action.
+
+    Its sum is left to right, so the partial sums of ``first, kind, kind, ...`` are kept and
+    extended (the plans of each length are one action longer): bit for bit the same value.
+    """
     runs: dict[tuple[str, str], list[float]] = {}
 
     def attempt(order: tuple[str, ...]) -> float:
-        """``cost.attempt_cost(order)``, in O(1) amortised for plans of one repeated action.
-
-        Its sum is left to right, so the partial sums of ``first, kind, kind, ...`` are
-        kept and extended (the plans of each length are one action longer): bit for bit
-        the same value.
-        """
         if len(order) < 3 or order.count(order[1]) - (order[0] == order[1]) != len(order) - 1:
             return cost.attempt_cost(order)
         partial = runs.setdefault((order[0], order[1]), [0 + cost.action_cost(order[0], True)])
@@ -152,15 +271,41 @@ def plan_exact(
             partial.append(partial[-1] + step)
         return cost.verify + partial[len(order) - 1]
 
+    return attempt
+
+
+def _search(
+    planner: ArcPlanner,
+    problem: Problem,
+    tol: float,
+    mass: Callable[[float], float],
+    attempt: Callable[[tuple[str, ...]], float],
+    p_best: float,
+    p_tol: float,
+    max_actions: int | None,
+    limit_hard: int,
+) -> list[_Scored]:
+    """The best plan of each length (and perhaps one more, see :func:`plan_exact`)."""
+    kinds = problem.action_kinds
+    cost = problem.cost
+    options: list[_Scored] = []
+    level: list[Counts] = [(0,) * len(kinds)]
+    first_kind = min(kinds, key=lambda t: cost.action_cost(t, first=True))
+    next_kind = min(kinds, key=lambda t: cost.action_cost(t))
+
+    def cheap_kinds(n: int) -> tuple[str, ...]:
+        """The action types of the cheapest attempt of ``n`` actions."""
+        return (first_kind,) + (next_kind,) * (n - 1)
+
     certain_at: int | None = None  # the length of the most certain plan, once found
-    extra: tuple[float, float, tuple[str, ...], float] | None = None
+    extra: _Scored | None = None
     k = 0
     while True:
         k += 1
         candidates, nxt = planner.extend(level)
         scored = []
         for key, t, width in candidates:
-            p, _ = prior.max_arc_mass(min(width, cap), group)
+            p = mass(width)
             order = planner.order(key, t)
             scored.append((p, cost.expected_from_attempt(attempt(order), p), order, width))
         cheapest = min(scored, key=lambda s: (s[1], -s[0]))
@@ -186,7 +331,7 @@ def plan_exact(
             if (
                 len(kinds) == 1
                 or (max_actions is not None and k >= max_actions)
-                or problem.cost.expected_cost(cheap_kinds(k + 1), p_best) >= bound * (1 - COST_RTOL)
+                or cost.expected_cost(cheap_kinds(k + 1), p_best) >= bound * (1 - COST_RTOL)
             ):
                 break
         if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
@@ -194,30 +339,4 @@ def plan_exact(
         level = nxt
     if extra is not None:
         options.append(extra)
-    bayes, most = choose_among([o[1] for o in options], [o[0] for o in options], p_tol)
-    if report == "best":  # as PlanResult.best_only, before the angles are computed
-        keep = sorted({bayes, most})
-        options = [options[i] for i in keep]
-        bayes, most = keep.index(bayes), keep.index(most)
-    planner.prepare_margins([(order, width) for _, _, order, width in options])
-    plans = tuple(
-        _option(planner, order, width, min(width, cap), p, cost)
-        for p, cost, order, width in options
-    )
-    return PlanResult(problem, plans, bayes, most, "exact")
-
-
-def _option(
-    planner: ArcPlanner,
-    kinds: tuple[str, ...],
-    width: float,
-    placed: float,
-    p: float,
-    cost: float,
-) -> PlanOption:
-    """Turn a plan's action types and success-arc width into angles, margin and goal.
-
-    ``placed`` is the length of arc the prior is placed on (``width`` capped at the period).
-    """
-    chain, tolerance = planner.witnesses(kinds, width)
-    return chain_option(planner.problem, chain, tolerance, placed, p, cost, chain[0].width)
+    return options

@@ -26,7 +26,7 @@ from typing import Literal, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..angles import TWO_PI, wrap, wrap_period
+from ..angles import TWO_PI
 from ..errors import NoPlanError, PlanningError
 from ..model.actions import Action
 from ..model.problem import Problem
@@ -44,6 +44,8 @@ __all__ = [
     "choose_indices",
     "execute_plan",
     "max_plan_length",
+    "new_option",
+    "new_result",
     "plan_actions",
     "short_turns",
 ]
@@ -325,15 +327,32 @@ def choose_among(
     >>> choose_among([6.0, 6.0, 7.0], [0.3, 0.5, 0.5])
     (0, 1)
     """
-    cost = [float(c) for c in costs]
-    prob = [float(p) for p in probs]
-    m = min(cost)
+    if not costs:
+        raise ValueError("no plans to choose among")
+    # Loops, not min/max and generators: the exact planner calls this for every part.
+    cost = []
+    m = math.inf
+    for x in costs:
+        c = float(x)
+        cost.append(c)
+        if c < m:
+            m = c
+    bayes = 0
     if math.isfinite(m):
-        bayes = next(i for i, c in enumerate(cost) if c - m <= COST_RTOL * abs(m))
-    else:
-        bayes = 0
-    top = max(prob) - tol
-    most = next(i for i, p in enumerate(prob) if p >= top)
+        slack = COST_RTOL * abs(m)
+        while cost[bayes] - m > slack:
+            bayes += 1
+    prob = []
+    top = -math.inf
+    for x in probs:
+        q = float(x)
+        prob.append(q)
+        if q > top:
+            top = q
+    top -= tol
+    most = 0
+    while not prob[most] >= top:
+        most += 1
     return bayes, most
 
 
@@ -391,12 +410,70 @@ def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[lis
     """
     steps = []
     carry = 0.0  # how much further round the part lies in the current frame
+    remainder, pi = math.remainder, math.pi
     for action, angle in zip(actions, angles, strict=True):
-        a = wrap(angle + carry)
-        short = wrap_period(a, action.gripper_period)
+        # wrap(angle + carry), then wrap_period(a, g) (angles.py), inlined: the planners
+        # make every step of every plan here.
+        r = remainder(angle + carry, TWO_PI)
+        a = pi if r == -pi else r
+        g = action.gripper_period
+        r = remainder(a, g)
+        short = g / 2.0 if r == -g / 2.0 else r
         carry = a - short  # 0, or +-pi for a period of pi
-        steps.append(PlanStep(action.name, short))
+        step = _new(PlanStep)
+        _set_kind(step, action.name)
+        _set_alpha(step, short)
+        steps.append(step)
     return steps, carry
+
+
+# The planners make thousands of steps, options and results a second; a frozen dataclass's
+# __init__ sets each field through object.__setattr__, about twice the cost of setting its
+# slots directly. short_turns, new_option and new_result make the same objects (none of the
+# classes has a __post_init__; tests/planning/test_small.py checks them against their
+# constructors).
+_new = object.__new__
+_set_kind, _set_alpha = (vars(PlanStep)[name].__set__ for name in ("kind", "alpha"))
+_set_option = [vars(PlanOption)[name].__set__ for name in PlanOption.__slots__]
+
+
+def new_option(
+    steps: tuple[PlanStep, ...],
+    final_orientation: float,
+    success_probability: float,
+    expected_cost: float,
+    tolerance: float | None,
+    success_arc: tuple[float, float],
+) -> PlanOption:
+    """``PlanOption(...)`` of these fields, made faster (for the planners' inner loops)."""
+    out = _new(PlanOption)
+    a, b, c, d, e, f = _set_option
+    a(out, steps)
+    b(out, final_orientation)
+    c(out, success_probability)
+    d(out, expected_cost)
+    e(out, tolerance)
+    f(out, success_arc)
+    return out
+
+
+_set_result = [vars(PlanResult)[name].__set__ for name in PlanResult.__slots__]
+
+
+def new_result(
+    problem: Problem,
+    options: tuple[PlanOption, ...],
+    bayes: int,
+    most_certain: int,
+    method: str,
+) -> PlanResult:
+    """``PlanResult(problem, options, bayes, most_certain, method)``, made faster."""
+    out = _new(PlanResult)
+    for setter, value in zip(
+        _set_result, (problem, options, bayes, most_certain, method, None, "ok", None), strict=True
+    ):
+        setter(out, value)
+    return out
 
 
 def execute_plan(
