@@ -301,7 +301,8 @@ def arc_front(
 
 def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
     """:func:`arc_front` in plain Python floats for a few states (:func:`_front_lists`)."""
-    lists = _front_lists(f.stable.tolist(), f.basin_lo.tolist(), f.basin_hi.tolist(), max_span)
+    stable, lo, hi = (list(v) for v in f.values)  # no arrays made for a few states
+    lists = _front_lists(stable, lo, hi, max_span)
     return ArcFront(f.kind, *lists)
 
 
@@ -1066,7 +1067,7 @@ def few_states(transfers: Iterable[TransferFunction]) -> bool:
     The plain-list paths of the planners (:func:`small_options`) run for such problems.
     """
     for f in transfers:
-        if len(f.stable) > SMALL:
+        if f.n_states > SMALL:
             return False
     return True
 
