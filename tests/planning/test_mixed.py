@@ -34,6 +34,7 @@ def landed(pb: Problem, o: PlanOption, theta: np.ndarray = GRID) -> float:
     return float(np.mean(d < 1e-9))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("push_cost", [1.0, 2.0])
 def test_exact_agrees_with_breadth_first(rng: np.random.Generator, push_cost: float) -> None:
     """Best plan of every length up to 4 actions, exhaustive search (no node limit).
