@@ -279,7 +279,7 @@ CASES = [
 
 @pytest.mark.parametrize(("sigma", "res"), SENSORS, ids=["exact", "quantised", "noisy"])
 @pytest.mark.parametrize(("name", "parts", "actions", "prior"), CASES, ids=[c[0] for c in CASES])
-@pytest.mark.parametrize("depth", [1, 2])
+@pytest.mark.parametrize(("depth", "accuracy_deg"), [(1, 0.0), (2, 0.0), (2, 3.0), (2, 12.0)])
 def test_planner_equals_and_or_search(
     name: str,
     parts: list[list[tuple[float, float]]],
@@ -288,12 +288,16 @@ def test_planner_equals_and_or_search(
     sigma: float,
     res: float,
     depth: int,
+    accuracy_deg: float,
 ) -> None:
-    problems = [build(p, actions=actions) for p in parts]
+    """Also with a gripper accuracy: the reference keeps only the classes it allows."""
+    acc = math.radians(accuracy_deg)
+    problems = [build(p, actions=actions, accuracy=acc) for p in parts]
     pol = plan_policy(problems, WidthSensor(sigma, res), depth, part_prior=prior)
     ref = reference_cost(problems, sigma, res, depth, prior)
     assert_allclose(pol.expected_cost, ref, rtol=0, atol=1e-9)
     check_claims(pol)
+    assert all(m >= acc for m in margins(pol.root))
 
 
 @pytest.mark.slow
@@ -561,27 +565,6 @@ def test_bad_input_is_a_clear_error(kwargs: dict, match: str) -> None:
 def test_candidate_parts_must_share_the_accuracy() -> None:
     with pytest.raises(PlanningError, match="same gripper `accuracy`"):
         plan_policy([build(QUAD, accuracy=0.01), build(TRIANGLE)], "width")
-
-
-@pytest.mark.parametrize(("sigma", "res"), SENSORS, ids=["exact", "quantised", "noisy"])
-@pytest.mark.parametrize(("name", "parts", "actions", "prior"), CASES, ids=[c[0] for c in CASES])
-@pytest.mark.parametrize("accuracy_deg", [3.0, 12.0])
-def test_planner_with_an_accuracy_equals_and_or_search(
-    name: str,
-    parts: list[list[tuple[float, float]]],
-    actions: tuple[str, ...],
-    prior: tuple[float, ...] | None,
-    sigma: float,
-    res: float,
-    accuracy_deg: float,
-) -> None:
-    acc = math.radians(accuracy_deg)
-    problems = [build(p, actions=actions, accuracy=acc) for p in parts]
-    pol = plan_policy(problems, WidthSensor(sigma, res), 2, part_prior=prior)
-    ref = reference_cost(problems, sigma, res, 2, prior)
-    assert_allclose(pol.expected_cost, ref, rtol=0, atol=1e-9)
-    check_claims(pol)
-    assert all(m >= acc for m in margins(pol.root))
 
 
 def margins(node: PolicyNode) -> list[float]:
