@@ -311,3 +311,19 @@ def test_small_arrays_whose_sum_overflows_take_the_general_check() -> None:
     assert_array_equal(part.outline, big)
     assert not part.outline.flags.writeable
     assert part.outline is not big  # a copy, as as_points makes
+
+
+def test_the_public_constructor_copies_and_reads_pairs_as_rows() -> None:
+    """Pairs given as an (N, 2) list keep their rows; the caller's arrays stay writeable."""
+    import numpy as np
+
+    from bayesgrasp.geometry import Part
+    from bayesgrasp.geometry.diameter import DiameterFunction, diameter_function
+
+    d = diameter_function(Part.from_points([(0, 0), (3, 0), (1, 2)]).hull)
+    mine = np.array(d.breaks)
+    again = DiameterFunction(
+        d.polygon, mine, d.lengths, d.phases, d.pairs.tolist(), d.minima, d.maxima
+    )
+    assert again.pairs.tolist() == d.pairs.tolist()
+    assert again.breaks.tolist() == d.breaks.tolist() and mine.flags.writeable

@@ -125,7 +125,8 @@ def test_a_cut_bounds_the_value_and_values_fall_with_the_price(
     seed: int, rel: float, r: int, shift: float
 ) -> None:
     """``value(q, r, budget)``: the exact value, or a bound in ``[budget, V]``; and ``V``
-    does not rise when the price falls (what makes the floors lower bounds)."""
+    does not fall when the price falls (``c - lambda p`` grows as ``lambda`` shrinks: what
+    makes the values of earlier, higher prices lower bounds later)."""
     exact = programme(seed, rel, frozenset())
     cut = programme(seed, rel, ALL)
     g = np.random.default_rng(seed)

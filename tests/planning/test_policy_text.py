@@ -85,3 +85,13 @@ def test_plan_sense_folds_the_printed_tree(capsys: pytest.CaptureFixture[str]) -
         tree = capsys.readouterr().out.rsplit("\n", 2)[0]  # without the figures' line
         assert tree == policy_text(pol, min_probability=t)
     assert main([*argv, "--fold-below", "1.5"]) == 2
+
+
+def test_huge_part_weights_are_normalised_without_overflow() -> None:
+    from bayesgrasp.geometry import Part
+
+    tri = Problem.build(Part.from_points([(0.0, 0.0), (4.0, 0.0), (1.0, 3.0)], name="a"))
+    rect = Problem.build(Part.from_points([(0, 0), (3, 0), (3, 1), (0, 1)], name="b"))
+    big = plan_policy([tri, rect], "width", 2, part_prior="1e308,1e308")
+    assert big.part_prior == (0.5, 0.5)
+    assert big.expected_cost == plan_policy([tri, rect], "width", 2).expected_cost

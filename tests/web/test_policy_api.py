@@ -59,7 +59,8 @@ def test_policy_equals_cli(
         ({"sense": "camera"}, "width:SIGMA,RES"),
         ({"part_prior": [1, 2]}, "one weight per part"),
         ({"max_actions": 0}, "max_actions"),
-        ({"max_actions": 9}, "max_actions"),
+        ({"max_actions": 5}, "max_actions"),
+        ({"also": [{"catalogue": "key"}] * 4}, "also"),
         ({"also": [{"catalogue": "no-such-part"}]}, "not a catalogue part"),
     ],
 )

@@ -138,7 +138,8 @@ PartPriorOpt = Annotated[
 MaxActionsOpt = Annotated[
     int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
 ]
-"""The options of a sensing policy (plan, simulate and plot --sense): a :class:`SenseSpec`."""
+# SenseOpt, AlsoOpt, PartPriorOpt and MaxActionsOpt: the options of a sensing policy (plan,
+# simulate and plot --sense), gathered into a SenseSpec.
 FoldOpt = Annotated[
     float,
     typer.Option(

@@ -110,9 +110,21 @@ class DiameterFunction:
         minima: ArrayLike,
         maxima: ArrayLike,
     ) -> None:
+        f8 = np.float64
+        cols = (
+            np.array(breaks, dtype=f8),
+            np.array(lengths, dtype=f8),
+            np.array(phases, dtype=f8),
+            np.array(pairs, dtype=np.intp).reshape(-1, 2),
+            np.array(minima, dtype=f8),
+            np.array(maxima, dtype=f8),
+        )  # copies: the caller's arrays stay theirs (and writeable)
+        self._set(polygon, cols)
+
+    def _set(self, polygon: ConvexPolygon, data: tuple[object, ...]) -> None:
         put = object.__setattr__
         put(self, "polygon", polygon)
-        put(self, "_data", (breaks, lengths, phases, pairs, minima, maxima))
+        put(self, "_data", data)
         put(self, "_arrays", None)
 
     @classmethod
@@ -128,7 +140,9 @@ class DiameterFunction:
         Unchecked; lists become read-only arrays on first use.
         """
         breaks, lengths, phases, i_plus, i_minus = pieces
-        return cls(polygon, breaks, lengths, phases, (i_plus, i_minus), minima, maxima)
+        out = cls.__new__(cls)
+        out._set(polygon, (breaks, lengths, phases, (i_plus, i_minus), minima, maxima))
+        return out
 
     def __setattr__(self, name: str, value: object) -> None:
         raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
@@ -151,7 +165,7 @@ class DiameterFunction:
             for k, col in enumerate(self._data):
                 if type(col) is np.ndarray:
                     arr = col
-                elif k == 3:  # the jaws' vertex indices, as two columns
+                elif k == 3:  # the jaws' vertex indices (i_plus, i_minus), as two columns
                     arr = np.array(col, dtype=np.intp).reshape(2, -1).T.copy()
                 else:
                     arr = np.array(col, dtype=np.float64)

@@ -139,8 +139,15 @@ class CostModel:
             raise CostError(f"at least one of the costs {listed} must be positive; got all zero")
 
     def attempt_cost(self, names: Iterable[str]) -> float:
-        """Cost of one attempt: the actions in order, then the verification."""
-        return self.verify + sum(self.action_cost(n, i == 0) for i, n in enumerate(names))
+        """Cost of one attempt: the actions in order, then the verification.
+
+        Added left to right in a loop (``sum`` of floats is compensated from Python 3.12):
+        the planners' running sums of the same costs must be this value bit for bit.
+        """
+        run = 0.0
+        for i, n in enumerate(names):
+            run += self.action_cost(n, i == 0)
+        return self.verify + run
 
     def expected_cost(self, names: Iterable[str], p: float) -> float:
         """Expected cost of repeating the plan until verification succeeds (inf if p = 0)."""

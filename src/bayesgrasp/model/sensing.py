@@ -391,6 +391,8 @@ def parse_part_prior(spec: str | Sequence[float] | None, n_parts: int) -> FloatA
     [0.25, 0.75]
     >>> parse_part_prior(None, 4).tolist()
     [0.25, 0.25, 0.25, 0.25]
+    >>> parse_part_prior("1e308,1e308", 2).tolist()
+    [0.5, 0.5]
     """
     if n_parts < 1:
         raise SensorError(f"at least one part is needed; got {n_parts}")
@@ -405,10 +407,11 @@ def parse_part_prior(spec: str | Sequence[float] | None, n_parts: int) -> FloatA
         raise SensorError(
             f"the part prior needs one weight per part ({n_parts}); got {len(w)} in {spec!r}"
         )
-    if not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
+    if not np.all(np.isfinite(w)) or np.any(w < 0) or w.max() <= 0:
         raise SensorError(
             f"the part prior's weights must be finite, >= 0 and not all zero; got {spec!r}"
         )
+    w = w / w.max()  # weights near the largest float must not overflow their sum
     return np.asarray(w / w.sum(), dtype=np.float64)
 
 

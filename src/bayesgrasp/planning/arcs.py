@@ -379,8 +379,9 @@ STAIR_CELLS = 2_000_000
 _MAX_STEPS = 16
 
 FUSED = True
-"""Run the plain-list paths of parts of few states (:meth:`ArcPlanner.plan_options`); the
-tests turn it off to compare them with the general paths."""
+"""Run the plain-list paths of parts of few states (:meth:`ArcPlanner.plan_options` and the
+fused one-action planner of :func:`bayesgrasp.planning.exact.plan_exact`); the tests turn it
+off to compare them with the general paths."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -331,7 +331,8 @@ class Policy:
     @property
     def expected_total_actions(self) -> float:
         """Expected number of actions until a cycle succeeds (``expected_actions / P``)."""
-        return self.expected_actions / self.success_probability
+        p = self.success_probability
+        return self.expected_actions / p if p > 0 else math.inf
 
     @property
     def depth(self) -> int:

@@ -595,8 +595,9 @@ def plan_part(
     if options.sense is not None:
         try:
             _policy(row, rep.problem, options)
-        except Exception as exc:
+        except Exception as exc:  # the plan columns stay; the message says which step failed
             _error(row, exc)
+            row["error_message"] = f"sensing policy: {row['error_message']}"
     row["plan_seconds"] = time.perf_counter() - t0
     if options.simulate is not None:
         t1 = time.perf_counter()

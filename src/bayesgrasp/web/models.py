@@ -144,12 +144,17 @@ class PolicyRequest(ProblemOptions):
     )
     also: list[PartIn] = Field(
         default_factory=list,
-        max_length=7,
+        max_length=3,
         description="More candidate parts to tell apart (--also); each given as `part` is.",
     )
     part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
-        None, max_length=8, description="Weights of the candidate parts (--part-prior)."
+        None, max_length=4, description="Weights of the candidate parts (--part-prior)."
     )
     max_actions: int = Field(
-        3, ge=1, le=8, description="Deepest policy: actions on any path (--max-actions)."
+        3,
+        ge=1,
+        le=4,
+        description="Deepest policy: actions on any path (--max-actions; the server takes at "
+        "most 4, and at most 4 candidate parts: a request past its time limit keeps a "
+        "worker busy until it ends).",
     )

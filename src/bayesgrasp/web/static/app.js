@@ -487,9 +487,20 @@ async function showFigures() {
 
 const FOLD_BELOW = 0.01; // branches below this probability at their node are told as one line
 
+function fixed(x, d) {
+  // Python's format: an exact tie (0.125 to 2 decimals) rounds to even, where toFixed rounds
+  // it up. toFixed with many digits is the double's exact expansion, and a tie's ends in "5".
+  const a = Math.abs(x);
+  const s = a.toFixed(Math.min(100, d + 40));
+  const cut = s.indexOf(".") + 1 + d;
+  if (!/^50*$/.test(s.slice(cut))) return x.toFixed(d);
+  const even = Number(s[cut - 1]) % 2 === 0;
+  return (x < 0 ? "-" : "") + (even ? s.slice(0, cut) : a.toFixed(d));
+}
+
 function prob(p) {
   // as policy_text: two decimals, or two significant digits below 0.01 ("4.6e-13")
-  if (p >= 0.01 || p === 0) return p.toFixed(2);
+  if (p >= 0.01 || p === 0) return fixed(p, 2);
   const [m, e] = p.toExponential(1).split("e");
   const n = Math.abs(Number(e));
   return `${m}e${Number(e) < 0 ? "-" : "+"}${String(n).padStart(2, "0")}`;
@@ -498,7 +509,7 @@ function prob(p) {
 function policyLines(node, depth, first, unit, lines) {
   // the tree as policy_text prints it (bayesgrasp/planning/policy.py), small branches folded
   const pad = "  ".repeat(depth);
-  const deg = (r) => `${((r * 180) / Math.PI).toFixed(2)} deg`;
+  const deg = (r) => `${fixed((r * 180) / Math.PI, 2)} deg`;
   const act = node.action;
   lines.push(first ? `${pad}${act.type} with the gripper at ${deg(act.alpha_rad)}` : `${pad}turn ${deg(act.alpha_rad)}, ${act.type}`);
   let folded = 0, foldedP = 0;
@@ -511,9 +522,9 @@ function policyLines(node, depth, first, unit, lines) {
     const [lo, hi] = b.reading;
     const reads =
       lo === null && hi === null ? "any width"
-      : lo === null ? `the width reads below ${hi.toFixed(2)}${unit}`
-      : hi === null ? `the width reads ${lo.toFixed(2)}${unit} or more`
-      : `the width reads in [${lo.toFixed(2)}, ${hi.toFixed(2)})${unit}`;
+      : lo === null ? `the width reads below ${fixed(hi, 2)}${unit}`
+      : hi === null ? `the width reads ${fixed(lo, 2)}${unit} or more`
+      : `the width reads in [${fixed(lo, 2)}, ${fixed(hi, 2)})${unit}`;
     const cond = `${pad}  if ${reads} (p = ${prob(b.probability)})`;
     const n = b.next;
     if (n.action) {
@@ -522,7 +533,7 @@ function policyLines(node, depth, first, unit, lines) {
     } else if (n.reject) lines.push(`${cond}: reject (back to the feeder)`);
     else {
       const what = state.policyParts > 1 ? `part '${n.declare.part}' at ` : "";
-      lines.push(`${cond}: declare ${what}${deg(n.declare.orientation_rad)} (success ${n.success_probability.toFixed(2)})`);
+      lines.push(`${cond}: declare ${what}${deg(n.declare.orientation_rad)} (success ${fixed(n.success_probability, 2)})`);
     }
   }
   if (folded) {
@@ -540,7 +551,9 @@ async function showPolicy() {
   try {
     const doc = await post("/policy", body);
     state.policyParts = doc.parts.length;
-    const units = state.last && state.last.plan ? state.last.plan.part.units : null;
+    // the units of the last plan, when it was of this part (the policy document has none)
+    const last = state.last && state.last.plan ? state.last.plan.part : null;
+    const units = last && last.name === doc.parts[0] ? last.units : null;
     $("policy-tree").textContent = policyLines(doc.root, 0, true, units ? ` ${units}` : "", []).join("\n");
     const blind = doc.sensorless_cost === null ? "" : ` (sensorless Bayes plan ${doc.sensorless_cost.toFixed(4)})`;
     $("policy-summary").textContent =
