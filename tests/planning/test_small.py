@@ -97,6 +97,31 @@ def test_the_fused_path_runs_on_few_states_only() -> None:
         assert not arcs.ArcPlanner.for_problem(pb).small
 
 
+def test_plan_exact_goes_through_the_fused_paths(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Not only the flag: the fused planner and the list angles run (and not when off)."""
+    import bayesgrasp.planning.exact as exact
+
+    calls = {"one": 0, "angles": 0}
+
+    def counted(name: str, fn: Any) -> Any:
+        def wrapper(*a: Any, **k: Any) -> Any:
+            calls[name] += 1
+            return fn(*a, **k)
+
+        return wrapper
+
+    monkeypatch.setattr(exact, "_plan_one_small", counted("one", exact._plan_one_small))
+    monkeypatch.setattr(arcs, "small_options", counted("angles", arcs.small_options))
+    rect = Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])
+    exact.plan_exact(Problem.build(rect))
+    assert calls == {"one": 1, "angles": 1}
+    exact.plan_exact(Problem.build(rect, actions=("squeeze", "push-grasp")))
+    assert calls == {"one": 1, "angles": 2}  # two action types: the list angles only
+    with paths(False, arcs.SMALL):
+        exact.plan_exact(Problem.build(rect))
+    assert calls == {"one": 1, "angles": 2}
+
+
 @pytest.mark.parametrize("actions", [("squeeze",), ("push-grasp",), ("squeeze", "push-grasp")])
 def test_study_polygons(actions: tuple[str, ...]) -> None:
     """The seed's study polygons (seed 1), every plan of every length."""

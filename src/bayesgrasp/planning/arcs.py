@@ -126,8 +126,9 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 Counts = tuple[int, ...]
 """How many actions of each type, in ``problem.action_kinds`` order."""
-Plans = list[tuple[float, float, tuple[str, ...], float]]
-"""``(p, cost, action types, success-arc length)`` of each plan, as the exact planner finds it."""
+Scored = tuple[float, float, tuple[str, ...], float]
+"""``(p, cost, action types, success-arc length)`` of a plan, as the exact planner finds it."""
+Plans = list[Scored]
 
 ARC_CHUNK = 1 << 20
 """Arcs :func:`arc_front` enumerates at once (bounds memory for parts with many states)."""

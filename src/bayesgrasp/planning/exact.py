@@ -46,7 +46,7 @@ from ..model.cost import CostModel
 from ..model.prior import Prior
 from ..model.problem import Problem
 from . import arcs
-from .arcs import ArcPlanner, Counts
+from .arcs import ArcPlanner, Counts, Scored
 from .result import COST_RTOL, PlanResult, choose_among, max_plan_length, new_result
 
 __all__ = ["Report", "plan_exact"]
@@ -138,8 +138,7 @@ def plan_exact(
     return PlanResult(problem, tuple(planner.plan_options(options)), bayes, most, "exact")
 
 
-# (p, cost, action types, width) of the best plan of a length; angles come last.
-_Scored = tuple[float, float, tuple[str, ...], float]
+# Scored (arcs.py): (p, cost, action types, width) of the best plan of a length; angles last.
 
 
 def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -> PlanResult:
@@ -189,7 +188,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     p_tol = problem.part.hull.tol.probability
     step = cost.action_cost(kind)
     run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
-    options: list[_Scored] = []
+    options: list[Scored] = []
     costs: list[float] = []
     probs: list[float] = []
     k = 0
@@ -222,12 +221,12 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
 
 
 def _choose(
-    options: list[_Scored],
+    options: list[Scored],
     p_tol: float,
     report: Report,
     costs: list[float] | None = None,
     probs: list[float] | None = None,
-) -> tuple[list[_Scored], int, int]:
+) -> tuple[list[Scored], int, int]:
     """The options to report, and the indices of the Bayes and the most certain among them.
 
     ``costs`` and ``probs`` are the options' expected costs and probabilities, if at hand.
@@ -284,11 +283,11 @@ def _search(
     p_tol: float,
     max_actions: int | None,
     limit_hard: int,
-) -> list[_Scored]:
+) -> list[Scored]:
     """The best plan of each length (and perhaps one more, see :func:`plan_exact`)."""
     kinds = problem.action_kinds
     cost = problem.cost
-    options: list[_Scored] = []
+    options: list[Scored] = []
     level: list[Counts] = [(0,) * len(kinds)]
     first_kind = min(kinds, key=lambda t: cost.action_cost(t, first=True))
     next_kind = min(kinds, key=lambda t: cost.action_cost(t))
@@ -298,7 +297,7 @@ def _search(
         return (first_kind,) + (next_kind,) * (n - 1)
 
     certain_at: int | None = None  # the length of the most certain plan, once found
-    extra: _Scored | None = None
+    extra: Scored | None = None
     k = 0
     while True:
         k += 1
