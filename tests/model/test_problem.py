@@ -222,3 +222,15 @@ def test_action_kinds_are_made_once_and_follow_the_actions() -> None:
     assert pb.goal_group == 1 and Problem.build(part, goal=Goal("symmetry")).goal_group == 1
     rect = Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])
     assert Problem.build(rect, goal=Goal("symmetry")).goal_group == 2
+
+
+def test_replace_gives_a_fresh_cache() -> None:
+    """Derived values are not carried over to a problem made by dataclasses.replace."""
+    import dataclasses
+
+    from bayesgrasp.model.actions import PUSH_GRASP
+
+    pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    assert pb.action_kinds == ("squeeze",)
+    other = dataclasses.replace(pb, actions=(PUSH_GRASP,))
+    assert other.action_kinds == ("push-grasp",)

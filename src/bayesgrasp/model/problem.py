@@ -173,8 +173,9 @@ class Problem:
     cost: CostModel
     goal: Goal
     accuracy: float = 0.0
-    # Derived values computed on first use (the action classes, the goal's group order).
-    _cache: dict[Any, Any] = field(default_factory=dict, repr=False)
+    # Derived values computed on first use (the action classes, the goal's group order);
+    # not an init field, so ``dataclasses.replace`` gives the new problem a fresh cache.
+    _cache: dict[Any, Any] = field(default_factory=dict, init=False, repr=False)
 
     @classmethod
     def build(
@@ -260,7 +261,6 @@ class Problem:
             cost,
             goal or _DEFAULT_GOAL,
             float(accuracy),
-            {},
         )
 
     @property

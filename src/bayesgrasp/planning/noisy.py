@@ -547,11 +547,7 @@ def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list
     if not noise.turn.exact:
         runs += [(problem.accuracy + m * noise.turn.scale, "accuracy") for m in ACCURACY_SEEDS]
     for acc, label in runs:
-        pb = (
-            problem
-            if acc == problem.accuracy
-            else dataclasses.replace(problem, accuracy=acc, _cache={})
-        )
+        pb = problem if acc == problem.accuracy else dataclasses.replace(problem, accuracy=acc)
         res = plan_exact(pb, max_actions)
         out += [
             _Cand(
