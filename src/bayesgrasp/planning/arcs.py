@@ -99,6 +99,7 @@ from numpy.typing import NDArray
 from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
+from ..model.actions import Action
 from ..model.problem import Problem
 from ..sizes import SMALL
 from .result import PlanOption, new_option, plan_actions, short_turns
@@ -344,10 +345,13 @@ def _front_lists(
         end = left(s2, si + max_span)
         if end > i + k:
             end = i + k
-        for j in range(i + 1, end):
-            w = hi2[j] - li
-            if w > widest:
-                add((s2[j] - si, w, i))
+        # The widths grow with j (hi2 increases; float subtraction keeps the order): skip
+        # the arcs no wider than the widest basin, then every later one is wider.
+        start = i + 1
+        while start < end and hi2[start] - li <= widest:
+            start += 1
+        for j in range(start, end):
+            add((s2[j] - si, hi2[j] - li, i))
     cand.sort()
     spans, widths, rows = [0.0], [widest], [first]
     best = widest
@@ -1120,7 +1124,9 @@ def small_options(
     cap = TWO_PI / group
     if period < cap:  # ArcPlanner.period: min(largest period, 2 pi / group)
         cap = period
-    actions = {a.name: a for a in problem.actions}
+    actions: dict[str, Action] = {}
+    for a in problem.actions:  # (a loop: a comprehension costs more on few actions)
+        actions[a.name] = a
     inf = math.inf
     # (kind, id of the staircase after it, or -1) -> (id, front index, rest, width, c)
     stairs: dict[tuple[str, int], tuple[int, list[int], list[float], list[float], list[float]]]
@@ -1178,7 +1184,7 @@ def small_options(
             f = fronts[kinds[m]]
             lo = f.lo_list[at]
             angles.append(0.5 * (s + s_last) - 0.5 * (lo + (lo + f.width_list[at])))
-        steps, turned = short_turns([actions[t] for t in kinds], angles)
+        steps, turned = short_turns(list(map(actions.__getitem__, kinds)), angles)
         final = math.fmod(f.s_first_list[at] + turned + TWO_PI, TWO_PI)
         out.append(new_option(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
     return out
