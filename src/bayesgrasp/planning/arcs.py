@@ -90,7 +90,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -303,13 +303,13 @@ def arc_front(
 
 def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
     """:func:`arc_front` in plain Python floats for a few states (:func:`_front_lists`)."""
-    stable, lo, hi = (list(v) for v in f.values)  # no arrays made for a few states
+    stable, lo, hi = f.values  # no arrays made for a few states
     lists = _front_lists(stable, lo, hi, max_span)
     return ArcFront(f.kind, *lists)
 
 
 def _front_lists(
-    stable: list[float], lo: list[float], hi: list[float], max_span: float
+    stable: Sequence[float], lo: Sequence[float], hi: Sequence[float], max_span: float
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Span, width, first stable orientation and start of the front's arcs, step for step.
 
@@ -328,8 +328,9 @@ def _front_lists(
     several loop steps; the loops below avoid them.)
     """
     k = len(stable)
-    s2 = stable + [x + TWO_PI for x in stable]
-    hi2 = hi + [x + TWO_PI for x in hi]
+    add_turn = TWO_PI.__add__  # TWO_PI + x is x + TWO_PI, bit for bit
+    s2 = [*stable, *map(add_turn, stable)]
+    hi2 = [*hi, *map(add_turn, hi)]
     widest = -math.inf
     first = 0
     for i in range(k):
