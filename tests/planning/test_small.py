@@ -224,8 +224,8 @@ def test_many_states_at_the_cut_off(n: int) -> None:
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(pts=clouds(), kind=st.sampled_from(["squeeze", "push-grasp"]), extra=st.floats(-0.5, 7.0))
 def test_list_front_is_the_enumerated_front(pts: np.ndarray, kind: str, extra: float) -> None:
-    """The plain-list front (which skips each row's arcs no wider than the widest basin)
-    is numpy's enumeration of every arc, bit for bit, for any span bound."""
+    """The plain-list front is numpy's enumeration of every arc, bit for bit, for any span
+    bound."""
     try:
         part = Part.from_points(pts)
     except PartError:

@@ -346,13 +346,10 @@ def _front_lists(
         end = left(s2, si + max_span)
         if end > i + k:
             end = i + k
-        # The widths grow with j (hi2 increases; float subtraction keeps the order): skip
-        # the arcs no wider than the widest basin, then every later one is wider.
-        start = i + 1
-        while start < end and hi2[start] - li <= widest:
-            start += 1
-        for j in range(start, end):
-            add((s2[j] - si, hi2[j] - li, i))
+        for j in range(i + 1, end):
+            w = hi2[j] - li
+            if w > widest:
+                add((s2[j] - si, w, i))
     cand.sort()
     spans, widths, rows = [0.0], [widest], [first]
     best = widest
