@@ -221,6 +221,28 @@ def test_many_states_at_the_cut_off(n: int) -> None:
     assert res.ok
 
 
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(pts=clouds(), kind=st.sampled_from(["squeeze", "push-grasp"]), extra=st.floats(-0.5, 7.0))
+def test_list_front_is_the_enumerated_front(pts: np.ndarray, kind: str, extra: float) -> None:
+    """The plain-list front is numpy's enumeration of every arc, bit for bit, for any span
+    bound."""
+    try:
+        part = Part.from_points(pts)
+    except PartError:
+        return
+    f = Problem.build(part, actions=(kind,)).transfers[kind]
+    if f.n_states > SMALL:
+        return
+    fast = arcs.arc_front(f, f.period + extra)
+    slow = arcs.arc_front(f, f.period + extra, prune=False)
+
+    def lists(a: arcs.ArcFront) -> list[list[str]]:
+        values = (a.span_list, a.width_list, a.s_first_list, a.lo_list)
+        return [[x.hex() for x in v] for v in values]
+
+    assert lists(fast) == lists(slow)
+
+
 def test_fast_constructors_make_the_same_objects() -> None:
     """The planners' fast constructors set every field as the dataclasses' own do."""
     from bayesgrasp.model.actions import SQUEEZE

@@ -90,7 +90,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -99,6 +99,7 @@ from numpy.typing import NDArray
 from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
+from ..model.actions import Action
 from ..model.problem import Problem
 from ..sizes import SMALL
 from .result import PlanOption, new_option, plan_actions, short_turns
@@ -302,13 +303,13 @@ def arc_front(
 
 def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
     """:func:`arc_front` in plain Python floats for a few states (:func:`_front_lists`)."""
-    stable, lo, hi = (list(v) for v in f.values)  # no arrays made for a few states
+    stable, lo, hi = f.values  # no arrays made for a few states
     lists = _front_lists(stable, lo, hi, max_span)
     return ArcFront(f.kind, *lists)
 
 
 def _front_lists(
-    stable: list[float], lo: list[float], hi: list[float], max_span: float
+    stable: Sequence[float], lo: Sequence[float], hi: Sequence[float], max_span: float
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Span, width, first stable orientation and start of the front's arcs, step for step.
 
@@ -327,8 +328,9 @@ def _front_lists(
     several loop steps; the loops below avoid them.)
     """
     k = len(stable)
-    s2 = stable + [x + TWO_PI for x in stable]
-    hi2 = hi + [x + TWO_PI for x in hi]
+    add_turn = TWO_PI.__add__  # TWO_PI + x is x + TWO_PI, bit for bit
+    s2 = [*stable, *map(add_turn, stable)]
+    hi2 = [*hi, *map(add_turn, hi)]
     widest = -math.inf
     first = 0
     for i in range(k):
@@ -1120,7 +1122,9 @@ def small_options(
     cap = TWO_PI / group
     if period < cap:  # ArcPlanner.period: min(largest period, 2 pi / group)
         cap = period
-    actions = {a.name: a for a in problem.actions}
+    actions: dict[str, Action] = {}
+    for a in problem.actions:  # (a loop: a comprehension costs more on few actions)
+        actions[a.name] = a
     inf = math.inf
     # (kind, id of the staircase after it, or -1) -> (id, front index, rest, width, c)
     stairs: dict[tuple[str, int], tuple[int, list[int], list[float], list[float], list[float]]]
@@ -1178,7 +1182,7 @@ def small_options(
             f = fronts[kinds[m]]
             lo = f.lo_list[at]
             angles.append(0.5 * (s + s_last) - 0.5 * (lo + (lo + f.width_list[at])))
-        steps, turned = short_turns([actions[t] for t in kinds], angles)
+        steps, turned = short_turns(list(map(actions.__getitem__, kinds)), angles)
         final = math.fmod(f.s_first_list[at] + turned + TWO_PI, TWO_PI)
         out.append(new_option(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
     return out
