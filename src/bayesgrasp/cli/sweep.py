@@ -10,7 +10,14 @@ from typing import Annotated, Any
 import typer
 
 from .common import emit_json, with_progress
-from .options import FLATTEN_HELP, SHAPE_HELP, JsonOpt, command_app, problem_options
+from .options import (
+    FLATTEN_HELP,
+    SHAPE_HELP,
+    JsonOpt,
+    MaxActionsOpt,
+    command_app,
+    problem_options,
+)
 from .specs import Engine, ProblemSpec
 
 app = command_app()
@@ -69,9 +76,7 @@ def sweep(
             "(SIGMA and RES in each part's units): the policy_* columns.",
         ),
     ] = None,
-    max_actions: Annotated[
-        int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
-    ] = 3,
+    max_actions: MaxActionsOpt = 3,
     layer: Annotated[str | None, typer.Option(help="DXF: read only this layer.")] = None,
     flatten_tol: Annotated[float | None, typer.Option(help=FLATTEN_HELP)] = None,
     shape_tol: Annotated[float, typer.Option(min=0, help=SHAPE_HELP)] = 0.0,

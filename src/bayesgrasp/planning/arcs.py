@@ -241,6 +241,19 @@ class ArcFront:
         return self.width_list[n] if n >= 0 else 0.0
 
 
+def period_cap(problem: Problem) -> float:
+    """The angle no plan orients beyond: the largest period of the action types, or less.
+
+    ``2 pi / g`` when that is smaller (``g`` the goal's group order).
+    """
+    period = 0.0
+    for t in problem.action_kinds:  # a loop: cheaper than max() over a generator here
+        if problem.transfers[t].period > period:
+            period = problem.transfers[t].period
+    cap = TWO_PI / problem.goal_group
+    return period if period < cap else cap
+
+
 def arc_front(
     f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK, prune: bool | None = None
 ) -> ArcFront:
@@ -809,7 +822,7 @@ class ArcPlanner:
         kinds = self.problem.action_kinds
         self.index = {t: i for i, t in enumerate(kinds)}
         transfers = [self.problem.transfers[t] for t in kinds]
-        self.period = min(max(f.period for f in transfers), TWO_PI / self.problem.goal_group)
+        self.period = period_cap(self.problem)
         self.small = few_states(transfers)
 
     @classmethod
@@ -1115,13 +1128,7 @@ def small_options(
     """
     accuracy = problem.accuracy
     prior, group = problem.prior, problem.goal_group
-    period = 0.0
-    for t in problem.action_kinds:
-        if problem.transfers[t].period > period:
-            period = problem.transfers[t].period
-    cap = TWO_PI / group
-    if period < cap:  # ArcPlanner.period: min(largest period, 2 pi / group)
-        cap = period
+    cap = period_cap(problem)
     actions: dict[str, Action] = {}
     for a in problem.actions:  # (a loop: a comprehension costs more on few actions)
         actions[a.name] = a

@@ -40,7 +40,6 @@ import bisect
 from collections.abc import Callable
 from typing import Literal
 
-from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..model.cost import CostModel
 from ..model.prior import Prior
@@ -159,9 +158,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     f = problem.transfers[kind]
     tol = problem.states.angle_tol
     group = problem.goal_group
-    cap = TWO_PI / group  # ArcPlanner.period: min(period, 2 pi / group)
-    if f.period < cap:
-        cap = f.period
+    cap = arcs.period_cap(problem)  # ArcPlanner.period
     front = arcs.arc_front(f, f.period + tol)  # ArcPlanner.max_span
     spans, widths = front.span_list, front.width_list
     left = bisect.bisect_left
