@@ -40,6 +40,7 @@ import bisect
 import dataclasses
 import heapq
 import math
+from operator import lt
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -272,14 +273,21 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     """
     tol = polygon.tol.angle
     small = polygon.n_sides <= _SMALL
-    pieces: Pieces
-    if small:
-        pieces = _pieces_python(*polygon._coords(), tol, math.pi)
-    else:
-        pieces = _pieces_numpy(polygon.vertices, tol, math.pi)
     depth = polygon.tol.barrier_for(polygon.size)
     r = polygon.symmetry_order_from(3)  # a half turn changes nothing: d has the period pi
     periods = r * (1 + r % 2) // 2 if r > 1 else 1  # periods of d in [0, pi)
+    pieces: Pieces
+    if small:
+        breaks, lengths, phases, i_plus, i_minus, slopes = _piece_lists(
+            *polygon._coords(), tol, math.pi
+        )
+        lists = (breaks, lengths, phases, i_plus, i_minus)
+        found = _in_order(breaks, phases, lengths, slopes, depth) if periods == 1 else None
+        if found is not None:  # most parts
+            return DiameterFunction._of_floats(polygon, lists, *found)
+        pieces = (*lists, _extrema_python(breaks, phases, lengths, slopes))
+    else:
+        pieces = _pieces_numpy(polygon.vertices, tol, math.pi)
     if periods > 1:
         # One period of the exactly symmetric part, simplified as a periodic function and
         # repeated: the shallow pairs go in every period or in none.
@@ -410,23 +418,37 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
 
     ``xs`` and ``ys`` are the vertices' coordinates; the pieces are lists.
     """
+    breaks, lengths, phases, i_plus, i_minus, slopes = _piece_lists(xs, ys, tol, period)
+    extrema = _extrema_python(breaks, phases, lengths, slopes)
+    return breaks, lengths, phases, i_plus, i_minus, extrema
+
+
+Slopes = tuple[list[int], list[int], list[float]]
+"""Over the pieces of the window: the slope signs at the start and at the end of each piece
+(zero within the angle tolerance of flat), and d at each start."""
+
+
+def _piece_lists(
+    xs: list[float], ys: list[float], tol: float, period: float
+) -> tuple[list[float], list[float], list[float], list[int], list[int], Slopes]:
+    """:func:`_pieces_python` up to the extrema: the pieces, and the slopes of the window's."""
     pi, two_pi, quarter = math.pi, TWO_PI, math.pi / 2
     atan2, hypot, cos, find = math.atan2, math.hypot, math.cos, bisect.bisect_left
     n = len(xs)
-    normals = []
-    for dy, dx in zip(
-        [b - a for a, b in zip(ys, [*ys[1:], ys[0]], strict=True)],
-        [b - a for a, b in zip(xs, [*xs[1:], xs[0]], strict=True)],
-        strict=True,
-    ):
-        x = (atan2(dy, dx) - quarter) % two_pi  # _wrap1(..., 2 pi)
-        normals.append(0.0 if x >= two_pi else x)
+    # Edge i runs from vertex i to vertex i + 1; its outward normal, reduced to [0, 2 pi),
+    # and the edge's alignment -normal reduced to [0, pi) (the same from 2 pi as from 0).
+    normals, b = [], []
+    for x0, y0, x1, y1 in zip(xs, ys, [*xs[1:], xs[0]], [*ys[1:], ys[0]], strict=True):
+        x = (atan2(y1 - y0, x1 - x0) - quarter) % two_pi
+        normals.append(x)
+        b.append(-x % pi)
+    if two_pi in normals:  # _wrap1: % can round a tiny negative up to 2 pi (never above)
+        normals = [0.0 if x >= two_pi else x for x in normals]
+    if pi in b:
+        b = [0.0 if x >= pi else x for x in b]
     order = sorted(range(n), key=normals.__getitem__)
-    normals_sorted = [normals[i] for i in order]
-    b = []
-    for x in normals:
-        x = -x % pi  # _wrap1(-x, pi)
-        b.append(0.0 if x >= pi else x)
+    normals_sorted = sorted(normals)
+    order.append(order[0])  # a direction past the last normal: the least one's edge
     b.sort()
     prev = b[-1] - pi
     breaks = []
@@ -437,17 +459,18 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
     if not breaks:
         breaks = b[:1]
     ends = [*breaks[1:], breaks[0] + pi]
-    w = _window(breaks, period, tol)
+    w = len(breaks) if period >= pi else _window(breaks, period, tol)
+    ntol = -tol
     lengths, phases, i_plus, i_minus = [], [], [], []
     starts: list[int] = []  # slope signs at the start and end of each piece of the window
     stops: list[int] = []
     at_break = []
     for k, (lo, hi) in enumerate(zip(breaks, ends, strict=True)):
         mid = 0.5 * (lo + hi)
-        u = -mid % two_pi  # _wrap1(-mid, 2 pi)
-        a = order[find(normals_sorted, 0.0 if u >= two_pi else u) % n]
-        u = (pi - mid) % two_pi
-        c = order[find(normals_sorted, 0.0 if u >= two_pi else u) % n]
+        # The sorted normals lie in [0, 2 pi): a direction % rounded up to 2 pi finds the
+        # same edge as 0 would (_wrap1 changes nothing here).
+        a = order[find(normals_sorted, -mid % two_pi)]
+        c = order[find(normals_sorted, (pi - mid) % two_pi)]
         cx, cy = xs[a] - xs[c], ys[a] - ys[c]
         length = hypot(cx, cy)
         phase = mid - ((mid + atan2(cy, cx) + pi) % two_pi - pi)
@@ -457,9 +480,18 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
         phases.append(phase)
         if k < w:
             to_start, to_end = phase - lo, phase - hi
-            starts.append((to_start > tol) - (to_start < -tol))
-            stops.append((to_end > tol) - (to_end < -tol))
+            starts.append((to_start > tol) - (to_start < ntol))
+            stops.append((to_end > tol) - (to_end < ntol))
             at_break.append(length * cos(to_start))
+    return breaks, lengths, phases, i_plus, i_minus, (starts, stops, at_break)
+
+
+def _extrema_python(
+    breaks: list[float], phases: list[float], lengths: list[float], slopes: Slopes
+) -> Extrema:
+    """The extrema over the window (see the comment above :func:`_pieces_numpy`)."""
+    starts, stops, at_break = slopes
+    w = len(starts)
     min_at, min_d, max_at, max_d, kmax_at, kmax_d = [], [], [], [], [], []
     if 0 not in starts and 0 not in stops:
         # Most parts: no zeros, so each change is between neighbouring entries: at a break
@@ -500,14 +532,60 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
             else:
                 kmax_at.append(breaks[at])
                 kmax_d.append(at_break[at])
-    return (
-        breaks,
-        lengths,
-        phases,
-        i_plus,
-        i_minus,
-        (min_at, min_d, max_at + kmax_at, max_d + kmax_d),
-    )
+    return min_at, min_d, max_at + kmax_at, max_d + kmax_d
+
+
+def _in_order(
+    breaks: list[float],
+    phases: list[float],
+    lengths: list[float],
+    slopes: Slopes,
+    depth: float,
+) -> tuple[list[float], list[float]] | None:
+    """Minima and maxima over ``[0, pi)`` of most parts, in one pass over the pieces.
+
+    What :func:`_extrema_python`, :func:`_merged` (origin 0, period pi) and
+    :func:`_drop_shallow` give when no slope is flat within the tolerance and no pair is
+    shallower than ``depth``: the extrema then come piece by piece in order of angle (only
+    an interior maximum of the last piece may pass pi, and is the first from 0). Returns
+    None for any other part, which the general path then decides.
+    """
+    starts, stops, at_break = slopes
+    if 0 in starts or 0 in stops:
+        return None
+    pi = math.pi
+    at: list[float] = []
+    val: list[float] = []
+    first_is_max = wraps = False
+    before = stops[-1]  # the sign at the end of the last piece
+    for k, start in enumerate(starts):
+        if before != start:  # a kink: a maximum when the slope turns down
+            if not at:
+                first_is_max = before > 0
+            at.append(breaks[k])
+            val.append(at_break[k])
+            wraps = False
+        before = stops[k]
+        if start != before:
+            if start < 0:  # pragma: no cover - not a concave piece: the general path
+                return None
+            if not at:
+                first_is_max = True
+            x = phases[k]
+            wraps = x >= pi  # only the last piece's can
+            at.append(x % pi if wraps else x)
+            val.append(lengths[k])
+    if wraps:
+        at.insert(0, at.pop())
+        val.insert(0, val.pop())
+        first_is_max = True
+    m = len(at)
+    # Distinct angles in order (what _merged sorts by), and no pair to cancel (_drop_shallow).
+    if m < 2 or not all(map(lt, at, at[1:])):
+        return None
+    if m > 2 and min([abs(x - y) for x, y in zip(val, [val[-1], *val[:-1]], strict=True)]) <= depth:
+        return None
+    return (at[1::2], at[0::2]) if first_is_max else (at[0::2], at[1::2])
 
 
 def _window(breaks: list[float], period: float, tol: float) -> int:
