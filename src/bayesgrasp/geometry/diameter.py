@@ -123,10 +123,9 @@ class DiameterFunction:
         self._set(polygon, cols)
 
     def _set(self, polygon: ConvexPolygon, data: tuple[object, ...]) -> None:
-        put = object.__setattr__
-        put(self, "polygon", polygon)
-        put(self, "_data", data)
-        put(self, "_arrays", None)
+        _SET_POLYGON(self, polygon)
+        _SET_DATA(self, data)
+        _SET_ARRAYS(self, None)
 
     @classmethod
     def _of_floats(
@@ -185,6 +184,14 @@ class DiameterFunction:
             tuple(highs.tolist() if isinstance(highs, np.ndarray) else highs),  # type: ignore[arg-type]
         )
 
+    def _extrema_lists(self) -> tuple[list[float], list[float]]:
+        """``minima`` and ``maxima`` as lists of Python floats (the caller must not change them)."""
+        lows, highs = self._data[4], self._data[5]
+        return (
+            lows.tolist() if isinstance(lows, np.ndarray) else lows,  # type: ignore[return-value]
+            highs.tolist() if isinstance(highs, np.ndarray) else highs,
+        )
+
     @property
     def breaks(self) -> FloatArray:
         """Edge-alignment angles in ``[0, pi)``, increasing (read-only)."""
@@ -238,6 +245,12 @@ class DiameterFunction:
     def diameter(self) -> float:
         """The polygon's diameter (the largest value of ``d``)."""
         return float(self.lengths.max())
+
+
+# The slots' own setters: about half the cost of object.__setattr__ (see transfer.py).
+_SET_POLYGON, _SET_DATA, _SET_ARRAYS = (
+    DiameterFunction.__dict__[name].__set__ for name in ("polygon", "_data", "_arrays")
+)
 
 
 def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:

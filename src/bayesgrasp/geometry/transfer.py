@@ -112,12 +112,11 @@ class TransferFunction:
     ) -> TransferFunction:
         """From tuples of Python floats, unchecked; the arrays are made on first use."""
         f = object.__new__(cls)
-        put = object.__setattr__
-        put(f, "kind", kind)
-        put(f, "period", period)
-        put(f, "angle_tol", angle_tol)
-        put(f, "_values", values)
-        put(f, "_arrays", None)
+        _SET_KIND(f, kind)
+        _SET_PERIOD(f, period)
+        _SET_ANGLE_TOL(f, angle_tol)
+        _SET_VALUES(f, values)
+        _SET_ARRAYS(f, None)
         return f
 
     def __setattr__(self, name: str, value: object) -> None:
@@ -225,6 +224,14 @@ class TransferFunction:
     def widths(self) -> FloatArray:
         """Width of each basin (radians)."""
         return self.basin_hi - self.basin_lo
+
+
+# The slots' own setters: a frozen value's fields set at about half the cost of
+# object.__setattr__ (the squeeze function of every part is built this way).
+_SET_KIND, _SET_PERIOD, _SET_ANGLE_TOL, _SET_VALUES, _SET_ARRAYS = (
+    TransferFunction.__dict__[name].__set__
+    for name in ("kind", "period", "angle_tol", "_values", "_arrays")
+)
 
 
 def detect_period(stable: FloatArray, boundaries: FloatArray, tol: float) -> float:
@@ -388,9 +395,14 @@ def squeeze_function(
     """
     d = part if isinstance(part, DiameterFunction) else diameter_function(part)
     tol = d.polygon.tol.angle
-    pi = math.pi
+    pi, two_pi = math.pi, TWO_PI
+    lows, highs = d._extrema_lists()
     # x in [0, pi): a + pi is no tiny negative, so % needs none of _wrap's care.
-    stable, bounds = ([*x, *[(a + pi) % TWO_PI for a in x]] for x in d.extrema)
+    stable, bounds = [*lows], [*highs]
+    for a in lows:
+        stable.append((a + pi) % two_pi)
+    for a in highs:
+        bounds.append((a + pi) % two_pi)
     stable.sort()
     bounds.sort()
     half_turn = 2 if tol >= _HALF_TURN_TOL else 1

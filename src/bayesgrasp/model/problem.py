@@ -26,6 +26,7 @@ computed on first use inside it; callers never prepare anything.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -220,7 +221,7 @@ class Problem:
         >>> pb.accuracy
         0.01
         """
-        if (
+        if not (type(accuracy) is float and 0.0 <= accuracy < math.inf) and (
             isinstance(accuracy, bool)
             or not isinstance(accuracy, int | float)
             or not math.isfinite(accuracy)
@@ -243,25 +244,34 @@ class Problem:
             raise PlanningError(f"`goal` must be a Goal; got {type(goal).__name__}")
         d, states = squeeze_model(part)  # a curved part: its exact model (geometry/curved.py)
         transfers = {SQUEEZE.name: states}
-        for a in acts:
-            f = a.build(part, states)
-            # A transfer function is named by its action (two actions may move alike).
-            transfers[a.name] = f if f.kind == a.name else f.renamed(a.name)
+        if acts is not _DEFAULT_ACTIONS:  # the default's squeeze is the squeeze function
+            for a in acts:
+                f = a.build(part, states)
+                # A transfer function is named by its action (two actions may move alike).
+                transfers[a.name] = f if f.kind == a.name else f.renamed(a.name)
         if cost is None:
             cost = _DEFAULT_COST
         else:
             cost.check_positive(a.name for a in acts)
-        return cls(
-            part,
-            states,
-            d,
-            prior or _DEFAULT_PRIOR,
-            acts,
-            MappingProxyType(transfers),
-            cost,
-            goal or _DEFAULT_GOAL,
-            float(accuracy),
-        )
+        prior = prior or _DEFAULT_PRIOR
+        goal = goal or _DEFAULT_GOAL
+        accuracy = float(accuracy)
+        proxy = MappingProxyType(transfers)
+        if cls is not Problem:
+            return cls(part, states, d, prior, acts, proxy, cost, goal, accuracy)
+        # The dataclass's __init__, by the slots' own setters (half object.__setattr__'s cost).
+        pb = object.__new__(Problem)
+        _SET_PART(pb, part)
+        _SET_STATES(pb, states)
+        _SET_DIAMETER(pb, d)
+        _SET_PRIOR(pb, prior)
+        _SET_ACTIONS(pb, acts)
+        _SET_TRANSFERS(pb, proxy)
+        _SET_COST(pb, cost)
+        _SET_GOAL(pb, goal)
+        _SET_ACCURACY(pb, accuracy)
+        _SET_CACHE(pb, {})
+        return pb
 
     @property
     def action_kinds(self) -> tuple[str, ...]:
@@ -345,3 +355,17 @@ class Problem:
             return np.asarray(masses, dtype=np.float64)
         idx = nearest_state(self.states, f.stable)
         return np.bincount(idx, weights=masses, minlength=self.n_states).astype(np.float64)
+
+
+(
+    _SET_PART,
+    _SET_STATES,
+    _SET_DIAMETER,
+    _SET_PRIOR,
+    _SET_ACTIONS,
+    _SET_TRANSFERS,
+    _SET_COST,
+    _SET_GOAL,
+    _SET_ACCURACY,
+    _SET_CACHE,
+) = (Problem.__dict__[f.name].__set__ for f in dataclasses.fields(Problem))
