@@ -40,7 +40,7 @@ import bisect
 import dataclasses
 import heapq
 import math
-from operator import lt
+from operator import lt, sub
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -291,11 +291,11 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     periods = r * (1 + r % 2) // 2 if r > 1 else 1  # periods of d in [0, pi)
     pieces: Pieces
     if small:
-        breaks, lengths, phases, i_plus, i_minus, slopes = _piece_lists(
+        breaks, lengths, phases, i_plus, i_minus, slopes, events = _piece_lists(
             *polygon._coords(), tol, math.pi
         )
         lists = (breaks, lengths, phases, i_plus, i_minus)
-        found = _in_order(breaks, phases, lengths, slopes, depth) if periods == 1 else None
+        found = _in_order(breaks, phases, slopes, events, depth) if periods == 1 else None
         if found is not None:  # most parts
             return DiameterFunction._of_floats(polygon, lists, *found)
         pieces = (*lists, _extrema_python(breaks, phases, lengths, slopes))
@@ -431,7 +431,7 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
 
     ``xs`` and ``ys`` are the vertices' coordinates; the pieces are lists.
     """
-    breaks, lengths, phases, i_plus, i_minus, slopes = _piece_lists(xs, ys, tol, period)
+    breaks, lengths, phases, i_plus, i_minus, slopes, _ = _piece_lists(xs, ys, tol, period)
     extrema = _extrema_python(breaks, phases, lengths, slopes)
     return breaks, lengths, phases, i_plus, i_minus, extrema
 
@@ -440,10 +440,14 @@ Slopes = tuple[list[int], list[int], list[float]]
 """Over the pieces of the window: the slope signs at the start and at the end of each piece
 (zero within the angle tolerance of flat), and d at each start."""
 
+Events = tuple[list[float], list[float], bool]
+"""Angles and values of d at the extrema after the first break, in order, and whether the
+first of them is a maximum."""
+
 
 def _piece_lists(
     xs: list[float], ys: list[float], tol: float, period: float
-) -> tuple[list[float], list[float], list[float], list[int], list[int], Slopes]:
+) -> tuple[list[float], list[float], list[float], list[int], list[int], Slopes, Events]:
     """:func:`_pieces_python` up to the extrema: the pieces, and the slopes of the window's."""
     pi, two_pi, quarter = math.pi, TWO_PI, math.pi / 2
     atan2, hypot, cos, find = math.atan2, math.hypot, math.cos, bisect.bisect_left
@@ -478,6 +482,12 @@ def _piece_lists(
     starts: list[int] = []  # slope signs at the start and end of each piece of the window
     stops: list[int] = []
     at_break = []
+    # The extrema after break 0 in order, read from the signs as if none were zero (only
+    # used when none is: see _in_order). A piece's start sign is never below its end's.
+    at: list[float] = []
+    val: list[float] = []
+    first_is_max = False
+    stop = 0
     for k, (lo, hi) in enumerate(zip(breaks, ends, strict=True)):
         mid = 0.5 * (lo + hi)
         # The sorted normals lie in [0, 2 pi): a direction % rounded up to 2 pi finds the
@@ -493,10 +503,25 @@ def _piece_lists(
         phases.append(phase)
         if k < w:
             to_start, to_end = phase - lo, phase - hi
-            starts.append((to_start > tol) - (to_start < ntol))
-            stops.append((to_end > tol) - (to_end < ntol))
-            at_break.append(length * cos(to_start))
-    return breaks, lengths, phases, i_plus, i_minus, (starts, stops, at_break)
+            before = stop
+            start = (to_start > tol) - (to_start < ntol)
+            stop = (to_end > tol) - (to_end < ntol)
+            starts.append(start)
+            stops.append(stop)
+            height = length * cos(to_start)
+            at_break.append(height)
+            if start != before and k:  # a kink at the break: a maximum if d turns down
+                if not at:
+                    first_is_max = before > 0
+                at.append(lo)
+                val.append(height)
+            if start != stop:  # a maximum inside the piece
+                if not at:
+                    first_is_max = True
+                at.append(phase)
+                val.append(length)
+    slopes = (starts, stops, at_break)
+    return breaks, lengths, phases, i_plus, i_minus, slopes, (at, val, first_is_max)
 
 
 def _extrema_python(
@@ -551,52 +576,36 @@ def _extrema_python(
 def _in_order(
     breaks: list[float],
     phases: list[float],
-    lengths: list[float],
     slopes: Slopes,
+    events: Events,
     depth: float,
 ) -> tuple[list[float], list[float]] | None:
-    """Minima and maxima over ``[0, pi)`` of most parts, in one pass over the pieces.
+    """Minima and maxima over ``[0, pi)`` of most parts, from the pieces' pass.
 
     What :func:`_extrema_python`, :func:`_merged` (origin 0, period pi) and
     :func:`_drop_shallow` give when no slope is flat within the tolerance and no pair is
-    shallower than ``depth``: the extrema then come piece by piece in order of angle (only
-    an interior maximum of the last piece may pass pi, and is the first from 0). Returns
-    None for any other part, which the general path then decides.
+    shallower than ``depth``: the extrema then come piece by piece in order of angle, the
+    ``events`` of :func:`_piece_lists`; the one at the first break (after the last piece)
+    goes first, and an interior maximum of the last piece past pi wraps to the front.
+    Returns None for any other part, which the general path then decides.
     """
     starts, stops, at_break = slopes
     if 0 in starts or 0 in stops:
         return None
-    pi = math.pi
-    at: list[float] = []
-    val: list[float] = []
-    first_is_max = wraps = False
-    before = stops[-1]  # the sign at the end of the last piece
-    for k, start in enumerate(starts):
-        if before != start:  # a kink: a maximum when the slope turns down
-            if not at:
-                first_is_max = before > 0
-            at.append(breaks[k])
-            val.append(at_break[k])
-            wraps = False
-        before = stops[k]
-        if start != before:
-            if start < 0:  # pragma: no cover - not a concave piece: the general path
-                return None
-            if not at:
-                first_is_max = True
-            x = phases[k]
-            wraps = x >= pi  # only the last piece's can
-            at.append(x % pi if wraps else x)
-            val.append(lengths[k])
-    if wraps:
-        at.insert(0, at.pop())
+    at, val, first_is_max = events
+    if stops[-1] != starts[0]:  # a kink at the first break
+        at.insert(0, breaks[0])
+        val.insert(0, at_break[0])
+        first_is_max = stops[-1] > 0
+    if starts[-1] != stops[-1] and phases[-1] >= math.pi:  # the last piece's maximum
+        at.insert(0, at.pop() % math.pi)
         val.insert(0, val.pop())
         first_is_max = True
     m = len(at)
     # Distinct angles in order (what _merged sorts by), and no pair to cancel (_drop_shallow).
     if m < 2 or not all(map(lt, at, at[1:])):
         return None
-    if m > 2 and min([abs(x - y) for x, y in zip(val, [val[-1], *val[:-1]], strict=True)]) <= depth:
+    if m > 2 and min(map(abs, map(sub, val, [val[-1], *val[:-1]]))) <= depth:
         return None
     return (at[1::2], at[0::2]) if first_is_max else (at[0::2], at[1::2])
 

@@ -630,13 +630,13 @@ class ConvexPolygon:
         known = self._symmetry
         if known > 0:
             return known if known >= lowest else 1
-        if known < 0 and lowest >= -known:
-            return 1  # every order from -known up failed
-        below = -known if known < 0 else math.inf
-        found = self._find_symmetry_order(
-            [r for r in _orders(len(self.vertices)) if lowest <= r < below]
-        )
-        object.__setattr__(self, "_symmetry", found if found > 1 else -lowest)
+        orders = _orders_from(len(self.vertices), lowest)
+        if known < 0:
+            if lowest >= -known:
+                return 1  # every order from -known up failed
+            orders = [r for r in orders if r < -known]
+        found = self._find_symmetry_order(orders)
+        _SET_SYMMETRY(self, found if found > 1 else -lowest)
         return found
 
     def _find_symmetry_order(self, orders: list[int]) -> int:
@@ -725,6 +725,16 @@ def _orders(n: int) -> list[int]:
     return sorted({n, *small, *(n // r for r in small)} - {1}, reverse=True)
 
 
+@functools.cache
+def _orders_from(n: int, lowest: int) -> list[int]:
+    """:func:`_orders` from ``lowest`` up (the caller must not change the list)."""
+    return [r for r in _orders(n) if r >= lowest]
+
+
+# The symmetry order's cache, set at half object.__setattr__'s cost (once for every part).
+_SET_SYMMETRY = ConvexPolygon.__dict__["_symmetry"].__set__
+
+
 def _symmetry_order_python(
     xs: list[float], ys: list[float], centroid: FloatArray, orders: list[int], eps: float
 ) -> int:
@@ -734,7 +744,9 @@ def _symmetry_order_python(
     compared with vertex 0's, rejects most orders of most parts before any other work.
     ``xs`` and ``ys`` are the vertices' coordinates.
     """
-    cx, cy = float(centroid[0]), float(centroid[1])
+    if not orders:
+        return 1
+    cx, cy = centroid.tolist()
     n = len(xs)
     r0 = math.hypot(xs[0] - cx, ys[0] - cy)
     radii: list[float] = []
