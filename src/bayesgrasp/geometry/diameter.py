@@ -40,7 +40,7 @@ import bisect
 import dataclasses
 import heapq
 import math
-from operator import lt, sub
+from operator import lt
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -295,10 +295,12 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
             *polygon._coords(), tol, math.pi
         )
         lists = (breaks, lengths, phases, i_plus, i_minus)
-        found = _in_order(breaks, phases, slopes, events, depth) if periods == 1 else None
+        found = None
+        if periods == 1:
+            found = _in_order(breaks, lengths, phases, slopes, events, tol, depth)
         if found is not None:  # most parts
             return DiameterFunction._of_floats(polygon, lists, *found)
-        pieces = (*lists, _extrema_python(breaks, phases, lengths, slopes))
+        pieces = (*lists, _extrema_python(breaks, phases, lengths, slopes, tol))
     else:
         pieces = _pieces_numpy(polygon.vertices, tol, math.pi)
     if periods > 1:
@@ -432,17 +434,17 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
     ``xs`` and ``ys`` are the vertices' coordinates; the pieces are lists.
     """
     breaks, lengths, phases, i_plus, i_minus, slopes, _ = _piece_lists(xs, ys, tol, period)
-    extrema = _extrema_python(breaks, phases, lengths, slopes)
+    extrema = _extrema_python(breaks, phases, lengths, slopes, tol)
     return breaks, lengths, phases, i_plus, i_minus, extrema
 
 
-Slopes = tuple[list[int], list[int], list[float]]
-"""Over the pieces of the window: the slope signs at the start and at the end of each piece
-(zero within the angle tolerance of flat), and d at each start."""
+Slopes = tuple[list[float], list[float]]
+"""Over the pieces of the window: ``phase - start`` and ``phase - end`` (the slope of d at
+the piece's start and end has their sign)."""
 
-Events = tuple[list[float], list[float], bool]
-"""Angles and values of d at the extrema after the first break, in order, and whether the
-first of them is a maximum."""
+Events = tuple[list[float], list[float], bool, bool]
+"""Angles and values of d at the extrema after the first break, in order, whether the first
+of them is a maximum, and whether a slope is flat within the tolerance (they are then moot)."""
 
 
 def _piece_lists(
@@ -467,6 +469,7 @@ def _piece_lists(
     normals_sorted = sorted(normals)
     order.append(order[0])  # a direction past the last normal: the least one's edge
     b.sort()
+    # Keep b[i] when the gap *before* it is wide: parallel edges give one alignment.
     prev = b[-1] - pi
     breaks = []
     for x in b:
@@ -476,18 +479,20 @@ def _piece_lists(
     if not breaks:
         breaks = b[:1]
     ends = [*breaks[1:], breaks[0] + pi]
-    w = len(breaks) if period >= pi else _window(breaks, period, tol)
-    ntol = -tol
-    lengths, phases, i_plus, i_minus = [], [], [], []
-    starts: list[int] = []  # slope signs at the start and end of each piece of the window
-    stops: list[int] = []
-    at_break = []
-    # The extrema after break 0 in order, read from the signs as if none were zero (only
-    # used when none is: see _in_order). A piece's start sign is never below its end's.
+    p = len(breaks)
+    w = p if period >= pi else _window(breaks, period, tol)
+    lengths: list[float] = []
+    phases: list[float] = []
+    i_plus: list[int] = []
+    i_minus: list[int] = []
+    to_start: list[float] = []  # phase - start and phase - end of the window's pieces
+    to_end: list[float] = []
+    # The extrema after break 0 in order, read from the slopes as if none were flat (used
+    # only when none is: see _in_order). d is concave on a piece: to_start >= to_end.
     at: list[float] = []
     val: list[float] = []
-    first_is_max = False
-    stop = 0
+    ntol = -tol
+    first_is_max = rising = flat = False
     for k, (lo, hi) in enumerate(zip(breaks, ends, strict=True)):
         mid = 0.5 * (lo + hi)
         # The sorted normals lie in [0, 2 pi): a direction % rounded up to 2 pi finds the
@@ -502,34 +507,40 @@ def _piece_lists(
         lengths.append(length)
         phases.append(phase)
         if k < w:
-            to_start, to_end = phase - lo, phase - hi
-            before = stop
-            start = (to_start > tol) - (to_start < ntol)
-            stop = (to_end > tol) - (to_end < ntol)
-            starts.append(start)
-            stops.append(stop)
-            height = length * cos(to_start)
-            at_break.append(height)
-            if start != before and k:  # a kink at the break: a maximum if d turns down
+            x, y = phase - lo, phase - hi
+            to_start.append(x)
+            to_end.append(y)
+            # The slope's signs at the start and the end (zero within the tolerance: flat).
+            up = x > tol
+            if not up and x >= ntol:
+                flat = True
+            if up != rising and k:  # a kink at the break: a maximum if d turns down
                 if not at:
-                    first_is_max = before > 0
+                    first_is_max = rising
                 at.append(lo)
-                val.append(height)
-            if start != stop:  # a maximum inside the piece
+                val.append(length * cos(x))
+            rising = y > tol
+            if not rising and y >= ntol:
+                flat = True
+            if up and not rising:  # a maximum inside the piece
                 if not at:
                     first_is_max = True
                 at.append(phase)
                 val.append(length)
-    slopes = (starts, stops, at_break)
-    return breaks, lengths, phases, i_plus, i_minus, slopes, (at, val, first_is_max)
+    slopes = (to_start, to_end)
+    return breaks, lengths, phases, i_plus, i_minus, slopes, (at, val, first_is_max, flat)
 
 
 def _extrema_python(
-    breaks: list[float], phases: list[float], lengths: list[float], slopes: Slopes
+    breaks: list[float], phases: list[float], lengths: list[float], slopes: Slopes, tol: float
 ) -> Extrema:
     """The extrema over the window (see the comment above :func:`_pieces_numpy`)."""
-    starts, stops, at_break = slopes
-    w = len(starts)
+    to_start, to_end = slopes
+    w = len(to_start)
+    # Slope signs at the start and end of each piece, zero within the tolerance of flat.
+    starts = [(x > tol) - (x < -tol) for x in to_start]
+    stops = [(x > tol) - (x < -tol) for x in to_end]
+    at_break = [x * math.cos(y) for x, y in zip(lengths, to_start, strict=False)]  # d at each start
     min_at, min_d, max_at, max_d, kmax_at, kmax_d = [], [], [], [], [], []
     if 0 not in starts and 0 not in stops:
         # Most parts: no zeros, so each change is between neighbouring entries: at a break
@@ -575,9 +586,11 @@ def _extrema_python(
 
 def _in_order(
     breaks: list[float],
+    lengths: list[float],
     phases: list[float],
     slopes: Slopes,
     events: Events,
+    tol: float,
     depth: float,
 ) -> tuple[list[float], list[float]] | None:
     """Minima and maxima over ``[0, pi)`` of most parts, from the pieces' pass.
@@ -589,24 +602,33 @@ def _in_order(
     goes first, and an interior maximum of the last piece past pi wraps to the front.
     Returns None for any other part, which the general path then decides.
     """
-    starts, stops, at_break = slopes
-    if 0 in starts or 0 in stops:
-        return None
-    at, val, first_is_max = events
-    if stops[-1] != starts[0]:  # a kink at the first break
+    at, val, first_is_max, flat = events
+    if flat:
+        return None  # a slope flat within the tolerance somewhere
+    to_start, to_end = slopes
+    if (to_end[-1] > 0) != (to_start[0] > 0):  # a kink at the first break
         at.insert(0, breaks[0])
-        val.insert(0, at_break[0])
-        first_is_max = stops[-1] > 0
-    if starts[-1] != stops[-1] and phases[-1] >= math.pi:  # the last piece's maximum
+        val.insert(0, lengths[0] * math.cos(to_start[0]))
+        first_is_max = to_end[-1] > 0
+    if to_start[-1] > 0 > to_end[-1] and phases[-1] >= math.pi:  # the last piece's maximum
         at.insert(0, at.pop() % math.pi)
         val.insert(0, val.pop())
         first_is_max = True
     m = len(at)
-    # Distinct angles in order (what _merged sorts by), and no pair to cancel (_drop_shallow).
-    if m < 2 or not all(map(lt, at, at[1:])):
+    if m < 2:  # pragma: no cover - d rises or falls all round: a bug
         return None
-    if m > 2 and min(map(abs, map(sub, val, [val[-1], *val[:-1]]))) <= depth:
+    # The angles increase strictly, as _merged sorts them: breaks < phase < next break on a
+    # piece whose slopes are not flat; a last phase past pi stays below the first break +
+    # pi by more than one rounding there once the tolerance is one (1e-15: ulp(2 pi) is
+    # 8.9e-16). Below that tolerance it is tested.
+    if tol < 1e-15 and not all(map(lt, at, at[1:])):
         return None
+    if m > 2:  # no pair shallower than depth (_drop_shallow would cancel it)
+        prev = val[-1]
+        for x in val:
+            if -depth <= x - prev <= depth:
+                return None
+            prev = x
     return (at[1::2], at[0::2]) if first_is_max else (at[0::2], at[1::2])
 
 

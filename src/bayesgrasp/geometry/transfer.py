@@ -262,26 +262,26 @@ def _period_count(
     what their test would give. Plain Python: ``K`` is small, and numpy's cost per call
     would be most of the work.
     """
-    k = len(stable)
     first = stable[0]
-    for m in _divisors(k):  # largest first
+    pi, two_pi = math.pi, TWO_PI
+    floor = max(base, known)  # what every count from here down gives (tested or not)
+    for m, step, t in _divisors(len(stable)):  # largest first
+        if m <= floor:
+            break
         if m > top or m % base:
             continue
-        if m <= base or m <= known:
-            break
-        step, t = k // m, TWO_PI / m
         # Cheap test on one point first: most m fail there.
-        if abs((stable[step] - first - t + math.pi) % TWO_PI - math.pi) > tol:
+        if abs((stable[step] - first - t + pi) % two_pi - pi) > tol:
             continue
         if _shifts_onto_itself(stable, step, t, tol) and _shifts_onto_itself(bounds, step, t, tol):
             return m
-    return max(base, known)
+    return floor
 
 
 @functools.cache
-def _divisors(k: int) -> tuple[int, ...]:
-    """The divisors of ``k``, largest first."""
-    return tuple(m for m in range(k, 0, -1) if k % m == 0)
+def _divisors(k: int) -> tuple[tuple[int, int, float], ...]:
+    """The divisors ``m`` of ``k``, largest first, with the step ``k / m`` and ``2 pi / m``."""
+    return tuple((m, k // m, TWO_PI / m) for m in range(k, 0, -1) if k % m == 0)
 
 
 def _shifts_onto_itself(points: list[float], step: int, shift: float, tol: float) -> bool:
