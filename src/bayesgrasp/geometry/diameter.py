@@ -291,16 +291,18 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     periods = r * (1 + r % 2) // 2 if r > 1 else 1  # periods of d in [0, pi)
     pieces: Pieces
     if small:
-        breaks, lengths, phases, i_plus, i_minus, slopes, events = _piece_lists(
-            *polygon._coords(), tol, math.pi
+        breaks, ends, lengths, phases, i_plus, i_minus, events = _piece_lists(
+            *polygon._coords(), tol
         )
         lists = (breaks, lengths, phases, i_plus, i_minus)
-        found = None
         if periods == 1:
-            found = _in_order(breaks, lengths, phases, slopes, events, tol, depth)
-        if found is not None:  # most parts
+            found = _in_order(breaks, ends, lengths, phases, events, tol, depth)  # most parts
+            if found is None:
+                ext = _extrema_python(breaks, ends, lengths, phases, len(breaks), tol)
+                kept = _drop_shallow(_merged(ext, 0.0, math.pi), depth)
+                found = [x for x, _, top in kept if not top], [x for x, _, top in kept if top]
             return DiameterFunction._of_floats(polygon, lists, *found)
-        pieces = (*lists, _extrema_python(breaks, phases, lengths, slopes, tol))
+        pieces = (*lists, ([], [], [], []))  # the extrema come from the symmetrized polygon
     else:
         pieces = _pieces_numpy(polygon.vertices, tol, math.pi)
     if periods > 1:
@@ -433,24 +435,20 @@ def _pieces_python(xs: list[float], ys: list[float], tol: float, period: float =
 
     ``xs`` and ``ys`` are the vertices' coordinates; the pieces are lists.
     """
-    breaks, lengths, phases, i_plus, i_minus, slopes, _ = _piece_lists(xs, ys, tol, period)
-    extrema = _extrema_python(breaks, phases, lengths, slopes, tol)
+    breaks, ends, lengths, phases, i_plus, i_minus, _ = _piece_lists(xs, ys, tol)
+    extrema = _extrema_python(breaks, ends, lengths, phases, _window(breaks, period, tol), tol)
     return breaks, lengths, phases, i_plus, i_minus, extrema
 
 
-Slopes = tuple[list[float], list[float]]
-"""Over the pieces of the window: ``phase - start`` and ``phase - end`` (the slope of d at
-the piece's start and end has their sign)."""
-
-Events = tuple[list[float], list[float], bool, bool]
-"""Angles and values of d at the extrema after the first break, in order, whether the first
-of them is a maximum, and whether a slope is flat within the tolerance (they are then moot)."""
+Events = tuple[list[float], list[float], bool]
+"""Angles and values of d at the extrema in order from the first break (a kink there
+first, real or not), and whether a slope is flat within the tolerance (they are then moot)."""
 
 
 def _piece_lists(
-    xs: list[float], ys: list[float], tol: float, period: float
-) -> tuple[list[float], list[float], list[float], list[int], list[int], Slopes, Events]:
-    """:func:`_pieces_python` up to the extrema: the pieces, and the slopes of the window's."""
+    xs: list[float], ys: list[float], tol: float
+) -> tuple[list[float], list[float], list[float], list[float], list[int], list[int], Events]:
+    """``breaks``, their ends, ``lengths``, ``phases``, ``i_plus``, ``i_minus`` and the events."""
     pi, two_pi, quarter = math.pi, TWO_PI, math.pi / 2
     atan2, hypot, cos, find = math.atan2, math.hypot, math.cos, bisect.bisect_left
     n = len(xs)
@@ -479,21 +477,19 @@ def _piece_lists(
     if not breaks:
         breaks = b[:1]
     ends = [*breaks[1:], breaks[0] + pi]
-    p = len(breaks)
-    w = p if period >= pi else _window(breaks, period, tol)
     lengths: list[float] = []
     phases: list[float] = []
     i_plus: list[int] = []
     i_minus: list[int] = []
-    to_start: list[float] = []  # phase - start and phase - end of the window's pieces
-    to_end: list[float] = []
-    # The extrema after break 0 in order, read from the slopes as if none were flat (used
-    # only when none is: see _in_order). d is concave on a piece: to_start >= to_end.
+    # The extrema in order from the first break, read from the slopes as if none were flat
+    # (used only when none is: see _in_order). The first is a kink at the first break,
+    # there or not (_in_order decides). d is concave on a piece: phase - start >= phase - end.
     at: list[float] = []
     val: list[float] = []
     ntol = -tol
-    first_is_max = rising = flat = False
-    for k, (lo, hi) in enumerate(zip(breaks, ends, strict=True)):
+    flat = False
+    rising: bool | None = None
+    for lo, hi in zip(breaks, ends, strict=True):
         mid = 0.5 * (lo + hi)
         # The sorted normals lie in [0, 2 pi): a direction % rounded up to 2 pi finds the
         # same edge as 0 would (_wrap1 changes nothing here).
@@ -506,41 +502,38 @@ def _piece_lists(
         i_minus.append(c)
         lengths.append(length)
         phases.append(phase)
-        if k < w:
-            x, y = phase - lo, phase - hi
-            to_start.append(x)
-            to_end.append(y)
-            # The slope's signs at the start and the end (zero within the tolerance: flat).
-            up = x > tol
-            if not up and x >= ntol:
-                flat = True
-            if up != rising and k:  # a kink at the break: a maximum if d turns down
-                if not at:
-                    first_is_max = rising
-                at.append(lo)
-                val.append(length * cos(x))
-            rising = y > tol
-            if not rising and y >= ntol:
-                flat = True
-            if up and not rising:  # a maximum inside the piece
-                if not at:
-                    first_is_max = True
-                at.append(phase)
-                val.append(length)
-    slopes = (to_start, to_end)
-    return breaks, lengths, phases, i_plus, i_minus, slopes, (at, val, first_is_max, flat)
+        # The slope's signs at the start and the end (zero within the tolerance: flat).
+        x, y = phase - lo, phase - hi
+        up = x > tol
+        if not up and x >= ntol:
+            flat = True
+        if up != rising:  # a kink at the break: a maximum if d turns down
+            at.append(lo)
+            val.append(length * cos(x))
+        rising = y > tol
+        if not rising and y >= ntol:
+            flat = True
+        if up and not rising:  # a maximum inside the piece
+            at.append(phase)
+            val.append(length)
+    return breaks, ends, lengths, phases, i_plus, i_minus, (at, val, flat)
 
 
 def _extrema_python(
-    breaks: list[float], phases: list[float], lengths: list[float], slopes: Slopes, tol: float
+    breaks: list[float],
+    ends: list[float],
+    lengths: list[float],
+    phases: list[float],
+    w: int,
+    tol: float,
 ) -> Extrema:
-    """The extrema over the window (see the comment above :func:`_pieces_numpy`)."""
-    to_start, to_end = slopes
-    w = len(to_start)
+    """The extrema over the first ``w`` pieces (see the comment above :func:`_pieces_numpy`)."""
+    to_start = [x - lo for x, lo in zip(phases[:w], breaks, strict=False)]
+    to_end = [x - hi for x, hi in zip(phases[:w], ends, strict=False)]
     # Slope signs at the start and end of each piece, zero within the tolerance of flat.
     starts = [(x > tol) - (x < -tol) for x in to_start]
     stops = [(x > tol) - (x < -tol) for x in to_end]
-    at_break = [x * math.cos(y) for x, y in zip(lengths, to_start, strict=False)]  # d at each start
+    at_break = [x * math.cos(y) for x, y in zip(lengths, to_start, strict=False)]  # d at starts
     min_at, min_d, max_at, max_d, kmax_at, kmax_d = [], [], [], [], [], []
     if 0 not in starts and 0 not in stops:
         # Most parts: no zeros, so each change is between neighbouring entries: at a break
@@ -586,9 +579,9 @@ def _extrema_python(
 
 def _in_order(
     breaks: list[float],
+    ends: list[float],
     lengths: list[float],
     phases: list[float],
-    slopes: Slopes,
     events: Events,
     tol: float,
     depth: float,
@@ -598,20 +591,23 @@ def _in_order(
     What :func:`_extrema_python`, :func:`_merged` (origin 0, period pi) and
     :func:`_drop_shallow` give when no slope is flat within the tolerance and no pair is
     shallower than ``depth``: the extrema then come piece by piece in order of angle, the
-    ``events`` of :func:`_piece_lists`; the one at the first break (after the last piece)
-    goes first, and an interior maximum of the last piece past pi wraps to the front.
-    Returns None for any other part, which the general path then decides.
+    ``events`` of :func:`_piece_lists` (the first break's kink only when the last piece
+    ends with the other slope than the first starts), and an interior maximum of the last
+    piece past pi wraps to the front. Returns None for any other part, which the general
+    path then decides.
     """
-    at, val, first_is_max, flat = events
+    at, val, flat = events
     if flat:
         return None  # a slope flat within the tolerance somewhere
-    to_start, to_end = slopes
-    if (to_end[-1] > 0) != (to_start[0] > 0):  # a kink at the first break
-        at.insert(0, breaks[0])
-        val.insert(0, lengths[0] * math.cos(to_start[0]))
-        first_is_max = to_end[-1] > 0
-    if to_start[-1] > 0 > to_end[-1] and phases[-1] >= math.pi:  # the last piece's maximum
-        at.insert(0, at.pop() % math.pi)
+    first_up = phases[0] - breaks[0] > 0  # the slopes, as _extrema_python computes them
+    last_up = phases[-1] - ends[-1] > 0
+    if first_up == last_up:  # no kink at the first break
+        del at[0], val[0]
+        first_is_max = first_up
+    else:
+        first_is_max = last_up
+    if phases[-1] - breaks[-1] > 0 > phases[-1] - ends[-1] and phases[-1] >= math.pi:
+        at.insert(0, at.pop() % math.pi)  # the last piece's maximum, past pi
         val.insert(0, val.pop())
         first_is_max = True
     m = len(at)
