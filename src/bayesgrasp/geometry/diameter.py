@@ -141,7 +141,9 @@ class DiameterFunction:
         """
         breaks, lengths, phases, i_plus, i_minus = pieces
         out = cls.__new__(cls)
-        out._set(polygon, (breaks, lengths, phases, (i_plus, i_minus), minima, maxima))
+        _SET_POLYGON(out, polygon)
+        _SET_DATA(out, (breaks, lengths, phases, (i_plus, i_minus), minima, maxima))
+        _SET_ARRAYS(out, None)
         return out
 
     def __setattr__(self, name: str, value: object) -> None:
@@ -285,7 +287,7 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
     (3, 3)
     """
     tol = polygon.tol.angle
-    small = polygon.n_sides <= _SMALL
+    small = len(polygon.vertices) <= _SMALL
     depth = polygon.tol.barrier_for(polygon.size)
     r = polygon.symmetry_order_from(3)  # a half turn changes nothing: d has the period pi
     periods = r * (1 + r % 2) // 2 if r > 1 else 1  # periods of d in [0, pi)
@@ -455,7 +457,9 @@ def _piece_lists(
     # Edge i runs from vertex i to vertex i + 1; its outward normal, reduced to [0, 2 pi),
     # and the edge's alignment -normal reduced to [0, pi) (the same from 2 pi as from 0).
     normals, b = [], []
-    for x0, y0, x1, y1 in zip(xs, ys, [*xs[1:], xs[0]], [*ys[1:], ys[0]], strict=True):
+    # (Equal lengths by construction, here and below: zip's strict= would cost a third of
+    # the loop on a few vertices.)
+    for x0, y0, x1, y1 in zip(xs, ys, [*xs[1:], xs[0]], [*ys[1:], ys[0]]):  # noqa: B905
         x = (atan2(y1 - y0, x1 - x0) - quarter) % two_pi
         normals.append(x)
         b.append(-x % pi)
@@ -489,7 +493,7 @@ def _piece_lists(
     ntol = -tol
     flat = False
     rising: bool | None = None
-    for lo, hi in zip(breaks, ends, strict=True):
+    for lo, hi in zip(breaks, ends):  # noqa: B905
         mid = 0.5 * (lo + hi)
         # The sorted normals lie in [0, 2 pi): a direction % rounded up to 2 pi finds the
         # same edge as 0 would (_wrap1 changes nothing here).
@@ -620,9 +624,9 @@ def _in_order(
     if tol < 1e-15 and not all(map(lt, at, at[1:])):
         return None
     if m > 2:  # no pair shallower than depth (_drop_shallow would cancel it)
-        prev = val[-1]
+        prev, low = val[-1], -depth
         for x in val:
-            if -depth <= x - prev <= depth:
+            if low <= x - prev <= depth:
                 return None
             prev = x
     return (at[1::2], at[0::2]) if first_is_max else (at[0::2], at[1::2])

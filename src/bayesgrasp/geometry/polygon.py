@@ -630,20 +630,23 @@ class ConvexPolygon:
         known = self._symmetry
         if known > 0:
             return known if known >= lowest else 1
-        orders = _orders_from(len(self.vertices), lowest)
+        n = len(self.vertices)
+        orders = _orders_from(n, lowest)
         if known < 0:
             if lowest >= -known:
                 return 1  # every order from -known up failed
             orders = [r for r in orders if r < -known]
-        found = self._find_symmetry_order(orders)
+        eps = self.tol.symmetry_for(self.size)
+        if n <= _SMALL:
+            found = _symmetry_order_python(*self._coords(), self.centroid, orders, eps)
+        else:
+            found = self._find_symmetry_order(orders, eps)
         _SET_SYMMETRY(self, found if found > 1 else -lowest)
         return found
 
-    def _find_symmetry_order(self, orders: list[int]) -> int:
+    def _find_symmetry_order(self, orders: list[int], eps: float) -> int:
+        """The symmetry test by array operations (many vertices)."""
         n = len(self.vertices)
-        eps = self.tol.symmetry_for(self.size)
-        if n <= _SMALL:
-            return _symmetry_order_python(*self._coords(), self.centroid, orders, eps)
         if not orders:
             return 1
         # A rotation keeps the cyclic order: vertex i lands on vertex i + n / r, at the same

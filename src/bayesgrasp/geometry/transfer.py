@@ -26,7 +26,6 @@ import bisect
 import dataclasses
 import functools
 import math
-import operator
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -264,11 +263,13 @@ def _period_count(
     """
     first = stable[0]
     pi, two_pi = math.pi, TWO_PI
+    k = len(stable)
     floor = max(base, known)  # what every count from here down gives (tested or not)
-    for m, step, t in _divisors(len(stable)):  # largest first
+    every = top >= k and base == 1  # every divisor is a candidate (the squeeze function)
+    for m, step, t in _divisors(k):  # largest first
         if m <= floor:
             break
-        if m > top or m % base:
+        if not every and (m > top or m % base):
             continue
         # Cheap test on one point first: most m fail there.
         if abs((stable[step] - first - t + pi) % two_pi - pi) > tol:
@@ -337,14 +338,21 @@ def _from_sorted(
     # that index counts up by one: 0, 1, ..., K - 1 or 1, 2, ..., K.
     k0 = bisect.bisect_right(bounds, stable[0])
     # Boundary k0 + i - 1 <= stable[i] < boundary k0 + i, for every i (bisect's counts).
-    if k0 == 0:
-        alternate = all(map(operator.lt, stable, bounds)) and all(
-            map(operator.le, bounds, stable[1:])
-        )
-    else:
-        alternate = all(map(operator.le, bounds, stable)) and all(
-            map(operator.lt, stable, bounds[1:])
-        )
+    # (Equal lengths, checked above: zip's strict= would cost a third of these loops.)
+    alternate = True
+    prev = -math.inf
+    if k0 == 0:  # stable[0] < bounds[0] <= stable[1] < bounds[1] <= ...
+        for x, b in zip(stable, bounds):  # noqa: B905
+            if not prev <= x < b:
+                alternate = False
+                break
+            prev = b
+    else:  # bounds[0] <= stable[0] < bounds[1] <= stable[1] < ...
+        for x, b in zip(stable, bounds):  # noqa: B905
+            if not prev < b <= x:
+                alternate = False
+                break
+            prev = x
     if k0 > 1 or not alternate:
         raise BayesGraspError(  # pragma: no cover - a bug
             "internal error: extrema of the transfer function do not alternate"
@@ -396,14 +404,22 @@ def squeeze_function(
     d = part if isinstance(part, DiameterFunction) else diameter_function(part)
     tol = d.polygon.tol.angle
     pi, two_pi = math.pi, TWO_PI
-    lows, highs = d._extrema_lists()
+    lows, highs = d._data[4], d._data[5]  # minima and maxima: lists, or arrays
+    # Lists are diameter_function's own, sorted in [0, pi); arrays any the caller gave.
+    ordered = type(lows) is list and type(highs) is list
+    if not ordered:
+        lows, highs = d._extrema_lists()
     # x in [0, pi): a + pi is no tiny negative, so % needs none of _wrap's care.
     stable, bounds = [*lows], [*highs]
     for a in lows:
         stable.append((a + pi) % two_pi)
     for a in highs:
         bounds.append((a + pi) % two_pi)
-    stable.sort()
-    bounds.sort()
+    # Sorted lists shifted by pi stay sorted in [pi, 2 pi) after them, but for those that
+    # round up to 2 pi and wrap to 0 (the last ones): only then is there anything to sort.
+    if not ordered or (stable and stable[-1] < pi):
+        stable.sort()
+    if not ordered or (bounds and bounds[-1] < pi):
+        bounds.sort()
     half_turn = 2 if tol >= _HALF_TURN_TOL else 1
     return _from_sorted("squeeze", stable, bounds, tol, tol, half_turn)
