@@ -404,7 +404,9 @@ def squeeze_function(
     d = part if isinstance(part, DiameterFunction) else diameter_function(part)
     tol = d.polygon.tol.angle
     pi, two_pi = math.pi, TWO_PI
-    lows, highs = d._data[4], d._data[5]  # minima and maxima: lists, or arrays
+    lows: list[float]
+    highs: list[float]
+    lows, highs = d._data[4], d._data[5]  # type: ignore[assignment]  # lists, or arrays
     # Lists are diameter_function's own, sorted in [0, pi); arrays any the caller gave.
     ordered = type(lows) is list and type(highs) is list
     if not ordered:
