@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
 from bayesgrasp.angles import TWO_PI
-from bayesgrasp.errors import PartError, PlanningError
+from bayesgrasp.errors import BayesGraspError, PartError, PlanningError
 from bayesgrasp.geometry import diameter, polygon
 from bayesgrasp.geometry.curved import squeeze_model
 from bayesgrasp.geometry.diameter import DiameterFunction, diameter_function
@@ -327,3 +327,133 @@ def test_the_public_constructor_copies_and_reads_pairs_as_rows() -> None:
     )
     assert again.pairs.tolist() == d.pairs.tolist()
     assert again.breaks.tolist() == d.breaks.tolist() and mine.flags.writeable
+
+
+# --------------------------------------------------------------------------- one-pass extrema
+
+
+@st.composite
+def parallel_points(draw: st.DrawFn) -> FloatArray:
+    """Centrally symmetric clouds (parallel edges in pairs), sometimes squashed thin."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    half = rng.normal(size=(draw(st.integers(2, 12)), 2))
+    pts = np.concatenate([half, -half]) * [1.0, 10.0 ** draw(st.floats(-6, 0))]
+    return np.asarray(pts + rng.normal(size=2), dtype=np.float64)
+
+
+def general_diameter(poly: ConvexPolygon) -> DiameterFunction:
+    """:func:`diameter_function` with the one-pass extrema (``_in_order``) turned off."""
+    saved = diameter._in_order
+    diameter._in_order = lambda *args: None
+    try:
+        return diameter_function(poly)
+    finally:
+        diameter._in_order = saved
+
+
+TOLERANCES = [Tolerance(), Tolerance(angle=0.0), Tolerance(angle=1e-6), Tolerance(barrier=1e-3)]
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    pts=st.one_of(any_points(), parallel_points()),
+    tol=st.sampled_from(TOLERANCES),
+)
+def test_one_pass_extrema_are_the_general_paths(pts: FloatArray, tol: Tolerance) -> None:
+    """Bit for bit: the extrema read in the pieces' loop, and _merged + _drop_shallow."""
+    try:
+        poly = ConvexPolygon.from_points(pts, tol)
+    except PartError:
+        return
+    fast, general = diameter_function(poly), general_diameter(poly)
+    assert fast.extrema == general.extrema  # floats compared exactly
+    for a, b in zip(fast._columns(), general._columns(), strict=True):
+        assert a.tolist() == b.tolist()
+    outcome = []
+    for d in (fast, general):
+        try:  # (an equilateral triangle under angle=0 fails alike on both: a known bug)
+            s = squeeze_function(d)
+            outcome.append((s.values, s.period))
+        except BayesGraspError as e:
+            outcome.append(str(e))
+    assert outcome[0] == outcome[1]
+
+
+def test_the_study_polygons_take_the_one_pass_extrema() -> None:
+    """The common case is the fast one: no flat slope, no shallow pair, no symmetry."""
+    calls = []
+    saved = diameter._in_order
+
+    def spy(*args: object) -> object:
+        calls.append(saved(*args))  # type: ignore[arg-type]
+        return calls[-1]
+
+    diameter._in_order = spy  # type: ignore[assignment]
+    try:
+        for c in np.random.default_rng(1).uniform(size=(200, 10, 2)):
+            diameter_function(ConvexPolygon.from_points(c))
+    finally:
+        diameter._in_order = saved
+    assert len(calls) == 200 and all(found is not None for found in calls)
+
+
+def test_parallel_edges_and_flat_slopes_take_the_general_path() -> None:
+    """A rectangle's slopes are flat at its alignments: the general path decides."""
+    rect = ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])
+    d = diameter_function(rect)
+    assert d.extrema == general_diameter(rect).extrema
+    assert_allclose(d.minima, [0.0, math.pi / 2], atol=1e-15)
+
+
+def test_squeeze_function_sorts_only_what_wraps() -> None:
+    """Own extrema lists skip the sort unless a minimum + pi rounds up to 2 pi."""
+    poly = square_ish()
+    d = diameter_function(poly)
+    pieces = (list(d.breaks), list(d.lengths), list(d.phases), *d.pairs.T.tolist())
+    below_pi = math.nextafter(math.pi, 0.0)
+    assert (below_pi + math.pi) % TWO_PI == 0.0  # wraps to 0
+    for lows, highs in [(list(d.minima), list(d.maxima)), ([1.0, below_pi], [0.5, 2.0])]:
+        own = DiameterFunction._of_floats(poly, pieces, lows, highs)  # type: ignore[arg-type]
+        given_ = DiameterFunction(poly, *pieces[:3], d.pairs, np.array(lows), np.array(highs))
+        s1, s2 = squeeze_function(own), squeeze_function(given_)
+        assert s1.values == s2.values and s1.period == s2.period
+        assert list(s1.values[0]) == sorted(s1.values[0])
+
+
+def _alternate_reference(stable: list[float], bounds: list[float]) -> bool:
+    """The alternation test as it was written before (two all(map(...)) per case)."""
+    import bisect
+    import operator
+
+    k0 = bisect.bisect_right(bounds, stable[0])
+    if k0 == 0:
+        ok = all(map(operator.lt, stable, bounds)) and all(map(operator.le, bounds, stable[1:]))
+    else:
+        ok = all(map(operator.le, bounds, stable)) and all(map(operator.lt, stable, bounds[1:]))
+    return k0 <= 1 and ok
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    points=st.lists(
+        st.sampled_from([0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0]), min_size=2, max_size=12
+    ),
+    split=st.integers(0, 2**12 - 1),
+)
+def test_alternation_loop_is_the_all_map_test(points: list[float], split: int) -> None:
+    from bayesgrasp.geometry.transfer import _from_sorted
+
+    half = len(points) // 2
+    stable = sorted(points[:half])
+    bounds = sorted(points[half : 2 * half])
+    if not stable:
+        return
+    if split % 2:  # both orders of the first two kinds
+        stable, bounds = bounds, stable
+    expected = _alternate_reference(stable, bounds)
+    try:
+        _from_sorted("squeeze", stable, bounds, 1e-9, 1e-9)
+    except BayesGraspError:
+        assert not expected
+    else:
+        assert expected

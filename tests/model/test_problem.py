@@ -234,3 +234,35 @@ def test_replace_gives_a_fresh_cache() -> None:
     assert pb.action_kinds == ("squeeze",)
     other = dataclasses.replace(pb, actions=(PUSH_GRASP,))
     assert other.action_kinds == ("push-grasp",)
+
+
+def test_build_sets_the_fields_the_dataclass_would() -> None:
+    """Problem.build's own construction (the slots' setters) against the dataclass __init__."""
+    import dataclasses
+
+    part = Part.from_points([(0, 0), (2, 0), (2.2, 1), (0, 1.1)])
+    pb = Problem.build(part, accuracy=0.01)
+    names = [f.name for f in dataclasses.fields(Problem) if f.init]
+    again = Problem(*(getattr(pb, name) for name in names))
+    for name in names:
+        assert getattr(again, name) is getattr(pb, name)
+    assert pb._cache == {} and again._cache == {} and pb._cache is not again._cache
+    assert repr(again) == repr(pb)
+    assert pb.transfers["squeeze"] is pb.states and pb.accuracy == 0.01
+    assert type(Problem.build(part, accuracy=1).accuracy) is float
+
+
+def test_build_of_a_subclass_is_the_subclass() -> None:
+    class Mine(Problem):
+        __slots__ = ()
+
+    part = Part.from_points([(0, 0), (2, 0), (2.2, 1), (0, 1.1)])
+    pb = Mine.build(part)
+    assert type(pb) is Mine and pb.n_states == Problem.build(part).n_states
+
+
+@pytest.mark.parametrize("bad", [True, -0.1, math.nan, math.inf, -math.inf, "0.1", None])
+def test_build_rejects_bad_accuracy(bad: object) -> None:
+    part = Part.from_points([(0, 0), (2, 0), (2.2, 1), (0, 1.1)])
+    with pytest.raises(PlanningError, match="`accuracy` must be a finite number"):
+        Problem.build(part, accuracy=bad)  # type: ignore[arg-type]
