@@ -280,10 +280,7 @@ def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
 
 
 def _hull_python(
-    pts: FloatArray,
-    eps: float,
-    coords: tuple[list[float], list[float]] | None = None,
-    ordered: list[tuple[float, float]] | None = None,
+    pts: FloatArray, eps: float
 ) -> tuple[list[float], list[float], float, float, float]:
     """Hull, area and centroid of a few points in plain Python.
 
@@ -298,9 +295,7 @@ def _hull_python(
     area, cx, cy : float
         Area and centroid (area 0 when degenerate).
     """
-    if ordered is None:  # else the caller sorted them (and gives the list away)
-        px, py = coords if coords is not None else pts.T.tolist()
-        ordered = _sorted_pairs(px, py)
+    ordered = _sorted_pairs(*pts.T.tolist())
     lower = _chain_python(ordered)
     ordered.reverse()
     hull = lower[:-1] + _chain_python(ordered)[:-1]
@@ -629,15 +624,14 @@ class ConvexPolygon:
     ) -> None:
         v.setflags(write=False)
         centroid.setflags(write=False)
-        put = object.__setattr__
-        put(self, "tol", tol)
-        put(self, "_v", v)
-        put(self, "_xy", None)
-        put(self, "area", area)
-        put(self, "_c", centroid)
-        put(self, "_cxy", None)
-        put(self, "size", size)
-        put(self, "_symmetry", 0)
+        _poly_tol(self, tol)
+        _poly_v(self, v)
+        _poly_xy(self, None)
+        _poly_area(self, area)
+        _poly_c(self, centroid)
+        _poly_cxy(self, None)
+        _poly_size(self, size)
+        _poly_symmetry(self, 0)
 
     def __setattr__(self, name: str, value: object) -> None:
         raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
@@ -764,15 +758,10 @@ class ConvexPolygon:
         return cls._hull_of(as_points(points), tol)
 
     @classmethod
-    def _hull_of(
-        cls, pts: FloatArray, tol: Tolerance, coords: tuple[list[float], list[float]] | None = None
-    ) -> ConvexPolygon:
-        """:meth:`from_points` of points already checked by :func:`as_points`.
-
-        ``coords``: the points' x and y as Python floats, when the caller has them.
-        """
+    def _hull_of(cls, pts: FloatArray, tol: Tolerance) -> ConvexPolygon:
+        """:meth:`from_points` of points already checked by :func:`as_points`."""
         if 3 <= len(pts) <= _SMALL:
-            px, py = coords if coords is not None else pts.T.tolist()
+            px, py = pts.T.tolist()
             return cls._hull_of_floats(pts, px, py, tol)
         extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
         _check_magnitude(pts, extent)
