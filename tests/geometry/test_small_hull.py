@@ -125,7 +125,8 @@ def test_half_hull_is_the_chain_and_knows_when_its_tests_were_firm(
 ) -> None:
     pairs = polygon._sorted_pairs(*pts.T.tolist())
     for points in (pairs, pairs[::-1]):
-        chain, sure = polygon._half_hull(points, bound)
+        head, sure = polygon._half_hull(points, bound)
+        chain = head + points[-1:]  # the last point always ends the chain
         assert chain == polygon._chain_python(points)
         if sure:  # the last test of every inner vertex passed by more than the bound
             for a, b, p in zip(chain, chain[1:], chain[2:], strict=False):

@@ -399,9 +399,9 @@ def _hull_small(
     lower, sure = _half_hull(ordered, bound)
     ordered.reverse()
     upper, sure_upper = _half_hull(ordered, bound)
-    hull = lower[:-1] + upper[:-1]
+    hull = lower + upper
     n = len(hull)
-    last = len(lower) - 1  # where the chains meet: the first and the last point
+    last = len(lower)  # where the chains meet: the first and the last point
     if n >= 3 and (
         n == 3
         or (sure and sure_upper and _firm(hull, 0, eps, bound) and _firm(hull, last, eps, bound))
@@ -466,14 +466,16 @@ def _firm(hull: list[tuple[float, float]], i: int, eps: float, bound: float) -> 
 def _half_hull(
     points: list[tuple[float, float]], bound: float
 ) -> tuple[list[tuple[float, float]], bool]:
-    """:func:`_chain_python` (the same tests), and whether every test it passed exceeded ``bound``.
+    """:func:`_chain_python` (the same tests) less its last point, and whether it was firm.
 
-    The chain's last two points ``a`` and ``b`` are kept in local variables, the rest in a
-    list; when ``b`` is dropped from a chain of two, ``a`` and ``b`` are the same point
-    (a test between two equal points never passes: its cross product is 0).
+    The last point of the chain is the last of ``points``. Firm: every test the chain
+    passed exceeded ``bound``. The chain's last two points ``a`` and ``b`` are kept in local
+    variables, the rest in a list; when ``b`` is dropped from a chain of two, ``a`` and
+    ``b`` are the same point (a test between two equal points never passes: its cross
+    product is 0).
     """
     if len(points) < 2:
-        return list(points), True
+        return [], True
     below: list[tuple[float, float]] = []
     pop, push = below.pop, below.append
     a, b = points[0], points[1]
@@ -499,7 +501,6 @@ def _half_hull(
         a, ax, ay = b, bx, by
         b, bx, by = p, x, y
     push(a)
-    push(b)
     return below, sure
 
 
@@ -665,7 +666,7 @@ class ConvexPolygon:
         c = self._c
         if c is None:
             assert self._cxy is not None
-            c = np.array(self._cxy, dtype=np.float64)
+            c = np.array(self._cxy)  # float64: two Python floats
             c.setflags(write=False)
             object.__setattr__(self, "_c", c)
         return c
