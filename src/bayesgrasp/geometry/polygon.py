@@ -12,12 +12,13 @@ rotation of the part *as given* relative to the gripper frame.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import numbers
-from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any, NoReturn
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -29,6 +30,7 @@ from ..tolerance import DEFAULT_TOLERANCE, Tolerance
 __all__ = ["ConvexPolygon", "Part", "as_points", "find_crossing", "polygon_area_centroid"]
 
 FloatArray = NDArray[np.float64]
+_FLOAT64 = np.dtype(np.float64)
 
 
 def as_points(points: ArrayLike, what: str = "vertices") -> FloatArray:
@@ -278,15 +280,13 @@ def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
 
 
 def _hull_python(
-    pts: FloatArray,
-    eps: float,
-    coords: tuple[list[float], list[float]] | None = None,
-    ordered: list[tuple[float, float]] | None = None,
+    pts: FloatArray, eps: float
 ) -> tuple[list[float], list[float], float, float, float]:
     """Hull, area and centroid of a few points in plain Python.
 
     For a few points numpy's cost per call is larger than the work. The steps are those of
-    ``_hull_indices``, ``_drop_near_collinear`` and ``polygon_area_centroid``.
+    ``_hull_indices``, ``_drop_near_collinear`` and ``polygon_area_centroid``. The reference
+    of :func:`_hull_small` (which makes the same decisions with less work).
 
     Returns
     -------
@@ -295,13 +295,17 @@ def _hull_python(
     area, cx, cy : float
         Area and centroid (area 0 when degenerate).
     """
-    if ordered is None:  # else the caller sorted them (and gives the list away)
-        px, py = coords if coords is not None else pts.T.tolist()
-        ordered = _sorted_pairs(px, py)
+    ordered = _sorted_pairs(*pts.T.tolist())
     lower = _chain_python(ordered)
     ordered.reverse()
     hull = lower[:-1] + _chain_python(ordered)[:-1]
-    xs, ys = [p[0] for p in hull], [p[1] for p in hull]
+    return _drop_and_measure([p[0] for p in hull], [p[1] for p in hull], eps)
+
+
+def _drop_and_measure(
+    xs: list[float], ys: list[float], eps: float
+) -> tuple[list[float], list[float], float, float, float]:
+    """The near-collinear drop and the area and centroid of a hull chain, in plain Python."""
     hypot = math.hypot
     while len(xs) > 3:  # _drop_near_collinear, step for step
         n = len(xs)
@@ -366,6 +370,140 @@ def _chain_python(points: list[tuple[float, float]]) -> list[tuple[float, float]
     return chain
 
 
+# Below this the bound of _hull_small is not trusted (products near the underflow).
+_TINY = 1e-280
+
+
+def _hull_small(
+    ordered: list[tuple[float, float]], eps: float, extent: float, y0: float, y1: float
+) -> tuple[list[float], list[float], float, float, float, float]:
+    """:func:`_hull_python` and the hull's size, with the same results and less work.
+
+    ``ordered``: the points sorted (:func:`_sorted_pairs`, consumed), ``extent`` their
+    largest width along x or y, ``y0`` and ``y1`` their least and largest y. Returns the
+    hull's ``xs, ys, area, cx, cy`` as :func:`_hull_python` does and the size (the largest
+    distance from the centroid).
+
+    The near-collinear test of a vertex, ``|u x w| <= eps |u|`` (``u`` from the previous
+    vertex to the next, ``w`` to the vertex), needs no work for most vertices: the chain's
+    last test of a vertex ``b`` between ``a`` and ``p`` is ``(b - a) x (p - a) > 0`` with
+    the same two rounded products in the other order, so the same magnitude; and
+    ``eps |u| <= eps sqrt(2) extent`` (every coordinate difference is at most the extent),
+    less than ``bound = 2 eps extent`` after rounding. When every test the chains passed
+    exceeded the bound, only the two vertices where the chains meet are tested; otherwise
+    :func:`_drop_and_measure` decides as before.
+    """
+    bound = 2.0 * eps * extent
+    if not bound >= _TINY:  # (also NaN) every vertex tested
+        bound = math.inf
+    lower, sure = _half_hull(ordered, bound)
+    ordered.reverse()
+    upper, sure_upper = _half_hull(ordered, bound)
+    hull = lower + upper
+    n = len(hull)
+    last = len(lower)  # where the chains meet: the first and the last point
+    if n >= 3 and (
+        n == 3
+        or (sure and sure_upper and _firm(hull, 0, eps, bound) and _firm(hull, last, eps, bound))
+    ):
+        # _drop_and_measure with nothing to drop: the same sums in the same order, and the
+        # same scale, the largest |x - ox| and |y - oy| over the vertices (a rounded
+        # difference is monotone in its terms): the last point, of the largest x, is a
+        # vertex, and the least and largest y are checked to be.
+        ox, oy = hull[0]
+        scale = max(hull[last][0] - ox, y1 - oy, oy - y0)
+        xs, ys = [ox], [oy]
+        twice = cx = cy = qx = qy = 0.0
+        for bx, by in hull[1:]:
+            xs.append(bx)
+            ys.append(by)
+            rx = (bx - ox) / scale
+            ry = (by - oy) / scale
+            c = qx * ry - rx * qy
+            twice += c
+            cx += (qx + rx) * c
+            cy += (qy + ry) * c
+            qx = rx
+            qy = ry
+        c = qx * 0.0 - 0.0 * qy  # the edge back to the first vertex, at (0, 0)
+        twice += c
+        cx += (qx + 0.0) * c
+        cy += (qy + 0.0) * c
+        if twice != 0.0 and y0 in ys and y1 in ys and 0.0 < scale < math.inf:
+            unit = scale / (3.0 * twice)
+            cx = cx * unit + ox
+            cy = cy * unit + oy
+            return xs, ys, 0.5 * twice * scale * scale, cx, cy, _size(hull, cx, cy)
+    xs, ys, area, cx, cy = _drop_and_measure([p[0] for p in hull], [p[1] for p in hull], eps)
+    if not xs:
+        return xs, ys, area, cx, cy, 0.0
+    return xs, ys, area, cx, cy, _size(zip(xs, ys, strict=True), cx, cy)
+
+
+def _size(points: Iterable[tuple[float, float]], cx: float, cy: float) -> float:
+    """The largest distance of the points from ``(cx, cy)`` (as the hull's size was made)."""
+    top = 0.0
+    for x, y in points:
+        d = (x - cx) ** 2 + (y - cy) ** 2
+        if d > top:
+            top = d
+    return math.sqrt(top)
+
+
+def _firm(hull: list[tuple[float, float]], i: int, eps: float, bound: float) -> bool:
+    """Whether vertex ``i`` of a hull chain passes the near-collinear test (is kept).
+
+    Beyond ``bound`` (see :func:`_hull_small`) without the length of the chord.
+    """
+    ax, ay = hull[i - 1]
+    x, y = hull[i]
+    bx, by = hull[(i + 1) % len(hull)]
+    ux, uy = bx - ax, by - ay
+    c = abs(ux * (y - ay) - uy * (x - ax))
+    return c > bound or not c <= eps * math.hypot(ux, uy)
+
+
+def _half_hull(
+    points: list[tuple[float, float]], bound: float
+) -> tuple[list[tuple[float, float]], bool]:
+    """:func:`_chain_python` (the same tests) less its last point, and whether it was firm.
+
+    The last point of the chain is the last of ``points``. Firm: every test the chain
+    passed exceeded ``bound``. The chain's last two points ``a`` and ``b`` are kept in local
+    variables, the rest in a list; when ``b`` is dropped from a chain of two, ``a`` and
+    ``b`` are the same point (a test between two equal points never passes: its cross
+    product is 0).
+    """
+    if len(points) < 2:
+        return [], True
+    below: list[tuple[float, float]] = []
+    pop, push = below.pop, below.append
+    a, b = points[0], points[1]
+    ax, ay = a
+    bx, by = b
+    sure = True
+    for p in points[2:]:
+        x, y = p
+        while True:
+            c = (bx - ax) * (y - ay) - (by - ay) * (x - ax)
+            if c > bound:
+                break
+            if c > 0:
+                sure = False
+                break
+            b, bx, by = a, ax, ay  # b is dropped
+            if not below:
+                break
+            a = pop()
+            ax, ay = a
+        if a is not b:
+            push(a)
+        a, ax, ay = b, bx, by
+        b, bx, by = p, x, y
+    push(a)
+    return below, sure
+
+
 def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
     """Drop hull vertices closer than ``eps`` to the segment joining their neighbours.
 
@@ -392,16 +530,38 @@ def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
     return v
 
 
+def _refuse(pts: FloatArray, eps: float) -> NoReturn:
+    """Refuse points with no hull: too few distinct points, or all collinear."""
+    # Tell "too few points" from "collinear" only on failure (np.unique is slow).
+    distinct = 0
+    if len(pts):
+        grid = np.round((pts - pts.min(axis=0)) / max(eps, 1e-300))
+        distinct = len(np.unique(grid, axis=0))
+    if distinct < 3:
+        raise PartError(
+            f"a part needs at least 3 distinct points; got {len(pts)} point(s) "
+            f"with {distinct} distinct"
+        )
+    raise PartError("the part's points are all collinear; a part needs a non-zero area")
+
+
+def _restored(
+    vertices: FloatArray, tol: Tolerance, area: float, centroid: FloatArray, size: float
+) -> ConvexPolygon:
+    """A pickled :class:`ConvexPolygon` (its fields, already checked)."""
+    return ConvexPolygon._trusted(vertices, tol, area, centroid, size)
+
+
 # Up to this many points, ConvexPolygon.from_points works on Python floats (faster there).
 _SMALL = SMALL
 
 
-@dataclass(frozen=True, slots=True, eq=False)
 class ConvexPolygon:
     """Convex polygon, vertices counter-clockwise, no repeated closing vertex.
 
     Build it with :meth:`from_points`, which takes the convex hull of any point list.
-    The vertices array is read-only.
+    A frozen value: the arrays are read-only (made on first use when the hull was taken in
+    plain Python, from its Python floats).
 
     Attributes
     ----------
@@ -409,6 +569,11 @@ class ConvexPolygon:
         Counter-clockwise hull vertices in the user's coordinates (never rotated).
     tol : Tolerance
         The tolerances used for this polygon.
+    area : float
+    centroid : ndarray of shape (2,)
+        The area centroid.
+    size : float
+        The largest distance of a vertex from the centroid.
 
     Examples
     --------
@@ -416,19 +581,24 @@ class ConvexPolygon:
     3
     """
 
-    vertices: FloatArray
-    tol: Tolerance = DEFAULT_TOLERANCE
-    area: float = field(init=False)
-    centroid: FloatArray = field(init=False)
-    size: float = field(init=False)
-    # symmetry_order once known; -k when only known to be below k; 0 before any test.
-    _symmetry: int = field(init=False, repr=False)
-    # The vertices' x and y as Python floats (for the plain-Python paths), once asked for.
-    _xy: tuple[list[float], list[float]] | None = field(init=False, repr=False)
+    __slots__ = ("_c", "_cxy", "_symmetry", "_v", "_xy", "area", "size", "tol")
+    __match_args__ = ("vertices", "tol")
 
-    def __post_init__(self) -> None:
-        _check_tolerance(self.tol)
-        v = as_points(self.vertices)
+    tol: Tolerance
+    area: float
+    size: float
+    # symmetry_order once known; -k when only known to be below k; 0 before any test.
+    _symmetry: int
+    # The vertices and the centroid as read-only arrays, or as Python floats (for the
+    # plain-Python paths): at least one of each pair is set, the other made when asked for.
+    _v: FloatArray | None
+    _xy: tuple[list[float], list[float]] | None
+    _c: FloatArray | None
+    _cxy: tuple[float, float] | None
+
+    def __init__(self, vertices: ArrayLike, tol: Tolerance = DEFAULT_TOLERANCE) -> None:
+        _check_tolerance(tol)
+        v = as_points(vertices)
         n = len(v)
         what = "`vertices` must be a counter-clockwise convex polygon"
         if n < 3:
@@ -437,28 +607,69 @@ class ConvexPolygon:
         size = float(np.max(np.hypot(*(v - centroid).T)))
         e = np.concatenate((v[1:], v[:1])) - v  # (N, 2) edge i runs from vertex i to i + 1
         elen = np.hypot(e[:, 0], e[:, 1])
-        short = np.flatnonzero(elen <= self.tol.length_for(size))
+        short = np.flatnonzero(elen <= tol.length_for(size))
         if len(short):
             raise PartError(f"{what}; vertices {short[0]} and {(short[0] + 1) % n} coincide")
         en = np.concatenate((e[1:], e[:1]))  # (N, 2) the edge after each edge
         cross = e[:, 0] * en[:, 1] - e[:, 1] * en[:, 0]
-        right = np.flatnonzero(cross < -self.tol.angle * elen * np.roll(elen, -1))
+        right = np.flatnonzero(cross < -tol.angle * elen * np.roll(elen, -1))
         if len(right):
             raise PartError(f"{what}; it turns clockwise at vertex {(right[0] + 1) % n}")
         turns = float(np.sum(np.arctan2(cross, np.sum(e * en, axis=1)))) / (2.0 * math.pi)
         if abs(turns - 1.0) > 1e-6:
             raise PartError(f"{what}; it winds {turns:.3g} times around")
-        self._set(v, area, centroid, size)
+        self._set_arrays(tol, v, area, centroid, size)
 
-    def _set(self, v: FloatArray, area: float, centroid: FloatArray, size: float) -> None:
+    def _set_arrays(
+        self, tol: Tolerance, v: FloatArray, area: float, centroid: FloatArray, size: float
+    ) -> None:
         v.setflags(write=False)
         centroid.setflags(write=False)
-        object.__setattr__(self, "vertices", v)
-        object.__setattr__(self, "area", area)
-        object.__setattr__(self, "centroid", centroid)
-        object.__setattr__(self, "size", size)
-        object.__setattr__(self, "_symmetry", 0)
-        object.__setattr__(self, "_xy", None)
+        _poly_tol(self, tol)
+        _poly_v(self, v)
+        _poly_xy(self, None)
+        _poly_area(self, area)
+        _poly_c(self, centroid)
+        _poly_cxy(self, None)
+        _poly_size(self, size)
+        _poly_symmetry(self, 0)
+
+    def __setattr__(self, name: str, value: object) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name: str) -> None:
+        raise dataclasses.FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def __reduce__(self) -> tuple[object, ...]:
+        return (_restored, (self.vertices, self.tol, self.area, self.centroid, self.size))
+
+    def __repr__(self) -> str:
+        return (
+            f"ConvexPolygon(vertices={self.vertices!r}, tol={self.tol!r}, area={self.area!r}, "
+            f"centroid={self.centroid!r}, size={self.size!r})"
+        )
+
+    @property
+    def vertices(self) -> FloatArray:
+        """Counter-clockwise hull vertices, shape (N, 2), read-only."""
+        v = self._v
+        if v is None:
+            assert self._xy is not None
+            v = np.array(self._xy, dtype=np.float64).T.copy()
+            v.setflags(write=False)
+            object.__setattr__(self, "_v", v)
+        return v
+
+    @property
+    def centroid(self) -> FloatArray:
+        """The area centroid, shape (2,), read-only."""
+        c = self._c
+        if c is None:
+            assert self._cxy is not None
+            c = np.array(self._cxy)  # float64: two Python floats
+            c.setflags(write=False)
+            object.__setattr__(self, "_c", c)
+        return c
 
     def _coords(self) -> tuple[list[float], list[float]]:
         """The vertices' x and y coordinates as lists of Python floats (made once)."""
@@ -469,6 +680,15 @@ class ConvexPolygon:
             object.__setattr__(self, "_xy", xy)
         return xy
 
+    def _centroid_xy(self) -> tuple[float, float]:
+        """The centroid as two Python floats (made once)."""
+        cxy = self._cxy
+        if cxy is None:
+            cx, cy = self.centroid.tolist()
+            cxy = (cx, cy)
+            object.__setattr__(self, "_cxy", cxy)
+        return cxy
+
     @classmethod
     def _trusted(
         cls,
@@ -477,20 +697,36 @@ class ConvexPolygon:
         area: float,
         centroid: FloatArray,
         size: float | None = None,
-        xy: tuple[list[float], list[float]] | None = None,
     ) -> ConvexPolygon:
-        """A polygon known to be convex and counter-clockwise (from a hull or a rotation).
-
-        ``xy``: the vertices' coordinates as Python floats, when the caller has them.
-        """
+        """A polygon known to be convex and counter-clockwise (from a hull or a rotation)."""
         poly = object.__new__(cls)
-        object.__setattr__(poly, "tol", tol)
         if size is None:
             d = v - centroid
             size = math.sqrt(float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2)))
-        poly._set(v, area, centroid, size)
-        if xy is not None:
-            object.__setattr__(poly, "_xy", xy)
+        poly._set_arrays(tol, v, area, centroid, size)
+        return poly
+
+    @classmethod
+    def _of_floats(
+        cls,
+        xs: list[float],
+        ys: list[float],
+        tol: Tolerance,
+        area: float,
+        cx: float,
+        cy: float,
+        size: float,
+    ) -> ConvexPolygon:
+        """A hull taken in plain Python, from its floats; the arrays are made on first use."""
+        poly = object.__new__(cls)
+        _poly_tol(poly, tol)
+        _poly_v(poly, None)
+        _poly_xy(poly, (xs, ys))
+        _poly_area(poly, area)
+        _poly_c(poly, None)
+        _poly_cxy(poly, (cx, cy))
+        _poly_size(poly, size)
+        _poly_symmetry(poly, 0)
         return poly
 
     @classmethod
@@ -523,33 +759,17 @@ class ConvexPolygon:
         return cls._hull_of(as_points(points), tol)
 
     @classmethod
-    def _hull_of(
-        cls, pts: FloatArray, tol: Tolerance, coords: tuple[list[float], list[float]] | None = None
-    ) -> ConvexPolygon:
-        """:meth:`from_points` of points already checked by :func:`as_points`.
-
-        ``coords``: the points' x and y as Python floats, when the caller has them.
-        """
-        ordered = None
-        if 3 <= len(pts) <= _SMALL:  # the extent and magnitude on Python floats (same values)
-            px, py = coords if coords is not None else pts.T.tolist()
-            ordered = _sorted_pairs(px, py)  # by x first: the least and largest x at the ends
-            x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], min(py), max(py)
-            extent = max(x1 - x0, y1 - y0)
-            # The largest |coordinate| is the largest of max and -min.
-            if max(x1, -x0, y1, -y0) > _MAX_COORD or 0.0 < extent < _MIN_EXTENT:
-                _check_magnitude(pts, extent)
-        else:
-            extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
-            _check_magnitude(pts, extent)
+    def _hull_of(cls, pts: FloatArray, tol: Tolerance) -> ConvexPolygon:
+        """:meth:`from_points` of points already checked by :func:`as_points`."""
+        if 3 <= len(pts) <= _SMALL:
+            px, py = pts.T.tolist()
+            return cls._hull_of_floats(pts, px, py, tol)
+        extent = float(np.max(np.ptp(pts, axis=0))) if len(pts) else 0.0
+        _check_magnitude(pts, extent)
         eps = tol.length_for(extent)
         area = 0.0
         if len(pts) < 3 or extent == 0.0:
             hull = pts[:0]
-        elif len(pts) <= _SMALL:
-            xs, ys, area, cx, cy = _hull_python(pts, eps, ordered=ordered)
-            hull = np.array([xs, ys], dtype=np.float64).T.copy()
-            centroid = np.array([cx, cy])
         else:
             hull = pts[_hull_indices(pts)]
             if len(hull) > 3:
@@ -557,28 +777,37 @@ class ConvexPolygon:
             if len(hull) >= 3:
                 area, centroid = polygon_area_centroid(hull)
         if len(hull) < 3 or area <= eps * extent:
-            # Tell "too few points" from "collinear" only on failure (np.unique is slow).
-            distinct = 0
-            if len(pts):
-                grid = np.round((pts - pts.min(axis=0)) / max(eps, 1e-300))
-                distinct = len(np.unique(grid, axis=0))
-            if distinct < 3:
-                raise PartError(
-                    f"a part needs at least 3 distinct points; got {len(pts)} point(s) "
-                    f"with {distinct} distinct"
-                )
-            raise PartError("the part's points are all collinear; a part needs a non-zero area")
-        if len(pts) <= _SMALL:
-            size = math.sqrt(
-                max([(x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True)])
-            )
-            return cls._trusted(hull, tol, area, centroid, size, (xs, ys))
+            _refuse(pts, eps)
         return cls._trusted(hull, tol, area, centroid)
+
+    @classmethod
+    def _hull_of_floats(
+        cls, pts: FloatArray, px: list[float], py: list[float], tol: Tolerance
+    ) -> ConvexPolygon:
+        """:meth:`_hull_of` of 3 to :data:`_SMALL` points, in plain Python.
+
+        ``px`` and ``py`` are the coordinates of ``pts`` as Python floats (the same values).
+        """
+        ordered = _sorted_pairs(px, py)  # by x first: the least and largest x at the ends
+        by_y = sorted(py)  # (cheaper than min and max)
+        x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], by_y[0], by_y[-1]
+        extent = max(x1 - x0, y1 - y0)
+        big = _MAX_COORD  # the largest |coordinate| is the largest of max and -min
+        if x1 > big or -x0 > big or y1 > big or -y0 > big or 0.0 < extent < _MIN_EXTENT:
+            _check_magnitude(pts, extent)
+        eps = tol.length_for(extent)
+        if extent == 0.0:
+            _refuse(pts, eps)
+        xs, ys, area, cx, cy, size = _hull_small(ordered, eps, extent, y0, y1)
+        if len(xs) < 3 or area <= eps * extent:
+            _refuse(pts, eps)
+        return cls._of_floats(xs, ys, tol, area, cx, cy, size)
 
     @property
     def n_sides(self) -> int:
         """Number of sides (equal to the number of vertices)."""
-        return len(self.vertices)
+        xy = self._xy
+        return len(xy[0]) if xy is not None else len(self.vertices)
 
     def rotated(self, angle: float) -> ConvexPolygon:
         """The polygon rotated counter-clockwise by ``angle`` about the origin.
@@ -630,7 +859,7 @@ class ConvexPolygon:
         known = self._symmetry
         if known > 0:
             return known if known >= lowest else 1
-        n = len(self.vertices)
+        n = self.n_sides  # the arrays are made on first use: not here
         orders = _orders_from(n, lowest)
         if known < 0:
             if lowest >= -known:
@@ -638,7 +867,7 @@ class ConvexPolygon:
             orders = [r for r in orders if r < -known]
         eps = self.tol.symmetry_for(self.size)
         if n <= _SMALL:
-            found = _symmetry_order_python(*self._coords(), self.centroid, orders, eps)
+            found = _symmetry_order_python(*self._coords(), self._centroid_xy(), orders, eps)
         else:
             found = self._find_symmetry_order(orders, eps)
         _SET_SYMMETRY(self, found if found > 1 else -lowest)
@@ -721,6 +950,13 @@ class ConvexPolygon:
         return out.reshape(n, 2)
 
 
+# The slots' own setters: the frozen class's __setattr__ refuses, and object.__setattr__
+# costs twice as much (the plain-Python hull makes polygons by the thousand).
+_poly_c, _poly_cxy, _poly_symmetry, _poly_v, _poly_xy, _poly_area, _poly_size, _poly_tol = (
+    ConvexPolygon.__dict__[name].__set__ for name in ConvexPolygon.__slots__
+)
+
+
 @functools.cache
 def _orders(n: int) -> list[int]:
     """The divisors of ``n`` above 1, largest first: the possible orders of symmetry."""
@@ -739,7 +975,7 @@ _SET_SYMMETRY = ConvexPolygon.__dict__["_symmetry"].__set__
 
 
 def _symmetry_order_python(
-    xs: list[float], ys: list[float], centroid: FloatArray, orders: list[int], eps: float
+    xs: list[float], ys: list[float], centroid: Sequence[float], orders: list[int], eps: float
 ) -> int:
     """:meth:`ConvexPolygon.symmetry_order` for a few vertices, in plain Python (faster).
 
@@ -749,7 +985,7 @@ def _symmetry_order_python(
     """
     if not orders:
         return 1
-    cx, cy = centroid.tolist()
+    cx, cy = centroid
     n = len(xs)
     r0 = math.hypot(xs[0] - cx, ys[0] - cy)
     radii: list[float] = []
@@ -825,33 +1061,44 @@ class Part:
         PartError
             Bad coordinates, or a centre of mass outside the hull.
         """
-        coords = None
+        hull = None
         if (  # a few float64 points: the finite check on Python floats (a sum is finite
             # only if every term is; else as_points decides and words its refusal)
             type(points) is np.ndarray
-            and points.dtype == np.float64
+            and points.dtype is _FLOAT64  # (a non-native byte order is not)
             and points.ndim == 2
             and points.shape[1] == 2
             and 3 <= len(points) <= _SMALL
         ):
             outline = points.copy()
             px, py = outline.T.tolist()
-            coords = (px, py)
-            if not math.isfinite(sum(px) + sum(py)):
-                outline, coords = as_points(points), None
+            if math.isfinite(sum(px, sum(py))):
+                if tol is not DEFAULT_TOLERANCE:
+                    _check_tolerance(tol)
+                hull = ConvexPolygon._hull_of_floats(outline, px, py, tol)
+            else:
+                outline = as_points(points)
         else:
             outline = as_points(points)  # a fresh array
-        if tol is not DEFAULT_TOLERANCE:
-            _check_tolerance(tol)
-        hull = ConvexPolygon._hull_of(outline, tol, coords)
-        com = None
-        if center_of_mass is None:  # the hull's centroid: finite floats already
-            c = hull.centroid
-            if math.isfinite(c[0]) and math.isfinite(c[1]) and _holds_centroid(hull):
-                com = np.array(c, dtype=np.float64)
-        if com is None:
-            com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
+        if hull is None:
+            if tol is not DEFAULT_TOLERANCE:
+                _check_tolerance(tol)
+            hull = ConvexPolygon._hull_of(outline, tol)
         outline.setflags(write=False)
+        if center_of_mass is None:  # the hull's centroid (the same read-only array)
+            cx, cy = hull._centroid_xy()
+            if math.isfinite(cx) and math.isfinite(cy) and _holds_centroid(hull):
+                if cls is not Part:
+                    return cls(name, hull, outline, hull.centroid, units)
+                part = object.__new__(Part)  # Part(...), without its frozen __init__'s cost
+                _part_name(part, name)
+                _part_hull(part, hull)
+                _part_outline(part, outline)
+                _part_center_of_mass(part, hull.centroid)
+                _part_units(part, units)
+                _part_holes(part, ())
+                return part
+        com = _center_of_mass(hull, hull.centroid if center_of_mass is None else center_of_mass)
         com.setflags(write=False)
         return cls(name, hull, outline, com, units)
 
@@ -958,6 +1205,11 @@ class Part:
         return cls(name, hull, oriented[0], com, units, tuple(oriented[1:]))
 
 
+_part_name, _part_hull, _part_outline, _part_center_of_mass, _part_units, _part_holes = (
+    Part.__dict__[f.name].__set__ for f in dataclasses.fields(Part)
+)
+
+
 def _center_of_mass(hull: ConvexPolygon, point: ArrayLike) -> FloatArray:
     """A centre of mass as a fresh (2,) array, refused unless strictly inside the hull."""
     try:
@@ -983,20 +1235,19 @@ def _holds_centroid(hull: ConvexPolygon) -> bool:
     margin by far more than the rounding of the distances, every edge passes the test. Only
     thin polygons are tested edge by edge.
     """
-    c = hull.centroid
+    cx, cy = hull._centroid_xy()
     margin = hull.tol.length_for(hull.size)
-    slack = _CENTROID_SLACK * (abs(float(c[0])) + abs(float(c[1])) + hull.size)
+    slack = _CENTROID_SLACK * (abs(cx) + abs(cy) + hull.size)
     if hull.area > 6.0 * hull.size * (2.0 * margin + slack):
         return True
-    return hull_contains(hull, c)
+    return hull_contains(hull, hull.centroid)
 
 
 def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
     """Whether ``point`` lies strictly inside the convex polygon (by more than the tolerance)."""
-    v = hull.vertices
     margin = hull.tol.length_for(hull.size)
-    if len(v) <= SMALL:  # on Python floats (math.hypot may differ from numpy's by an ulp)
-        xs, ys = v[:, 0].tolist(), v[:, 1].tolist()
+    if hull.n_sides <= SMALL:  # on Python floats (math.hypot may differ from numpy's by an ulp)
+        xs, ys = hull._coords()
         px, py = float(point[0]), float(point[1])
         n = len(xs)
         for i in range(n):
@@ -1005,11 +1256,12 @@ def hull_contains(hull: ConvexPolygon, point: FloatArray) -> bool:
             if not cross / math.hypot(ex, ey) > margin:
                 return False
         return True
+    v = hull.vertices
     e = np.roll(v, -1, axis=0) - v
     rel = point - v
-    cross = e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0]
+    crosses = e[:, 0] * rel[:, 1] - e[:, 1] * rel[:, 0]
     lengths = np.hypot(e[:, 0], e[:, 1])
-    return bool(np.all(cross / lengths > margin))
+    return bool(np.all(crosses / lengths > margin))
 
 
 def _clean_ring(points: ArrayLike, what: str) -> FloatArray:

@@ -1,0 +1,295 @@
+"""The plain-Python hull of a few points against its step-for-step reference (issue 12).
+
+:func:`polygon._hull_small` skips the near-collinear test of every vertex the chains already
+passed by more than a bound, sums the area in one pass, and reads the scale off the points'
+extremes; :func:`polygon._hull_python` is the reference it must equal bit for bit (the same
+vertices, area, centroid and size, as float hex). Inputs: random, near-collinear (whole
+clouds and single vertices, the two where the chains meet included), duplicates, thin, huge
+and tiny clouds, under several tolerances. The lazily made arrays of the polygons and parts
+are compared with the eager construction.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import pickle
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.testing import assert_array_equal
+
+from bayesgrasp.errors import PartError
+from bayesgrasp.geometry import polygon
+from bayesgrasp.geometry.polygon import ConvexPolygon, Part
+from bayesgrasp.tolerance import DEFAULT_TOLERANCE, Tolerance
+from strategies import convex_points, lattice_points
+
+FloatArray = np.ndarray
+
+
+@st.composite
+def near_collinear_points(draw: st.DrawFn) -> FloatArray:
+    """A convex polygon with extra points a few tolerances off its edges or its vertices.
+
+    The offsets straddle both the tolerance ``eps`` and the bound ``2 eps extent`` of the
+    skipped tests, at the leftmost and rightmost points (where the chains meet) too.
+    """
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    k = draw(st.integers(3, 8))
+    t = np.sort(rng.uniform(0, 2 * math.pi, k))
+    v = np.column_stack([np.cos(t), 0.6 * np.sin(t)])
+    offset = 10.0 ** draw(st.floats(-13, -7))  # the default tolerance: 1e-10 of the extent
+    extra = []
+    for _ in range(draw(st.integers(1, 6))):
+        i = int(rng.integers(k))
+        a, b = v[i], v[(i + 1) % k]
+        normal = np.array([a[1] - b[1], b[0] - a[0]]) / np.hypot(*(b - a))
+        where = draw(st.sampled_from([0.0, 1.0, rng.uniform()]))  # on a vertex, or an edge
+        extra.append(a + where * (b - a) + offset * rng.normal() * normal)
+    pts = np.vstack([v, extra])
+    scale = 10.0 ** draw(st.sampled_from([0.0, -120.0, 120.0, float(rng.uniform(-5, 5))]))
+    return np.asarray(rng.permutation(pts) * scale + draw(st.sampled_from([0.0, 3.0])) * scale)
+
+
+@st.composite
+def scattered_points(draw: st.DrawFn) -> FloatArray:
+    """Clouds of 3 to 64 points: uniform, normal, thin, rounded, huge or tiny."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    n = draw(st.integers(3, 64))
+    kind = draw(st.sampled_from(["uniform", "normal", "thin", "rounded", "scaled"]))
+    if kind == "uniform":
+        return rng.uniform(size=(n, 2))
+    if kind == "normal":
+        return rng.normal(size=(n, 2))
+    if kind == "thin":
+        height = 10.0 ** draw(st.floats(-11, -1))
+        return np.column_stack([rng.uniform(size=n), rng.uniform(size=n) * height]) + 5.0
+    if kind == "rounded":
+        return np.round(rng.uniform(size=(n, 2)) * 8) / 8
+    return rng.uniform(size=(n, 2)) * 10.0 ** draw(st.floats(-149, 149))
+
+
+TOLERANCES = [DEFAULT_TOLERANCE, Tolerance(length=0.0), Tolerance(length=1e-4)]
+
+
+def any_points() -> st.SearchStrategy[FloatArray]:
+    return st.one_of(
+        near_collinear_points(),
+        scattered_points(),
+        convex_points(),
+        lattice_points(min_size=3, max_size=40, bound=3),
+    )
+
+
+def hexes(*values: float | list[float]) -> list[object]:
+    return [[x.hex() for x in v] if isinstance(v, list) else v.hex() for v in values]
+
+
+def reference(pts: FloatArray, tol: Tolerance) -> tuple[list[object], float] | None:
+    """``_hull_python`` and the size as the hull had them, or None when refused."""
+    px, py = pts.T.tolist()
+    x0, x1 = min(px), max(px)
+    extent = max(x1 - x0, max(py) - min(py))
+    eps = tol.length_for(extent)
+    xs, ys, area, cx, cy = polygon._hull_python(pts, eps)
+    if len(xs) < 3 or area <= eps * extent:
+        return None
+    size = math.sqrt(max([(x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True)]))
+    return hexes(xs, ys, area, cx, cy, size), extent
+
+
+@settings(max_examples=400, deadline=None)
+@given(pts=any_points(), tol=st.sampled_from(TOLERANCES))
+def test_small_hull_is_the_reference_bit_for_bit(pts: FloatArray, tol: Tolerance) -> None:
+    if np.max(np.abs(pts)) > 1e150 or np.ptp(pts, axis=0).max() < 1e-150:
+        return  # refused before any hull
+    ref = reference(pts, tol)
+    px, py = pts.T.tolist()
+    extent = max(max(px) - min(px), max(py) - min(py))
+    eps = tol.length_for(extent)
+    small = polygon._hull_small(polygon._sorted_pairs(px, py), eps, extent, min(py), max(py))
+    if ref is None:
+        xs, _, area, *_ = small
+        assert len(xs) < 3 or area <= eps * extent
+        return
+    assert hexes(*small) == ref[0]
+
+
+@settings(max_examples=300, deadline=None)
+@given(pts=any_points(), bound=st.sampled_from([0.0, 1e-12, 1e-9, 1e-3, math.inf]))
+def test_half_hull_is_the_chain_and_knows_when_its_tests_were_firm(
+    pts: FloatArray, bound: float
+) -> None:
+    pairs = polygon._sorted_pairs(*pts.T.tolist())
+    for points in (pairs, pairs[::-1]):
+        head, sure = polygon._half_hull(points, bound)
+        chain = head + points[-1:]  # the last point always ends the chain
+        assert chain == polygon._chain_python(points)
+        if sure:  # the last test of every inner vertex passed by more than the bound
+            for a, b, p in zip(chain, chain[1:], chain[2:], strict=False):
+                assert (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > bound
+        if bound == math.inf and len(chain) > 2:
+            assert not sure
+
+
+def test_the_bound_covers_the_chord_test() -> None:
+    """``|u x w| > 2 eps extent`` implies ``|u x w| > eps |u|`` (``|u|`` <= sqrt(2) extent)."""
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        extent = 10.0 ** rng.uniform(-130, 130)
+        eps = 10.0 ** rng.uniform(-16, -1) * extent
+        bound = 2.0 * eps * extent
+        for ux, uy in [rng.choice([-1.0, 1.0], 2) * extent, rng.uniform(-1, 1, 2) * extent]:
+            assert eps * math.hypot(ux, uy) < bound  # the longest chords, and any
+
+
+@pytest.mark.parametrize(
+    "pts",
+    [
+        # The leftmost point 1.5e-11 off the chord of its neighbours: dropped, though both
+        # chains pass all their tests firmly (only the test where they meet catches it).
+        [(0.0, 0.0), (2e-11, -1.0), (1.0, -1.0), (1.0, 1.0), (1e-11, 1.0)],
+        # The same at the rightmost point.
+        [(1.0, 0.0), (1.0 - 2e-11, 1.0), (0.0, 1.0), (0.0, -1.0), (1.0 - 1e-11, -1.0)],
+    ],
+)
+def test_a_joint_vertex_near_its_chord_is_dropped_as_before(
+    pts: list[tuple[float, float]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    arr = np.array(pts)
+    ref = reference(arr, DEFAULT_TOLERANCE)
+    assert ref is not None
+    firm = []
+    real = polygon._firm
+
+    def watched(*args: object) -> bool:
+        firm.append(real(*args))  # type: ignore[arg-type]
+        return firm[-1]
+
+    monkeypatch.setattr(polygon, "_firm", watched)
+    part = Part.from_points(arr)
+    assert False in firm  # the chains were sure: the joint test decided
+    assert part.hull.n_sides == 4
+    xs, ys = part.hull._coords()
+    assert hexes(xs, ys, part.hull.area, *part.hull.centroid.tolist(), part.hull.size) == ref[0]
+
+
+@settings(max_examples=100, deadline=None)
+@given(pts=scattered_points(), below=st.floats(0.0, 2.0), above=st.floats(0.0, 2.0))
+def test_extremes_missing_from_the_hull_take_the_general_path(
+    pts: FloatArray, below: float, above: float
+) -> None:
+    """Were the least or largest y not a vertex (a rounding of the chain's tests could drop
+    it), the scale read off them would be wrong: the general path must take over."""
+    px, py = pts.T.tolist()
+    extent = max(max(px) - min(px), max(py) - min(py))
+    if not 1e-140 < extent < 1e140:
+        return
+    eps = DEFAULT_TOLERANCE.length_for(extent)
+    y0, y1 = min(py) - below * extent, max(py) + above * extent
+    got = polygon._hull_small(polygon._sorted_pairs(px, py), eps, extent, y0, y1)
+    xs, ys, area, cx, cy = polygon._hull_python(pts, eps)
+    if len(xs) >= 3 and area > 0.0:
+        size = polygon._size(zip(xs, ys, strict=True), cx, cy)
+        assert hexes(*got) == hexes(xs, ys, area, cx, cy, size)
+
+
+def test_the_study_polygons_take_the_short_path(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The general drop runs only for the odd polygon (none of these 300)."""
+    calls = []
+    general = polygon._drop_and_measure
+
+    def counted(xs: list[float], ys: list[float], eps: float) -> object:
+        calls.append(len(xs))
+        return general(xs, ys, eps)
+
+    monkeypatch.setattr(polygon, "_drop_and_measure", counted)
+    for pts in np.random.default_rng(1).uniform(size=(300, 10, 2)):
+        Part.from_points(pts)
+    assert calls == []
+
+
+# --------------------------------------------------------------------------- Part.from_points
+
+
+@settings(max_examples=300, deadline=None)
+@given(pts=any_points(), tol=st.sampled_from(TOLERANCES))
+def test_part_from_points_is_the_reference(pts: FloatArray, tol: Tolerance) -> None:
+    """The small path's part: the reference hull, the outline copied, the arrays as before."""
+    try:
+        part = Part.from_points(pts, tol=tol)
+    except PartError:
+        ref = None if np.max(np.abs(pts)) > 1e150 else reference(pts, tol)
+        assert ref is None or np.ptp(pts, axis=0).max() < 1e-150
+        return
+    hull = part.hull
+    ref = reference(pts, tol)
+    assert ref is not None
+    xs, ys = hull._coords()
+    assert hexes(xs, ys, hull.area, *hull.centroid.tolist(), hull.size) == ref[0]
+    assert hull.tol is tol
+    eager = ConvexPolygon._trusted(
+        np.array([xs, ys]).T.copy(), tol, hull.area, np.array(hull.centroid), hull.size
+    )
+    for lazy, made in ((hull.vertices, eager.vertices), (hull.centroid, eager.centroid)):
+        assert lazy.dtype == np.float64 and lazy.shape == made.shape
+        assert lazy.flags.c_contiguous and lazy.flags.owndata and not lazy.flags.writeable
+        assert_array_equal(lazy, made)
+    assert hull.n_sides == len(hull.vertices) == len(xs)
+    assert_array_equal(part.outline, pts)
+    assert part.outline is not pts and not part.outline.flags.writeable
+    assert_array_equal(part.center_of_mass, hull.centroid)
+    assert not part.center_of_mass.flags.writeable
+    assert polygon._holds_centroid(hull) == polygon.hull_contains(hull, hull.centroid)
+
+
+def test_lists_and_arrays_give_the_same_part() -> None:
+    pts = np.random.default_rng(4).uniform(size=(10, 2))
+    a, b = Part.from_points(pts, name="p"), Part.from_points(pts.tolist(), name="p")
+    for x, y in ((a.hull.vertices, b.hull.vertices), (a.center_of_mass, b.center_of_mass)):
+        assert x.tobytes() == y.tobytes()
+    assert (a.hull.area, a.hull.size) == (b.hull.area, b.hull.size)
+    assert dataclasses.astuple(a)[0] == "p" and type(a) is Part
+
+
+# --------------------------------------------------------------------------- lazy arrays
+
+
+def test_lazy_arrays_are_made_once_read_only_and_frozen() -> None:
+    hull = ConvexPolygon.from_points(np.random.default_rng(5).uniform(size=(10, 2)))
+    assert hull._v is None and hull._c is None  # nothing asked for yet
+    assert hull.n_sides == 6 and hull._v is None
+    v, c = hull.vertices, hull.centroid
+    assert hull.vertices is v and hull.centroid is c
+    for arr in (v, c):
+        with pytest.raises(ValueError, match="read-only"):
+            arr[0] = 1.0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        hull.area = 1.0  # type: ignore[misc]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        del hull.size
+    assert list(hull._coords()) == v.T.tolist()
+    assert hull._centroid_xy() == tuple(c.tolist())
+
+
+def test_polygon_pickles_and_prints_as_before() -> None:
+    hull = Part.from_points(np.random.default_rng(6).uniform(size=(10, 2))).hull
+    back = pickle.loads(pickle.dumps(hull))
+    assert back.vertices.tobytes() == hull.vertices.tobytes() and back.tol == hull.tol
+    assert (back.area, back.size, back.centroid.tolist()) == (
+        hull.area,
+        hull.size,
+        hull.centroid.tolist(),
+    )
+    assert not back.vertices.flags.writeable and back.symmetry_order == hull.symmetry_order
+    assert repr(hull) == (
+        f"ConvexPolygon(vertices={hull.vertices!r}, tol={hull.tol!r}, area={hull.area!r}, "
+        f"centroid={hull.centroid!r}, size={hull.size!r})"
+    )
+    built = ConvexPolygon(hull.vertices, hull.tol)  # the checking constructor
+    assert_array_equal(built.vertices, hull.vertices)
+    assert built.vertices is not hull.vertices
+    assert ConvexPolygon(vertices=hull.vertices).tol is DEFAULT_TOLERANCE
