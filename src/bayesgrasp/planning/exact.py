@@ -37,16 +37,26 @@ Python lists end to end (one action type: :func:`_plan_one_small`; the angles of
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Callable
 from typing import Literal
 
+from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..model.cost import CostModel
-from ..model.prior import Prior
+from ..model.prior import Prior, UniformPrior
 from ..model.problem import Problem
 from . import arcs
-from .arcs import ArcPlanner, Counts, Scored
-from .result import COST_RTOL, PlanResult, choose_among, max_plan_length, new_result
+from .arcs import _ROUNDING, _SPAN_SLACK, ArcPlanner, Counts, Scored
+from .result import (
+    COST_RTOL,
+    PlanResult,
+    choose_among,
+    max_plan_length,
+    new_option,
+    new_result,
+    repeated_turns,
+)
 
 __all__ = ["Report", "plan_exact"]
 
@@ -137,55 +147,95 @@ def plan_exact(
     return PlanResult(problem, tuple(planner.plan_options(options)), bayes, most, "exact")
 
 
+_Stair = tuple[list[int], list[float], list[float], list[float]]
+"""A staircase of :func:`_plan_one_small`: front index, rest, width and ``c`` of each entry."""
+
 # Scored (arcs.py): (p, cost, action types, width) of the best plan of a length; angles last.
 
 
 def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -> PlanResult:
     """:func:`plan_exact` for one action type of at most :data:`~bayesgrasp.sizes.SMALL` states.
 
-    The same steps on plain lists, without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`:
-    the front (its plain-Python path); the widths ``W_k`` of each length, which for one
-    action type are one sequence, ``W_1`` the widest single basin and ``W_k`` the front's
-    widest under ``W_{k-1}`` less twice the margin
-    (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the search
-    to the first length that reaches its probability, as :func:`_search` does with one
-    type); the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right);
-    and the angles on the front's lists (:func:`~bayesgrasp.planning.arcs.small_options`).
-    The same plans, bit for bit (the tests run both).
+    The same steps on plain lists, without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`
+    nor any :class:`~bayesgrasp.planning.arcs.ArcFront`, staircase or arc object, and the
+    same plans, bit for bit (the tests run both):
+
+    - the front (:class:`~bayesgrasp.planning.arcs.SpanFront`), taken in order of span only
+      as far as the widths and the staircases below ask;
+    - the widths ``W_k`` of each length, which for one action type are one sequence: ``W_1``
+      the widest single basin, ``W_k`` the front's widest under ``W_{k-1}`` less twice the
+      margin (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the
+      search to the first length that reaches its probability, as :func:`_search` does with
+      one type); they ask for arcs of spans below ``cap - 2 max(tol, accuracy)`` only
+      (``W < cap`` before each step);
+    - the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right), and the
+      Bayes and the most certain plans (:func:`_choose`);
+    - the angles of the reported plans (:meth:`~bayesgrasp.planning.arcs.ArcPlanner.witnesses`,
+      :meth:`~bayesgrasp.planning.arcs.Staircase.pick` and
+      :func:`~bayesgrasp.planning.arcs.chain_option`, as
+      :func:`~bayesgrasp.planning.arcs.small_options` runs them for any action set): the
+      staircase of the last ``m`` actions, ``m = 1, 2, ..`` (for one action type it depends
+      on ``m`` only), and its ``tau`` at the front's arcs, up to the longest reported plan.
+
+    Only the front's arcs that can have a finite ``tau`` are visited. Let ``T`` be
+    ``max(tol, accuracy - _ROUNDING)`` (``tau`` is ``-inf`` unless above ``tol`` and at least
+    ``accuracy - _ROUNDING``) and ``Wmax`` the widest entry of a staircase. Every entry's
+    rest is at least ``T`` (or ``inf``), so an entry ``r`` with ``c_r = w_r - 2 rest_r >= x``
+    needs ``x <= Wmax - 2 T`` up to a rounding; hence for ``x >= Wmax - 2 T + slack`` the
+    first entry with ``c >= x`` is past the last, and ``tau(x) = (Wmax - x) / 2 < T`` (less
+    a rounding) is ``-inf``. Those arcs join no staircase and are never a first witness, so
+    their ``tau`` is not computed; the front is covered up to that bound. The last action's
+    staircase is its widest single basin, front arc 0 (span 0, rest ``inf``): its ``tau``
+    is ``(W_0 - x) / 2`` where it passes, which only falls with ``x`` (so the first ``-inf``
+    ends it), and it picks arc 0 for every span.
     """
     (action,) = problem.actions
     kind = action.name
     f = problem.transfers[kind]
     tol = problem.states.angle_tol
     group = problem.goal_group
-    cap = arcs.period_cap(problem)  # ArcPlanner.period
-    front = arcs.arc_front(f, f.period + tol)  # ArcPlanner.max_span
-    spans, widths = front.span_list, front.width_list
+    accuracy = problem.accuracy
+    cap = TWO_PI / group  # arcs.period_cap for one action type
+    if f.period < cap:
+        cap = f.period
+    margin2 = 2.0 * (tol if tol >= accuracy else accuracy)  # max(tol, accuracy)
+    floor = accuracy - _ROUNDING  # Staircase.tau: margins from accuracy (less the rounding)
+    low = tol if tol >= floor else floor  # T: every finite tau is at least this
+    stable, lo, hi = f.values
+    # ArcPlanner.max_span; the widths ask for spans below cap - margin2 <= cap - 2 T only.
+    front = arcs.SpanFront(stable, lo, hi, f.period + tol, cap - 2.0 * low + 2.0 * _SPAN_SLACK)
+    spans, widths, rows = front.spans, front.widths, front.rows
+    cover = front.cover
     left = bisect.bisect_left
-    margin2 = 2.0 * (tol if tol >= problem.accuracy else problem.accuracy)  # max(tol, accuracy)
     limit_hard = max_plan_length(problem)
     prior, cost = problem.prior, problem.cost
+    uniform = type(prior) is UniformPrior  # its max_arc_mass: group * length / (2 pi)
 
+    cover(tol)
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
     width = grown[0]
     for _ in range(limit_hard - 1):  # widest_reachable
         if width >= cap:
             break
-        n = left(spans, width - margin2) - 1
+        bound = width - margin2
+        cover(bound)
+        n = left(spans, bound) - 1
         wider = widths[n] if n >= 0 else 0.0
         grown.append(wider)
         if wider <= width + tol:
             break
         width = wider
     # The prior mass of the success arc, placed best (capped at the period; memoised).
-    masses = {}
+    masses: dict[float, float] = {}
     x = width if width <= cap else cap  # min(width, cap)
-    p_best = masses[x] = prior.max_arc_mass(x, group)[0]
+    if uniform:
+        p_best = group * x / TWO_PI
+    else:
+        p_best = masses[x] = prior.max_arc_mass(x, group)[0]
     p_tol = problem.part.hull.tol.probability
     step = cost.action_cost(kind)
     run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
-    options: list[Scored] = []
     costs: list[float] = []
     probs: list[float] = []
     k = 0
@@ -194,27 +244,135 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         if k > 1:
             run = run + step
         if k > len(grown):  # pragma: no cover - the widths reach p_best within `grown`
-            n = left(spans, grown[-1] - margin2) - 1
+            bound = grown[-1] - margin2
+            cover(bound)
+            n = left(spans, bound) - 1
             grown.append(widths[n] if n >= 0 else 0.0)
         width = grown[k - 1]
         x = width if width <= cap else cap
-        p = masses.get(x)
-        if p is None:
-            p = masses[x] = prior.max_arc_mass(x, group)[0]
-        c = cost.expected_from_attempt(cost.verify + run, p)
-        options.append((p, c, (kind,) * k, width))
-        costs.append(c)
+        if uniform:
+            p = group * x / TWO_PI
+        else:
+            known = masses.get(x)
+            p = masses[x] = prior.max_arc_mass(x, group)[0] if known is None else known
+        costs.append(cost.expected_from_attempt(cost.verify + run, p))
         probs.append(p)
         if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
             break
         if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
             raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
-    options, bayes, most = _choose(options, p_tol, report, costs, probs)
-    if k * len(front) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
-        plans = ArcPlanner.for_problem(problem).plan_options(options)
+    bayes, most = choose_among(costs, probs, p_tol)
+    if report == "best":  # as PlanResult.best_only, before the angles are computed
+        keep = [bayes] if bayes == most else sorted((bayes, most))
+        bayes, most = keep.index(bayes), keep.index(most)
     else:
-        plans = arcs.small_options(problem, {kind: front}, tol, options)
-    return new_result(problem, tuple(plans), bayes, most, "exact")
+        keep = list(range(k))
+    longest = keep[-1] + 1
+    if longest * len(widths) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
+        options = [(probs[n], costs[n], (kind,) * (n + 1), grown[n]) for n in keep]
+        plans = ArcPlanner.for_problem(problem).plan_options(options)
+        return new_result(problem, tuple(plans), bayes, most, "exact")
+
+    # The staircases of the last m = 1, 2, .. actions (front index, rest, width, c) and
+    # their tau at the front's arcs (as far as finite; -inf after).
+    inf = math.inf
+    w0 = widths[0]
+    cover(w0 - 2.0 * low + _SPAN_SLACK)
+    tau = []
+    for x in spans:  # the last action's staircase: (W_0 - x) / 2, falling with x
+        v = 0.5 * (w0 - x)
+        if v > tol and v >= floor:
+            tau.append(v)
+        else:
+            break
+    taus = [[], tau]  # by m (none for m = 0)
+    stairs: list[_Stair] = [([], [], [], []), ([0], [inf], [w0], [-inf])]  # arcs.staircase
+    for _ in range(2, longest):
+        # The staircase of m actions from the tau of m - 1 (arcs.staircase: every arc whose
+        # rest exceeds the rest of each wider arc, one scan from the widest down; no rest
+        # is finite and below tol).
+        idx: list[int] = []
+        rest: list[float] = []
+        best = -inf
+        for n in range(len(tau) - 1, -1, -1):
+            v = tau[n]
+            if v > best:
+                best = v
+                idx.append(n)
+                rest.append(v)
+        idx.reverse()
+        rest.reverse()
+        wid: list[float] = []
+        c: list[float] = []
+        for n, r in zip(idx, rest, strict=True):
+            w = widths[n]
+            wid.append(w)
+            c.append(w - 2.0 * r)
+        stairs.append((idx, rest, wid, c))
+        tau = []
+        if wid:
+            bound = wid[-1] - 2.0 * low + _SPAN_SLACK
+            cover(bound)
+            top = len(c)
+            for x in spans[: left(spans, bound)]:  # Staircase.tau
+                r = left(c, x)
+                at = rest[r] if r < top else -inf
+                before = 0.5 * (wid[r - 1] - x) if r > 0 else -inf
+                value = at if at >= before else before
+                tau.append(value if value > tol and value >= floor else -inf)
+        taus.append(tau)
+
+    out = []
+    for n in keep:
+        length = grown[n]
+        kk = n + 1
+        at = left(widths, length - tol)  # the arcs at..end are wide enough
+        if kk == 1:  # a single basin
+            tolerance = None
+            while spans[at] > 0.0:
+                at += 1
+        else:
+            vals = taus[kk - 1]
+            best = -inf
+            for m in range(at, len(vals)):
+                if vals[m] > best:
+                    best = vals[m]
+            if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
+                raise PlanningError("internal error: no witness chain for a plan the lengths allow")
+            while vals[at] < best - tol:
+                at += 1
+            tolerance = best
+        # chain_option, witness by witness: the first placed by the prior, each later one
+        # picked by its staircase for the span of the one before (Arc.span: s_last - s),
+        # the turn centring that image in it.
+        i = rows[at]
+        a = lo[i]
+        if uniform:
+            start = a
+        else:
+            start = prior.max_arc_mass(length if length < cap else cap, group, prefer=a)[1]
+        angles = [start - a]
+        arc = (a + widths[at]) - a  # Arc.width
+        for m in range(kk - 1, 0, -1):
+            s = stable[i]
+            s_last = s + spans[at]
+            if m == 1:
+                at = 0  # the last action's staircase picks arc 0
+            else:
+                idx, rest, wid, c = stairs[m]
+                x = s_last - s
+                r = left(c, x)
+                at_r = rest[r] if r < len(c) else -inf
+                before = 0.5 * (wid[r - 1] - x) if r > 0 else -inf
+                at = idx[r if at_r >= before else r - 1]
+            i = rows[at]
+            a = lo[i]
+            angles.append(0.5 * (s + s_last) - 0.5 * (a + (a + widths[at])))
+        steps, turned = repeated_turns(action, angles)
+        final = math.fmod(stable[i] + turned + TWO_PI, TWO_PI)
+        cost_n = costs[n]
+        out.append(new_option(steps, final, probs[n], cost_n, tolerance, (start, start + arc)))
+    return new_result(problem, tuple(out), bayes, most, "exact")
 
 
 def _choose(

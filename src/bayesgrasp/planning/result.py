@@ -47,6 +47,7 @@ __all__ = [
     "new_option",
     "new_result",
     "plan_actions",
+    "repeated_turns",
     "short_turns",
 ]
 
@@ -425,6 +426,38 @@ def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[lis
         _set_alpha(step, short)
         steps.append(step)
     return steps, carry
+
+
+def repeated_turns(action: Action, angles: Sequence[float]) -> tuple[tuple[PlanStep, ...], float]:
+    """:func:`short_turns` of a plan whose every step is ``action`` (the steps as a tuple).
+
+    The same steps and carry, bit for bit, with the action's period and name read once.
+
+    Examples
+    --------
+    >>> import math
+    >>> from bayesgrasp.model.actions import SQUEEZE
+    >>> steps, carry = repeated_turns(SQUEEZE, [math.radians(100), 0.0])
+    >>> [round(math.degrees(s.alpha), 6) for s in steps], round(math.degrees(carry), 6)
+    ([-80.0, 0.0], 180.0)
+    """
+    steps = []
+    carry = 0.0
+    remainder, pi = math.remainder, math.pi
+    g = action.gripper_period
+    half = g / 2.0
+    name = action.name
+    for angle in angles:
+        r = remainder(angle + carry, TWO_PI)
+        a = pi if r == -pi else r
+        r = remainder(a, g)
+        short = half if r == -half else r
+        carry = a - short
+        step = _new(PlanStep)
+        _set_kind(step, name)
+        _set_alpha(step, short)
+        steps.append(step)
+    return tuple(steps), carry
 
 
 # The planners make thousands of steps, options and results a second; a frozen dataclass's
