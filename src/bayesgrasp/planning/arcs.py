@@ -90,6 +90,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
+import operator
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -337,6 +338,8 @@ def _front_lists(
     return front.spans, front.widths, firsts, los
 
 
+_span_of = operator.itemgetter(0)
+
 # Slack of the span bounds of SpanFront (and of the fused planner's staircases): far above
 # the rounding of sums and differences of angles below 4 pi (a few ulps, about 1e-15).
 _SPAN_SLACK = 1e-12
@@ -353,12 +356,14 @@ class SpanFront:
     first basin). In the order that costs least on Python floats:
 
     - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
-    - the arcs of two or more basins sorted as ``(span, width, i)``: the stable sort by span,
-      except that arcs of one span come by width (then first basin), which leaves the same
-      arc of each span on the front. A prefix of that order gives the front's arcs of
-      spans below the first span not taken (later arcs span more, so they can neither
-      join the front below it nor replace an arc there): :meth:`cover` takes the arcs one
-      by one, only as far as asked.
+    - the arcs of two or more basins by a stable sort on the span alone, in the order
+      ``(i, j)`` (a sort on floats: tuples compare several times slower). Of the arcs of one
+      span the front keeps the widest, and of those the first, the least ``i`` (one row
+      has one arc of each span and width): the same arc as the order ``(span, width, i)``
+      keeps, which the second batch below uses. A prefix of either order gives the front's
+      arcs of spans below the first span not taken (later arcs span more, so they can
+      neither join the front below it nor replace an arc there): :meth:`cover` takes the
+      arcs one by one, only as far as asked.
     - The arcs are enumerated in two batches: first those of each row ``i`` whose last
       stable orientation lies below ``s_i + first`` (``first``, at most ``max_span``), then,
       only if a bound above ``first - _SPAN_SLACK`` is asked, the rest (sorted in with the
@@ -418,7 +423,7 @@ class SpanFront:
             # Arcs (i, j), i < j < i + K: the image spans less than `first` (of max_span).
             for j in range(i + 1, left(s2, si + first, i + 1, i + k)):
                 add((s2[j] - si, hi2[j] - li, i))
-        cand.sort()
+        cand.sort(key=_span_of)
         self.stable, self.lo, self.max_span = stable, lo, max_span
         self._s2, self._hi2, self._first = s2, hi2, first
         self._cand, self._pos = cand, 0
@@ -450,7 +455,11 @@ class SpanFront:
         self.covered = bound
 
     def _second_batch(self) -> None:
-        """The arcs of spans from ``first`` to ``max_span``, sorted in with those not taken."""
+        """The arcs of spans from ``first`` to ``max_span``, sorted in with those not taken.
+
+        By ``(span, width, i)``: arcs of one span from both batches are then in an order
+        that keeps the same arc of each span (the class notes).
+        """
         stable, lo, s2, hi2 = self.stable, self.lo, self._s2, self._hi2
         k = len(stable)
         left = bisect.bisect_left

@@ -273,73 +273,80 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         plans = ArcPlanner.for_problem(problem).plan_options(options)
         return new_result(problem, tuple(plans), bayes, most, "exact")
 
-    # The staircases of the last m = 1, 2, .. actions (front index, rest, width, c) and
-    # their tau at the front's arcs (as far as finite; -inf after).
+    # The staircases of the last m = 1, 2, .. actions and their tau at the front's arcs (as
+    # far as it is finite; -inf after). A staircase is its entries' front index, rest
+    # (then -inf), width (after -inf) and c: rest[r] and 0.5 * (width[r] - x) are then
+    # Staircase.tau's rest[r] (-inf past the last) and 0.5 * (width[r - 1] - x) (-inf
+    # before the first). "v > tol and v >= floor" is v >= passing.
     inf = math.inf
+    passing = math.nextafter(tol, inf)
+    if floor > passing:
+        passing = floor
     w0 = widths[0]
     cover(w0 - 2.0 * low + _SPAN_SLACK)
     tau = []
     for x in spans:  # the last action's staircase: (W_0 - x) / 2, falling with x
         v = 0.5 * (w0 - x)
-        if v > tol and v >= floor:
+        if v >= passing:
             tau.append(v)
         else:
             break
     taus = [[], tau]  # by m (none for m = 0)
-    stairs: list[_Stair] = [([], [], [], []), ([0], [inf], [w0], [-inf])]  # arcs.staircase
+    stairs: list[_Stair] = [([], [], [], []), ([0], [inf, -inf], [-inf, w0], [-inf])]
     for _ in range(2, longest):
         # The staircase of m actions from the tau of m - 1 (arcs.staircase: every arc whose
-        # rest exceeds the rest of each wider arc, one scan from the widest down; no rest
-        # is finite and below tol).
+        # rest exceeds the rest of each wider arc, one scan from the widest down; a finite
+        # tau is above tol), then its tau.
         idx: list[int] = []
-        rest: list[float] = []
+        rest = [-inf]
+        wid: list[float] = []
+        c: list[float] = []
         best = -inf
         for n in range(len(tau) - 1, -1, -1):
             v = tau[n]
             if v > best:
                 best = v
+                w = widths[n]
                 idx.append(n)
                 rest.append(v)
+                wid.append(w)
+                c.append(w - 2.0 * v)
+        wid.append(-inf)
         idx.reverse()
         rest.reverse()
-        wid: list[float] = []
-        c: list[float] = []
-        for n, r in zip(idx, rest, strict=True):
-            w = widths[n]
-            wid.append(w)
-            c.append(w - 2.0 * r)
+        wid.reverse()
+        c.reverse()
         stairs.append((idx, rest, wid, c))
         tau = []
-        if wid:
+        if c:
             bound = wid[-1] - 2.0 * low + _SPAN_SLACK
             cover(bound)
-            top = len(c)
             for x in spans[: left(spans, bound)]:  # Staircase.tau
                 r = left(c, x)
-                at = rest[r] if r < top else -inf
-                before = 0.5 * (wid[r - 1] - x) if r > 0 else -inf
+                at = rest[r]
+                before = 0.5 * (wid[r] - x)
                 value = at if at >= before else before
-                tau.append(value if value > tol and value >= floor else -inf)
+                tau.append(value if value >= passing else -inf)
         taus.append(tau)
 
     out = []
     for n in keep:
         length = grown[n]
-        kk = n + 1
         at = left(widths, length - tol)  # the arcs at..end are wide enough
-        if kk == 1:  # a single basin
+        if n == 0:  # one action: a single basin
             tolerance = None
             while spans[at] > 0.0:
                 at += 1
         else:
-            vals = taus[kk - 1]
+            vals = taus[n]
             best = -inf
-            for m in range(at, len(vals)):
-                if vals[m] > best:
-                    best = vals[m]
+            for v in vals[at:]:
+                if v > best:
+                    best = v
             if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
                 raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-            while vals[at] < best - tol:
+            best_tol = best - tol
+            while vals[at] < best_tol:
                 at += 1
             tolerance = best
         # chain_option, witness by witness: the first placed by the prior, each later one
@@ -353,7 +360,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             start = prior.max_arc_mass(length if length < cap else cap, group, prefer=a)[1]
         angles = [start - a]
         arc = (a + widths[at]) - a  # Arc.width
-        for m in range(kk - 1, 0, -1):
+        for m in range(n, 0, -1):
             s = stable[i]
             s_last = s + spans[at]
             if m == 1:
@@ -362,16 +369,13 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
                 idx, rest, wid, c = stairs[m]
                 x = s_last - s
                 r = left(c, x)
-                at_r = rest[r] if r < len(c) else -inf
-                before = 0.5 * (wid[r - 1] - x) if r > 0 else -inf
-                at = idx[r if at_r >= before else r - 1]
+                at = idx[r if rest[r] >= 0.5 * (wid[r] - x) else r - 1]
             i = rows[at]
             a = lo[i]
             angles.append(0.5 * (s + s_last) - 0.5 * (a + (a + widths[at])))
         steps, turned = repeated_turns(action, angles)
         final = math.fmod(stable[i] + turned + TWO_PI, TWO_PI)
-        cost_n = costs[n]
-        out.append(new_option(steps, final, probs[n], cost_n, tolerance, (start, start + arc)))
+        out.append(new_option(steps, final, probs[n], costs[n], tolerance, (start, start + arc)))
     return new_result(problem, tuple(out), bayes, most, "exact")
 
 
