@@ -312,21 +312,6 @@ def test_span_front_is_a_prefix_of_the_enumerated_front(
         assert [lo[i] for i in front.rows] == slow.lo_list[:n]
 
 
-def test_repeated_turns_are_short_turns() -> None:
-    """The turns of a plan of one action, bit for bit those of short_turns, edges too."""
-    from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
-    from bayesgrasp.planning.result import repeated_turns, short_turns
-
-    edges = [q * math.pi / 2 + e for q in range(-9, 10) for e in (0.0, 1e-15, -1e-15, 1e-9)]
-    angles = edges + np.random.default_rng(6).uniform(-20.0, 20.0, 200).tolist()
-    for action in (SQUEEZE, PUSH_GRASP):
-        steps, carry = repeated_turns(action, angles)
-        ref, ref_carry = short_turns([action] * len(angles), angles)
-        assert type(steps) is tuple
-        assert [(s.kind, s.alpha.hex()) for s in steps] == [(s.kind, s.alpha.hex()) for s in ref]
-        assert carry.hex() == ref_carry.hex()
-
-
 def test_fast_constructors_make_the_same_objects() -> None:
     """The planners' fast constructors set every field as the dataclasses' own do."""
     from bayesgrasp.model.actions import SQUEEZE

@@ -46,16 +46,16 @@ from ..errors import PlanningError
 from ..model.cost import CostModel
 from ..model.prior import Prior, UniformPrior
 from ..model.problem import Problem
-from . import arcs
+from . import arcs, result
 from .arcs import _ROUNDING, _SPAN_SLACK, ArcPlanner, Counts, Scored
 from .result import (
     COST_RTOL,
     PlanResult,
+    PlanStep,
     choose_among,
     max_plan_length,
     new_option,
     new_result,
-    repeated_turns,
 )
 
 __all__ = ["Report", "plan_exact"]
@@ -319,16 +319,22 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         stairs.append((idx, rest, wid, c))
         tau = []
         if c:
-            bound = wid[-1] - 2.0 * low + _SPAN_SLACK
-            cover(bound)
-            for x in spans[: left(spans, bound)]:  # Staircase.tau
+            cover(wid[-1] - 2.0 * low + _SPAN_SLACK)
+            for x in spans:  # Staircase.tau, as far as it passes
                 r = left(c, x)
                 at = rest[r]
                 before = 0.5 * (wid[r] - x)
                 value = at if at >= before else before
-                tau.append(value if value >= passing else -inf)
+                if value >= passing:
+                    tau.append(value)
+                else:
+                    break
         taus.append(tau)
 
+    remainder, pi = math.remainder, math.pi
+    g = action.gripper_period
+    half = g / 2.0
+    new_step, set_kind, set_alpha = result.new_step_setters()
     out = []
     for n in keep:
         length = grown[n]
@@ -337,30 +343,40 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             tolerance = None
             while spans[at] > 0.0:
                 at += 1
-        else:
+        else:  # the best tau of the arcs at..end (and the first within tol of it): at's
             vals = taus[n]
-            best = -inf
-            for v in vals[at:]:
-                if v > best:
-                    best = v
-            if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
+            if at >= len(vals):  # pragma: no cover - the lengths guarantee a chain
                 raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-            best_tol = best - tol
-            while vals[at] < best_tol:
-                at += 1
-            tolerance = best
+            tolerance = vals[at]
         # chain_option, witness by witness: the first placed by the prior, each later one
         # picked by its staircase for the span of the one before (Arc.span: s_last - s),
-        # the turn centring that image in it.
+        # the turn centring that image in it; each turn made short as short_turns makes
+        # it (wrap, then wrap_period of the gripper's period, the rest carried on).
         i = rows[at]
         a = lo[i]
         if uniform:
             start = a
         else:
             start = prior.max_arc_mass(length if length < cap else cap, group, prefer=a)[1]
-        angles = [start - a]
         arc = (a + widths[at]) - a  # Arc.width
-        for m in range(n, 0, -1):
+        angle = start - a
+        carry = 0.0
+        steps = []
+        m = n
+        while True:
+            wrapped = remainder(angle + carry, TWO_PI)
+            if wrapped == -pi:
+                wrapped = pi
+            short = remainder(wrapped, g)
+            if short == -half:
+                short = half
+            carry = wrapped - short
+            made = new_step(PlanStep)
+            set_kind(made, kind)
+            set_alpha(made, short)
+            steps.append(made)
+            if m == 0:
+                break
             s = stable[i]
             s_last = s + spans[at]
             if m == 1:
@@ -372,10 +388,11 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
                 at = idx[r if rest[r] >= 0.5 * (wid[r] - x) else r - 1]
             i = rows[at]
             a = lo[i]
-            angles.append(0.5 * (s + s_last) - 0.5 * (a + (a + widths[at])))
-        steps, turned = repeated_turns(action, angles)
-        final = math.fmod(stable[i] + turned + TWO_PI, TWO_PI)
-        out.append(new_option(steps, final, probs[n], costs[n], tolerance, (start, start + arc)))
+            angle = 0.5 * (s + s_last) - 0.5 * (a + (a + widths[at]))
+            m -= 1
+        final = math.fmod(stable[i] + carry + TWO_PI, TWO_PI)
+        steps_ = tuple(steps)
+        out.append(new_option(steps_, final, probs[n], costs[n], tolerance, (start, start + arc)))
     return new_result(problem, tuple(out), bayes, most, "exact")
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol, runtime_checkable
 
@@ -47,7 +47,6 @@ __all__ = [
     "new_option",
     "new_result",
     "plan_actions",
-    "repeated_turns",
     "short_turns",
 ]
 
@@ -330,29 +329,24 @@ def choose_among(
     """
     if not costs:
         raise ValueError("no plans to choose among")
-    # Loops, not min/max and generators: the exact planner calls this for every part.
-    cost = []
+    # Loops, not min/max and generators: the exact planner calls this for every part. The
+    # values are floats (or numpy's, which compare and subtract as floats do).
     m = math.inf
-    for x in costs:
-        c = float(x)
-        cost.append(c)
+    for c in costs:
         if c < m:
             m = c
     bayes = 0
     if math.isfinite(m):
         slack = COST_RTOL * abs(m)
-        while cost[bayes] - m > slack:
+        while costs[bayes] - m > slack:
             bayes += 1
-    prob = []
     top = -math.inf
-    for x in probs:
-        q = float(x)
-        prob.append(q)
+    for q in probs:
         if q > top:
             top = q
     top -= tol
     most = 0
-    while not prob[most] >= top:
+    while not probs[most] >= top:
         most += 1
     return bayes, most
 
@@ -428,38 +422,6 @@ def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[lis
     return steps, carry
 
 
-def repeated_turns(action: Action, angles: Sequence[float]) -> tuple[tuple[PlanStep, ...], float]:
-    """:func:`short_turns` of a plan whose every step is ``action`` (the steps as a tuple).
-
-    The same steps and carry, bit for bit, with the action's period and name read once.
-
-    Examples
-    --------
-    >>> import math
-    >>> from bayesgrasp.model.actions import SQUEEZE
-    >>> steps, carry = repeated_turns(SQUEEZE, [math.radians(100), 0.0])
-    >>> [round(math.degrees(s.alpha), 6) for s in steps], round(math.degrees(carry), 6)
-    ([-80.0, 0.0], 180.0)
-    """
-    steps = []
-    carry = 0.0
-    remainder, pi = math.remainder, math.pi
-    g = action.gripper_period
-    half = g / 2.0
-    name = action.name
-    for angle in angles:
-        r = remainder(angle + carry, TWO_PI)
-        a = pi if r == -pi else r
-        r = remainder(a, g)
-        short = half if r == -half else r
-        carry = a - short
-        step = _new(PlanStep)
-        _set_kind(step, name)
-        _set_alpha(step, short)
-        steps.append(step)
-    return tuple(steps), carry
-
-
 # The planners make thousands of steps, options and results a second; a frozen dataclass's
 # __init__ sets each field through object.__setattr__, about twice the cost of setting its
 # slots directly. short_turns, new_option and new_result make the same objects (none of the
@@ -468,6 +430,18 @@ def repeated_turns(action: Action, angles: Sequence[float]) -> tuple[tuple[PlanS
 _new = object.__new__
 _set_kind, _set_alpha = (vars(PlanStep)[name].__set__ for name in ("kind", "alpha"))
 _set_option = [vars(PlanOption)[name].__set__ for name in PlanOption.__slots__]
+
+
+def new_step_setters() -> tuple[
+    Callable[[type[PlanStep]], PlanStep],
+    Callable[[PlanStep, str], None],
+    Callable[[PlanStep, float], None],
+]:
+    """``object.__new__`` and the setters of :class:`PlanStep`'s ``kind`` and ``alpha`` slots.
+
+    For a planner that makes steps in its own loop (as :func:`short_turns` does).
+    """
+    return _new, _set_kind, _set_alpha
 
 
 def new_option(
@@ -502,10 +476,15 @@ def new_result(
 ) -> PlanResult:
     """``PlanResult(problem, options, bayes, most_certain, method)``, made faster."""
     out = _new(PlanResult)
-    for setter, value in zip(
-        _set_result, (problem, options, bayes, most_certain, method, None, "ok", None), strict=True
-    ):
-        setter(out, value)
+    a, b, c, d, e, f, g, h = _set_result
+    a(out, problem)
+    b(out, options)
+    c(out, bayes)
+    d(out, most_certain)
+    e(out, method)
+    f(out, None)
+    g(out, "ok")
+    h(out, None)
     return out
 
 
