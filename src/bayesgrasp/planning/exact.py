@@ -331,9 +331,10 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
                     break
         taus.append(tau)
 
-    remainder, pi = math.remainder, math.pi
+    remainder, pi, two_pi = math.remainder, math.pi, TWO_PI
     g = action.gripper_period
     half = g / 2.0
+    neg_pi, neg_half = -pi, -half
     new_step, set_kind, set_alpha = result.new_step_setters()
     out = []
     for n in keep:
@@ -364,13 +365,18 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         steps = []
         m = n
         while True:
-            wrapped = remainder(angle + carry, TWO_PI)
-            if wrapped == -pi:
-                wrapped = pi
-            short = remainder(wrapped, g)
-            if short == -half:
-                short = half
-            carry = wrapped - short
+            turn = angle + carry
+            if neg_half < turn < half:  # as short as it gets: wrap and wrap_period keep it
+                short = turn
+                carry = 0.0  # turn - turn
+            else:
+                wrapped = remainder(turn, two_pi)
+                if wrapped == neg_pi:
+                    wrapped = pi
+                short = remainder(wrapped, g)
+                if short == neg_half:
+                    short = half
+                carry = wrapped - short
             made = new_step(PlanStep)
             set_kind(made, kind)
             set_alpha(made, short)
@@ -390,7 +396,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             a = lo[i]
             angle = 0.5 * (s + s_last) - 0.5 * (a + (a + widths[at]))
             m -= 1
-        final = math.fmod(stable[i] + carry + TWO_PI, TWO_PI)
+        final = math.fmod(stable[i] + carry + two_pi, two_pi)
         steps_ = tuple(steps)
         out.append(new_option(steps_, final, probs[n], costs[n], tolerance, (start, start + arc)))
     return new_result(problem, tuple(out), bayes, most, "exact")
