@@ -410,6 +410,8 @@ class SpanFront:
         hi2 = [*hi, *map(add_turn, hi)]
         if first > max_span:
             first = max_span
+        if first > TWO_PI:  # then s2[i + k] >= s_i + first: the arcs below end before i + k
+            first = TWO_PI
         widest = -math.inf
         top = 0
         cand: list[tuple[float, float, int]] = []
@@ -421,7 +423,7 @@ class SpanFront:
             if w > widest:
                 widest, top = w, i
             # Arcs (i, j), i < j < i + K: the image spans less than `first` (of max_span).
-            for j in range(i + 1, left(s2, si + first, i + 1, i + k)):
+            for j in range(i + 1, left(s2, si + first)):
                 add((s2[j] - si, hi2[j] - li, i))
         cand.sort(key=_span_of)
         self.stable, self.lo, self.max_span = stable, lo, max_span

@@ -234,33 +234,32 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     else:
         p_best = masses[x] = prior.max_arc_mass(x, group)[0]
     p_tol = problem.part.hull.tol.probability
+    stop = p_best - p_tol
+    cut = limit_hard if max_actions is None else max_actions
     step = cost.action_cost(kind)
     run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
+    verify, retry = cost.verify, cost.retry
     costs: list[float] = []
     probs: list[float] = []
     k = 0
-    while True:
+    # The widths reach p_best within `grown` (p_best is the mass of one of them), and
+    # Goldberg 1993 bounds plans by O(n).
+    for width in grown:
         k += 1
-        if k > 1:
-            run = run + step
-        if k > len(grown):  # pragma: no cover - the widths reach p_best within `grown`
-            bound = grown[-1] - margin2
-            cover(bound)
-            n = left(spans, bound) - 1
-            grown.append(widths[n] if n >= 0 else 0.0)
-        width = grown[k - 1]
         x = width if width <= cap else cap
         if uniform:
             p = group * x / TWO_PI
         else:
             known = masses.get(x)
             p = masses[x] = prior.max_arc_mass(x, group)[0] if known is None else known
-        costs.append(cost.expected_from_attempt(cost.verify + run, p))
+        # CostModel.expected_from_attempt
+        costs.append((verify + run) / p + retry * (1.0 / p - 1.0) if p > 0.0 else math.inf)
         probs.append(p)
-        if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
+        if p >= stop or k >= cut:
             break
-        if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
-            raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
+        run = run + step
+    else:  # pragma: no cover - see above
+        raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
     bayes, most = choose_among(costs, probs, p_tol)
     if report == "best":  # as PlanResult.best_only, before the angles are computed
         keep = [bayes] if bayes == most else sorted((bayes, most))
@@ -283,7 +282,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     if floor > passing:
         passing = floor
     w0 = widths[0]
-    cover(w0 - 2.0 * low + _SPAN_SLACK)
+    bound = w0 - 2.0 * low + _SPAN_SLACK
+    if bound > front.covered:
+        cover(bound)
     tau = []
     for x in spans:  # the last action's staircase: (W_0 - x) / 2, falling with x
         v = 0.5 * (w0 - x)
@@ -319,7 +320,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         stairs.append((idx, rest, wid, c))
         tau = []
         if c:
-            cover(wid[-1] - 2.0 * low + _SPAN_SLACK)
+            bound = wid[-1] - 2.0 * low + _SPAN_SLACK
+            if bound > front.covered:
+                cover(bound)
             for x in spans:  # Staircase.tau, as far as it passes
                 r = left(c, x)
                 at = rest[r]
