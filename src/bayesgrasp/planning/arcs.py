@@ -444,14 +444,14 @@ class SpanFront:
         if end > pos:
             spans, widths, rows = self.spans, self.widths, self.rows
             best = widths[-1]
-            for x, w, i in cand[pos:end]:
-                if w > best:
-                    best = w
+            for arc in cand[pos:end]:
+                if arc[1] > best:
+                    x, best, i = arc
                     if spans[-1] == x:  # of equal spans only the widest stays
-                        widths[-1], rows[-1] = w, i
+                        widths[-1], rows[-1] = best, i
                     else:
                         spans.append(x)
-                        widths.append(w)
+                        widths.append(best)
                         rows.append(i)
             self._pos = end
         self.covered = bound

@@ -219,9 +219,12 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         if width >= cap:
             break
         bound = width - margin2
-        cover(bound)
-        n = left(spans, bound) - 1
-        wider = widths[n] if n >= 0 else 0.0
+        if bound > front.covered:  # (> tol >= 0) then the front holds just the arcs below
+            cover(bound)
+            wider = widths[-1]
+        else:
+            n = left(spans, bound) - 1
+            wider = widths[n] if n >= 0 else 0.0
         grown.append(wider)
         if wider <= width + tol:
             break
