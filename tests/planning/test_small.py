@@ -5,8 +5,10 @@ for bit (``float.hex``): plans, angles, final orientations, probabilities, costs
 tolerances, success arcs, the Bayes and most certain indices, every length's option:
 
 - *fused* (the default at most ``sizes.SMALL`` states): one action type without an
-  ``ArcPlanner``, staircases, witnesses and angles on the fronts' lists
-  (``arcs.small_options``);
+  ``ArcPlanner``, its front taken in order of span only as far as needed
+  (``arcs.SpanFront``; also with every arc left to its second batch), staircases,
+  witnesses and angles on lists (``exact._plan_one_small``; for several action types
+  ``arcs.small_options``);
 - *general* (``arcs.FUSED = False``): the ``ArcPlanner`` search with ``ArcFront`` and
   ``Staircase`` objects, still on plain-Python fronts and staircases;
 - *numpy* (``arcs.FUSED = False`` and ``arcs.SMALL = 0``): every front, staircase and pick

@@ -114,6 +114,7 @@ __all__ = [
     "ArcPlanner",
     "Counts",
     "Plans",
+    "SpanFront",
     "Staircase",
     "arc_front",
     "chain_option",

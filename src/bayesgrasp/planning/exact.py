@@ -30,8 +30,9 @@ Cost: O(K^2) once per action type for the front (K stable orientations; usually 
 arcs survive), then O(log K) per (count, type) for the lengths and O(F log F) per action of
 each reported plan for its witnesses (F arcs on the front). Parts whose every action has at
 most :data:`~bayesgrasp.sizes.SMALL` states (the seed's study: about 6) are planned on plain
-Python lists end to end (one action type: :func:`_plan_one_small`; the angles of any:
-:func:`~bayesgrasp.planning.arcs.small_options`), with the same plans bit for bit.
+Python lists end to end (one action type: :func:`_plan_one_small`, with exact prunings of
+the front and the staircases; the angles of any: :func:`~bayesgrasp.planning.arcs.small_options`),
+with the same plans bit for bit.
 """
 
 from __future__ import annotations
@@ -168,8 +169,10 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
       search to the first length that reaches its probability, as :func:`_search` does with
       one type); they ask for arcs of spans below ``cap - 2 max(tol, accuracy)`` only
       (``W < cap`` before each step);
-    - the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right), and the
-      Bayes and the most certain plans (:func:`_choose`);
+    - the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right), the
+      expected costs as :meth:`CostModel.expected_from_attempt` makes them, and the Bayes
+      and the most certain plans (:func:`~bayesgrasp.planning.result.choose_among`, as
+      :func:`_choose`);
     - the angles of the reported plans (:meth:`~bayesgrasp.planning.arcs.ArcPlanner.witnesses`,
       :meth:`~bayesgrasp.planning.arcs.Staircase.pick` and
       :func:`~bayesgrasp.planning.arcs.chain_option`, as
@@ -177,17 +180,33 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
       staircase of the last ``m`` actions, ``m = 1, 2, ..`` (for one action type it depends
       on ``m`` only), and its ``tau`` at the front's arcs, up to the longest reported plan.
 
-    Only the front's arcs that can have a finite ``tau`` are visited. Let ``T`` be
-    ``max(tol, accuracy - _ROUNDING)`` (``tau`` is ``-inf`` unless above ``tol`` and at least
-    ``accuracy - _ROUNDING``) and ``Wmax`` the widest entry of a staircase. Every entry's
-    rest is at least ``T`` (or ``inf``), so an entry ``r`` with ``c_r = w_r - 2 rest_r >= x``
-    needs ``x <= Wmax - 2 T`` up to a rounding; hence for ``x >= Wmax - 2 T + slack`` the
-    first entry with ``c >= x`` is past the last, and ``tau(x) = (Wmax - x) / 2 < T`` (less
-    a rounding) is ``-inf``. Those arcs join no staircase and are never a first witness, so
-    their ``tau`` is not computed; the front is covered up to that bound. The last action's
-    staircase is its widest single basin, front arc 0 (span 0, rest ``inf``): its ``tau``
-    is ``(W_0 - x) / 2`` where it passes, which only falls with ``x`` (so the first ``-inf``
-    ends it), and it picks arc 0 for every span.
+    Exact prunings (each keeps every float operation that decides a plan):
+
+    - *The front as far as asked.* Each width asks for the front's arcs of spans below its
+      bound, and each staircase for those below ``Wmax - 2 T + slack`` (next item);
+      :class:`~bayesgrasp.planning.arcs.SpanFront` takes its arcs in order of span up to
+      there and no further, the same arcs the whole front holds below that span.
+    - *tau where it can be finite.* Let ``T`` be ``max(tol, accuracy - _ROUNDING)``: a
+      ``tau`` is ``-inf`` unless above ``tol`` and at least ``accuracy - _ROUNDING``, so
+      every entry of a staircase has a rest of at least ``T`` (or ``inf``), and let
+      ``Wmax`` be its widest entry. An entry ``r`` with ``c_r = fl(w_r - 2 rest_r) >= x``
+      needs ``x <= Wmax - 2 T`` but for a rounding; so for ``x >= Wmax - 2 T + slack`` the
+      first entry with ``c >= x`` is past the last and ``tau(x) = (Wmax - x) / 2 < T``
+      (again but for a rounding, far below the slack) is ``-inf``.
+    - *tau only falls.* ``tau`` is non-increasing in ``x``, exactly in floats: for
+      ``x < x'`` with the same first entry ``r`` (``c_r >= x``) both terms fall (rounding
+      is monotone); with a later one ``r' > r``, ``rest_{r'} < rest_r`` and the entry
+      ``e = r' - 1 >= r`` has ``fl(w_e - 2 rest_e) < x'``, hence ``w_e - 2 rest_e < x'``
+      exactly (``x'`` is a float), ``fl(w_e - x') <= 2 rest_e`` and
+      ``0.5 fl(w_e - x') <= rest_e <= rest_r``. So along the front (spans increasing) the
+      first ``-inf`` ends the ``tau`` of a staircase; and the first witness of a plan of
+      ``k`` actions, the first arc whose ``tau`` is within ``tol`` of the best among the
+      arcs at least ``W_k - tol`` wide, is the first of those arcs.
+    - *The last action.* Its staircase is the widest single basin, front arc 0 (span 0,
+      rest ``inf``, ``c = -inf``): its ``tau`` is ``(W_0 - x) / 2`` where that passes, and
+      it picks arc 0 for every span.
+    - *The angles of the reported plans only* (``report="best"``: the Bayes and the most
+      certain), and the staircases up to the longest of them.
     """
     (action,) = problem.actions
     kind = action.name
