@@ -57,6 +57,7 @@ from .result import (
     max_plan_length,
     new_option,
     new_result,
+    short_turns,
 )
 
 __all__ = ["Report", "plan_exact"]
@@ -361,6 +362,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     half = g / 2.0
     neg_pi, neg_half = -pi, -half
     new_step, set_kind, set_alpha = result.new_step_setters()
+    zero = new_step(PlanStep)  # the first step of every plan under the uniform prior
+    set_kind(zero, kind)
+    set_alpha(zero, 0.0)
     out = []
     for n in keep:
         length = grown[n]
@@ -380,17 +384,28 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         # it (wrap, then wrap_period of the gripper's period, the rest carried on).
         i = rows[at]
         a = lo[i]
-        if uniform:
+        if uniform:  # the first turn, start - a, is a - a = +0.0: already short, carry 0.0
             start = a
+            steps = [zero]
+            carry = 0.0
         else:
             start = prior.max_arc_mass(length if length < cap else cap, group, prefer=a)[1]
+            steps, carry = short_turns((action,), (start - a,))
         arc = (a + widths[at]) - a  # Arc.width
-        angle = start - a
-        carry = 0.0
-        steps = []
         m = n
-        while True:
-            turn = angle + carry
+        while m:
+            s = stable[i]
+            s_last = s + spans[at]
+            if m == 1:
+                at = 0  # the last action's staircase picks arc 0
+            else:
+                idx, rest, wid, c = stairs[m]
+                x = s_last - s
+                r = left(c, x)
+                at = idx[r if rest[r] >= 0.5 * (wid[r] - x) else r - 1]
+            i = rows[at]
+            a = lo[i]
+            turn = 0.5 * (s + s_last) - 0.5 * (a + (a + widths[at])) + carry
             if neg_half < turn < half:  # as short as it gets: wrap and wrap_period keep it
                 short = turn
                 carry = 0.0  # turn - turn
@@ -406,20 +421,6 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             set_kind(made, kind)
             set_alpha(made, short)
             steps.append(made)
-            if m == 0:
-                break
-            s = stable[i]
-            s_last = s + spans[at]
-            if m == 1:
-                at = 0  # the last action's staircase picks arc 0
-            else:
-                idx, rest, wid, c = stairs[m]
-                x = s_last - s
-                r = left(c, x)
-                at = idx[r if rest[r] >= 0.5 * (wid[r] - x) else r - 1]
-            i = rows[at]
-            a = lo[i]
-            angle = 0.5 * (s + s_last) - 0.5 * (a + (a + widths[at]))
             m -= 1
         final = math.fmod(stable[i] + carry + two_pi, two_pi)
         steps_ = tuple(steps)
