@@ -299,7 +299,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     # far as it is finite; -inf after). A staircase is its entries' front index, rest
     # (then -inf), width (after -inf) and c: rest[r] and 0.5 * (width[r] - x) are then
     # Staircase.tau's rest[r] (-inf past the last) and 0.5 * (width[r - 1] - x) (-inf
-    # before the first). "v > tol and v >= floor" is v >= passing.
+    # before the first). "v > tol and v >= floor" is v >= passing. The tau of the longest
+    # plan's staircase is asked at one arc only (its first witness), so not made here.
+    last = longest - 1
     inf = math.inf
     passing = math.nextafter(tol, inf)
     if floor > passing:
@@ -309,7 +311,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     if bound > front.covered:
         cover(bound)
     tau = []
-    for x in spans:  # the last action's staircase: (W_0 - x) / 2, falling with x
+    for x in spans if last > 1 else ():  # the last action's staircase: (W_0 - x) / 2
         v = 0.5 * (w0 - x)
         if v >= passing:
             tau.append(v)
@@ -317,7 +319,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             break
     taus = [[], tau]  # by m (none for m = 0)
     stairs: list[_Stair] = [([], [], [], []), ([0], [inf, -inf], [-inf, w0], [-inf])]
-    for _ in range(2, longest):
+    for m in range(2, longest):
         # The staircase of m actions from the tau of m - 1 (arcs.staircase: every arc whose
         # rest exceeds the rest of each wider arc, one scan from the widest down; a finite
         # tau is above tol), then its tau.
@@ -346,7 +348,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             bound = wid[-1] - 2.0 * low + _SPAN_SLACK
             if bound > front.covered:
                 cover(bound)
-            for x in spans:  # Staircase.tau, as far as it passes
+            for x in spans if m < last else ():  # Staircase.tau, as far as it passes
                 r = left(c, x)
                 at = rest[r]
                 before = 0.5 * (wid[r] - x)
@@ -374,10 +376,24 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             while spans[at] > 0.0:
                 at += 1
         else:  # the best tau of the arcs at..end (and the first within tol of it): at's
-            vals = taus[n]
-            if at >= len(vals):  # pragma: no cover - the lengths guarantee a chain
+            if n < last:
+                vals = taus[n]
+                tolerance = vals[at] if at < len(vals) else -inf
+            elif at < len(spans):  # the longest plan: its staircase's tau at arc `at`
+                x = spans[at]
+                if n == 1:
+                    tolerance = 0.5 * (w0 - x)
+                else:
+                    _, rest, wid, c = stairs[n]
+                    r = left(c, x)
+                    tolerance = rest[r]
+                    before = 0.5 * (wid[r] - x)
+                    if before > tolerance:
+                        tolerance = before
+            else:
+                tolerance = -inf
+            if not tolerance >= passing:  # pragma: no cover - the lengths guarantee a chain
                 raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-            tolerance = vals[at]
         # chain_option, witness by witness: the first placed by the prior, each later one
         # picked by its staircase for the span of the one before (Arc.span: s_last - s),
         # the turn centring that image in it; each turn made short as short_turns makes
