@@ -318,7 +318,8 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         else:
             break
     taus = [[], tau]  # by m (none for m = 0)
-    stairs: list[_Stair] = [([], [], [], []), ([0], [inf, -inf], [-inf, w0], [-inf])]
+    # by m; none for m = 0, and the last action's (arc 0) is never looked up
+    stairs: list[_Stair] = [([], [], [], [])] * 2
     for m in range(2, longest):
         # The staircase of m actions from the tau of m - 1 (arcs.staircase: every arc whose
         # rest exceeds the rest of each wider arc, one scan from the widest down; a finite
@@ -444,20 +445,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     return new_result(problem, tuple(out), bayes, most, "exact")
 
 
-def _choose(
-    options: list[Scored],
-    p_tol: float,
-    report: Report,
-    costs: list[float] | None = None,
-    probs: list[float] | None = None,
-) -> tuple[list[Scored], int, int]:
-    """The options to report, and the indices of the Bayes and the most certain among them.
-
-    ``costs`` and ``probs`` are the options' expected costs and probabilities, if at hand.
-    """
-    if costs is None or probs is None:
-        costs, probs = [o[1] for o in options], [o[0] for o in options]
-    bayes, most = choose_among(costs, probs, p_tol)
+def _choose(options: list[Scored], p_tol: float, report: Report) -> tuple[list[Scored], int, int]:
+    """The options to report, and the indices of the Bayes and the most certain among them."""
+    bayes, most = choose_among([o[1] for o in options], [o[0] for o in options], p_tol)
     if report == "best":  # as PlanResult.best_only, before the angles are computed
         keep = sorted({bayes, most})
         return [options[i] for i in keep], keep.index(bayes), keep.index(most)
