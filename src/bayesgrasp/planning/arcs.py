@@ -366,15 +366,14 @@ class SpanFront:
       neither join the front below it nor replace an arc there): :meth:`cover` takes the
       arcs one by one, only as far as asked.
     - The arcs are enumerated in two batches: first those of each row ``i`` whose last
-      stable orientation lies below ``s_i + first`` (``first``, at most ``max_span``), then,
-      only if a bound above ``first - _SPAN_SLACK`` is asked, the rest (sorted in with the
-      arcs not taken yet). Every arc of the first batch spans at least ``first`` less a
-      rounding, so the first batch holds every arc that spans less than
-      ``first - _SPAN_SLACK``, and every arc of the second spans more than that.
-      The planner of one action type asks for no more than its widths need (they stop at
-      the period, :func:`bayesgrasp.planning.exact.plan_exact`), so the arcs of about a
-      period (half of all arcs of a squeeze span about a half-turn or less, and those of
-      exactly one half-turn are many) are seldom enumerated.
+      stable orientation lies below ``s_i + first`` (``first`` at most ``max_span`` and
+      ``2 pi``), then, only if a bound above ``first - _SPAN_SLACK`` is asked, the rest
+      (sorted in with the arcs not taken yet). An arc of the second batch spans at least
+      ``first`` less a rounding, so the first batch holds every arc that spans less than
+      ``first - _SPAN_SLACK``. The planner of one action type passes the spans its widths
+      ask for at most (``cap - 2 max(tol, accuracy)``, see
+      :func:`bayesgrasp.planning.exact.plan_exact`), so the arcs of a squeeze that span a
+      half-turn (K of about K^2 / 2) are seldom made.
 
     (On this interpreter a comprehension or a call of ``min`` or ``max`` costs as much as
     several loop steps, and ``map`` over a few floats more than a loop; the loops below avoid
