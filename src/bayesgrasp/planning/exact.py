@@ -318,9 +318,17 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         else:
             break
     taus = [[], tau]  # by m (none for m = 0)
+    top_tau = tau  # the tau the longest plan's staircase is made from
     # by m; none for m = 0, and the last action's (arc 0) is never looked up
     stairs: list[_Stair] = [([], [], [], [])] * 2
     for m in range(2, longest):
+        if m == last:  # the longest plan's staircase: asked at two spans only, _stair_top
+            if tau:
+                bound = widths[len(tau) - 1] - 2.0 * low + _SPAN_SLACK
+                if bound > front.covered:
+                    cover(bound)
+            top_tau = tau
+            break
         # The staircase of m actions from the tau of m - 1 (arcs.staircase: every arc whose
         # rest exceeds the rest of each wider arc, one scan from the widest down; a finite
         # tau is above tol), then its tau.
@@ -349,7 +357,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             bound = wid[-1] - 2.0 * low + _SPAN_SLACK
             if bound > front.covered:
                 cover(bound)
-            for x in spans if m < last else ():  # Staircase.tau, as far as it passes
+            for x in spans:  # Staircase.tau, as far as it passes
                 r = left(c, x)
                 at = rest[r]
                 before = 0.5 * (wid[r] - x)
@@ -382,15 +390,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
                 tolerance = vals[at] if at < len(vals) else -inf
             elif at < len(spans):  # the longest plan: its staircase's tau at arc `at`
                 x = spans[at]
-                if n == 1:
-                    tolerance = 0.5 * (w0 - x)
-                else:
-                    _, rest, wid, c = stairs[n]
-                    r = left(c, x)
-                    tolerance = rest[r]
-                    before = 0.5 * (wid[r] - x)
-                    if before > tolerance:
-                        tolerance = before
+                tolerance = 0.5 * (w0 - x) if n == 1 else _stair_top(top_tau, widths, x)[0]
             else:
                 tolerance = -inf
             if not tolerance >= passing:  # pragma: no cover - the lengths guarantee a chain
@@ -415,6 +415,8 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             s_last = s + spans[at]
             if m == 1:
                 at = 0  # the last action's staircase picks arc 0
+            elif m == last:
+                at = _stair_top(top_tau, widths, s_last - s)[1]
             else:
                 idx, rest, wid, c = stairs[m]
                 x = s_last - s
@@ -443,6 +445,38 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         steps_ = tuple(steps)
         out.append(new_option(steps_, final, probs[n], costs[n], tolerance, (start, start + arc)))
     return new_result(problem, tuple(out), bayes, most, "exact")
+
+
+def _stair_top(tau: list[float], widths: list[float], x: float) -> tuple[float, int]:
+    """``tau`` at span ``x`` of the staircase made from ``tau``, and the front arc it picks.
+
+    ``tau`` is the (finite, non-increasing) ``tau`` of the staircase after it at the front's
+    arcs ``0, 1, ..``, ``widths`` the front's widths. That staircase's entries are the arcs
+    ``n`` with ``tau[n] > tau[n + 1]`` and the last (arcs.staircase's scan from the widest
+    down keeps an arc whose rest exceeds every wider arc's), with ``c = w - 2 tau``
+    non-decreasing along them; its ``tau(x)`` and pick are decided by the first entry with
+    ``c >= x`` and the one before (:meth:`~bayesgrasp.planning.arcs.Staircase.tau`,
+    :meth:`~bayesgrasp.planning.arcs.Staircase.pick`). Found from the widest entry down,
+    for spans near the widest (the longest plan's first witness and its image) in a few
+    steps, without the staircase: the same floats and the same arc.
+    """
+    n = len(tau) - 1
+    if n < 0:  # pragma: no cover - the lengths guarantee a chain
+        return -math.inf, -1
+    if widths[n] - 2.0 * tau[n] < x:  # past the widest entry: (W - x) / 2 of the widest
+        return 0.5 * (widths[n] - x), n
+    cur = n  # the least entry so far with c >= x
+    m = n - 1
+    while m >= 0:
+        v = tau[m]
+        if v > tau[m + 1]:  # an entry
+            if widths[m] - 2.0 * v < x:  # the entry before the first with c >= x
+                before = 0.5 * (widths[m] - x)
+                value = tau[cur]
+                return (value, cur) if value >= before else (before, m)
+            cur = m
+        m -= 1
+    return tau[cur], cur
 
 
 def _choose(options: list[Scored], p_tol: float, report: Report) -> tuple[list[Scored], int, int]:
