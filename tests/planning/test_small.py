@@ -331,7 +331,14 @@ def test_span_front_is_a_prefix_of_the_enumerated_front(
 def test_fast_constructors_make_the_same_objects() -> None:
     """The planners' fast constructors set every field as the dataclasses' own do."""
     from bayesgrasp.model.actions import SQUEEZE
-    from bayesgrasp.planning.result import PlanOption, PlanStep, new_option, new_result, short_turns
+    from bayesgrasp.planning.result import (
+        PlanOption,
+        PlanStep,
+        new_option,
+        new_result,
+        short_turns,
+        slot_setters,
+    )
 
     for cls in (PlanStep, PlanOption, PlanResult):
         assert not hasattr(cls, "__post_init__"), cls  # nothing the fast paths would skip
@@ -340,6 +347,11 @@ def test_fast_constructors_make_the_same_objects() -> None:
     steps = (PlanStep("squeeze", 0.25), PlanStep("push-grasp", -1.0))
     fields = (steps, 1.5, 0.75, 4.0, None, (0.1, 2.0))
     assert new_option(*fields) == PlanOption(*fields)
+    for cls, values in ((PlanStep, ("squeeze", 0.25)), (PlanOption, fields)):
+        made = object.__new__(cls)
+        for setter, value in zip(slot_setters(cls), values, strict=True):
+            setter(made, value)
+        assert made == cls(*values)  # type: ignore[arg-type]
     pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
     opts = (PlanOption(*fields),)
     fast, slow = new_result(pb, opts, 0, 0, "exact"), PlanResult(pb, opts, 0, 0, "exact")

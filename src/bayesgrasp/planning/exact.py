@@ -51,11 +51,11 @@ from . import arcs, result
 from .arcs import _ROUNDING, _SPAN_SLACK, ArcPlanner, Counts, Scored
 from .result import (
     COST_RTOL,
+    PlanOption,
     PlanResult,
     PlanStep,
     choose_among,
     max_plan_length,
-    new_option,
     new_result,
     short_turns,
 )
@@ -372,8 +372,10 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     g = action.gripper_period
     half = g / 2.0
     neg_pi, neg_half = -pi, -half
-    new_step, set_kind, set_alpha = result.new_step_setters()
-    zero = new_step(PlanStep)  # the first step of every plan under the uniform prior
+    new = object.__new__  # PlanStep and PlanOption made as short_turns and new_option do
+    set_kind, set_alpha = result.slot_setters(PlanStep)
+    set_steps, set_final, set_p, set_cost, set_tolerance, set_arc = result.slot_setters(PlanOption)
+    zero = new(PlanStep)  # the first step of every plan under the uniform prior
     set_kind(zero, kind)
     set_alpha(zero, 0.0)
     out = []
@@ -436,14 +438,20 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
                 if short == neg_half:
                     short = half
                 carry = wrapped - short
-            made = new_step(PlanStep)
+            made = new(PlanStep)
             set_kind(made, kind)
             set_alpha(made, short)
             steps.append(made)
             m -= 1
         final = math.fmod(stable[i] + carry + two_pi, two_pi)
-        steps_ = tuple(steps)
-        out.append(new_option(steps_, final, probs[n], costs[n], tolerance, (start, start + arc)))
+        option = new(PlanOption)
+        set_steps(option, tuple(steps))
+        set_final(option, final)
+        set_p(option, probs[n])
+        set_cost(option, costs[n])
+        set_tolerance(option, tolerance)
+        set_arc(option, (start, start + arc))
+        out.append(option)
     return new_result(problem, tuple(out), bayes, most, "exact")
 
 

@@ -21,7 +21,7 @@ import dataclasses
 import math
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Literal, Protocol, runtime_checkable
+from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -432,16 +432,13 @@ _set_kind, _set_alpha = (vars(PlanStep)[name].__set__ for name in ("kind", "alph
 _set_option = [vars(PlanOption)[name].__set__ for name in PlanOption.__slots__]
 
 
-def new_step_setters() -> tuple[
-    Callable[[type[PlanStep]], PlanStep],
-    Callable[[PlanStep, str], None],
-    Callable[[PlanStep, float], None],
-]:
-    """``object.__new__`` and the setters of :class:`PlanStep`'s ``kind`` and ``alpha`` slots.
+def slot_setters(cls: type[PlanStep | PlanOption | PlanResult]) -> list[Callable[[Any, Any], None]]:
+    """The setters of the fields of a plan step, option or result, in field order.
 
-    For a planner that makes steps in its own loop (as :func:`short_turns` does).
+    For a planner that makes these objects in its own loop, as :func:`short_turns` does:
+    ``object.__new__(cls)``, then every field set.
     """
-    return _new, _set_kind, _set_alpha
+    return _SETTERS[cls]
 
 
 def new_option(
@@ -465,6 +462,11 @@ def new_option(
 
 
 _set_result = [vars(PlanResult)[name].__set__ for name in PlanResult.__slots__]
+_SETTERS: dict[type, list[Callable[[Any, Any], None]]] = {
+    PlanStep: [_set_kind, _set_alpha],
+    PlanOption: _set_option,
+    PlanResult: _set_result,
+}
 
 
 def new_result(
