@@ -90,6 +90,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
+import operator
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
@@ -113,6 +114,7 @@ __all__ = [
     "ArcPlanner",
     "Counts",
     "Plans",
+    "SpanFront",
     "Staircase",
     "arc_front",
     "chain_option",
@@ -326,60 +328,153 @@ def _front_lists(
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Span, width, first stable orientation and start of the front's arcs, step for step.
 
-    The front of :func:`arc_front`, bit for bit: the same candidates, the same float
-    operations and the same Pareto rule (:func:`pareto_front`: a stable sort by span, widths
-    strictly increasing, of equal spans the last kept; so of an equal span and width the
-    arc of the first basin). Done in the order that costs least on Python floats:
-
-    - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
-    - then the arcs of two or more basins, row by row; one no wider than the widest basin
-      never joins the front (the front's widths only increase), so it is not kept;
-    - sorted as ``(span, width, i)``: the stable sort by span, except that arcs of one span
-      come by width (then first basin), which leaves the same arc of each span on the front.
-
-    (On this interpreter a comprehension or a call of ``min`` or ``max`` costs as much as
-    several loop steps; the loops below avoid them.)
+    The whole front of a :class:`SpanFront` (every arc enumerated at once).
     """
-    k = len(stable)
-    add_turn = TWO_PI.__add__  # TWO_PI + x is x + TWO_PI, bit for bit
-    s2 = [*stable, *map(add_turn, stable)]
-    hi2 = [*hi, *map(add_turn, hi)]
-    widest = -math.inf
-    first = 0
-    for i in range(k):
-        w = hi[i] - lo[i]
-        if w > widest:
-            widest, first = w, i
-    cand: list[tuple[float, float, int]] = []
-    add = cand.append
-    left = bisect.bisect_left
-    for i in range(k):
-        si, li = stable[i], lo[i]
-        # Arcs (i, j) for i <= j < end: the image spans less than max_span (K basins at most).
-        end = left(s2, si + max_span)
-        if end > i + k:
-            end = i + k
-        for j in range(i + 1, end):
-            w = hi2[j] - li
-            if w > widest:
-                add((s2[j] - si, w, i))
-    cand.sort()
-    spans, widths, rows = [0.0], [widest], [first]
-    best = widest
-    for x, w, i in cand:
-        if w > best:
-            best = w
-            if spans[-1] == x:  # of equal spans only the widest stays
-                widths[-1], rows[-1] = w, i
-            else:
-                spans.append(x)
-                widths.append(w)
-                rows.append(i)
+    front = SpanFront(stable, lo, hi, max_span, max_span)
+    front.cover(math.inf)
     firsts, los = [], []
-    for i in rows:
+    for i in front.rows:
         firsts.append(stable[i])
         los.append(lo[i])
-    return spans, widths, firsts, los
+    return front.spans, front.widths, firsts, los
+
+
+_span_of = operator.itemgetter(0)
+
+# Slack of the span bounds of SpanFront (and of the fused planner's staircases): far above
+# the rounding of sums and differences of angles below 4 pi (a few ulps, about 1e-15).
+_SPAN_SLACK = 1e-12
+
+
+class SpanFront:
+    """The front of :func:`arc_front` in plain Python floats, built in order of span on demand.
+
+    ``spans``, ``widths`` and ``rows`` (the first basin of each arc) are the front's arcs
+    whose image spans less than the largest bound passed to :meth:`cover` so far, bit for
+    bit those of the whole front: the same candidates, the same float operations and the
+    same Pareto rule (:func:`pareto_front`: a stable sort by span, widths strictly
+    increasing, of equal spans the last kept; so of an equal span and width the arc of the
+    first basin). In the order that costs least on Python floats:
+
+    - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
+    - the arcs of two or more basins by a stable sort on the span alone, in the order
+      ``(i, j)`` (a sort on floats: tuples compare several times slower). Of the arcs of one
+      span the front keeps the widest, and of those the first, the least ``i`` (one row
+      has one arc of each span and width): the same arc as the order ``(span, width, i)``
+      keeps, which the second batch below uses. A prefix of either order gives the front's
+      arcs of spans below the first span not taken (later arcs span more, so they can
+      neither join the front below it nor replace an arc there): :meth:`cover` takes the
+      arcs one by one, only as far as asked.
+    - The arcs are enumerated in two batches: first those of each row ``i`` whose last
+      stable orientation lies below ``s_i + first`` (``first`` at most ``max_span`` and
+      ``2 pi``), then, only if a bound above ``first - _SPAN_SLACK`` is asked, the rest
+      (sorted in with the arcs not taken yet). An arc of the second batch spans at least
+      ``first`` less a rounding, so the first batch holds every arc that spans less than
+      ``first - _SPAN_SLACK``. The planner of one action type passes the spans its widths
+      ask for at most (``cap - 2 max(tol, accuracy)``, see
+      :func:`bayesgrasp.planning.exact.plan_exact`), so the arcs of a squeeze that span a
+      half-turn (K of about K^2 / 2) are seldom made.
+
+    (On this interpreter a comprehension or a call of ``min`` or ``max`` costs as much as
+    several loop steps, and ``map`` over a few floats more than a loop; the loops below avoid
+    them.)
+    """
+
+    __slots__ = (
+        "_cand",
+        "_complete",
+        "_first",
+        "_hi2",
+        "_pos",
+        "_s2",
+        "covered",
+        "lo",
+        "max_span",
+        "rows",
+        "spans",
+        "stable",
+        "widths",
+    )
+
+    def __init__(
+        self,
+        stable: Sequence[float],
+        lo: Sequence[float],
+        hi: Sequence[float],
+        max_span: float,
+        first: float,
+    ) -> None:
+        k = len(stable)
+        add_turn = TWO_PI.__add__  # TWO_PI + x is x + TWO_PI, bit for bit
+        s2 = [*stable, *map(add_turn, stable)]
+        hi2 = [*hi, *map(add_turn, hi)]
+        if first > max_span:
+            first = max_span
+        if first > TWO_PI:  # then s2[i + k] >= s_i + first: the arcs below end before i + k
+            first = TWO_PI
+        widest = -math.inf
+        top = 0
+        cand: list[tuple[float, float, int]] = []
+        add = cand.append
+        left = bisect.bisect_left
+        for i in range(k):
+            si, li = stable[i], lo[i]
+            w = hi[i] - li
+            if w > widest:
+                widest, top = w, i
+            # Arcs (i, j), i < j < i + K: the image spans less than `first` (of max_span).
+            for j in range(i + 1, left(s2, si + first)):
+                add((s2[j] - si, hi2[j] - li, i))
+        cand.sort(key=_span_of)
+        self.stable, self.lo, self.max_span = stable, lo, max_span
+        self._s2, self._hi2, self._first = s2, hi2, first
+        self._cand, self._pos = cand, 0
+        self._complete = math.inf if first >= max_span else first - _SPAN_SLACK
+        self.spans, self.widths, self.rows = [0.0], [widest], [top]
+        self.covered = -math.inf
+
+    def cover(self, bound: float) -> None:
+        """Take every arc whose image spans less than ``bound`` (at once: O(arcs taken))."""
+        if bound <= self.covered:
+            return
+        if bound > self._complete:
+            self._second_batch()
+        cand, pos = self._cand, self._pos
+        end = bisect.bisect_left(cand, (bound,), pos)  # the arcs of span < bound
+        if end > pos:
+            spans, widths, rows = self.spans, self.widths, self.rows
+            best = widths[-1]
+            for arc in cand[pos:end]:
+                if arc[1] > best:
+                    x, best, i = arc
+                    if spans[-1] == x:  # of equal spans only the widest stays
+                        widths[-1], rows[-1] = best, i
+                    else:
+                        spans.append(x)
+                        widths.append(best)
+                        rows.append(i)
+            self._pos = end
+        self.covered = bound
+
+    def _second_batch(self) -> None:
+        """The arcs of spans from ``first`` to ``max_span``, sorted in with those not taken.
+
+        By ``(span, width, i)``: arcs of one span from both batches are then in an order
+        that keeps the same arc of each span (the class notes).
+        """
+        stable, lo, s2, hi2 = self.stable, self.lo, self._s2, self._hi2
+        k = len(stable)
+        left = bisect.bisect_left
+        cand = self._cand[self._pos :]
+        add = cand.append
+        first, max_span = self._first, self.max_span
+        for i in range(k):
+            si, li = stable[i], lo[i]
+            start = left(s2, si + first, i + 1, i + k)
+            for j in range(start, left(s2, si + max_span, i + 1, i + k)):
+                add((s2[j] - si, hi2[j] - li, i))
+        cand.sort()
+        self._cand, self._pos, self._complete = cand, 0, math.inf
 
 
 PRUNE_STATES = 256

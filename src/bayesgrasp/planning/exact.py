@@ -30,23 +30,35 @@ Cost: O(K^2) once per action type for the front (K stable orientations; usually 
 arcs survive), then O(log K) per (count, type) for the lengths and O(F log F) per action of
 each reported plan for its witnesses (F arcs on the front). Parts whose every action has at
 most :data:`~bayesgrasp.sizes.SMALL` states (the seed's study: about 6) are planned on plain
-Python lists end to end (one action type: :func:`_plan_one_small`; the angles of any:
-:func:`~bayesgrasp.planning.arcs.small_options`), with the same plans bit for bit.
+Python lists end to end (one action type: :func:`_plan_one_small`, with exact prunings of
+the front and the staircases; the angles of any: :func:`~bayesgrasp.planning.arcs.small_options`),
+with the same plans bit for bit.
 """
 
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Callable
 from typing import Literal
 
+from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..model.cost import CostModel
-from ..model.prior import Prior
+from ..model.prior import Prior, UniformPrior
 from ..model.problem import Problem
-from . import arcs
-from .arcs import ArcPlanner, Counts, Scored
-from .result import COST_RTOL, PlanResult, choose_among, max_plan_length, new_result
+from . import arcs, result
+from .arcs import _ROUNDING, _SPAN_SLACK, ArcPlanner, Counts, Scored
+from .result import (
+    COST_RTOL,
+    PlanOption,
+    PlanResult,
+    PlanStep,
+    choose_among,
+    max_plan_length,
+    new_result,
+    short_turns,
+)
 
 __all__ = ["Report", "plan_exact"]
 
@@ -137,100 +149,347 @@ def plan_exact(
     return PlanResult(problem, tuple(planner.plan_options(options)), bayes, most, "exact")
 
 
+_Stair = tuple[list[int], list[float], list[float], list[float]]
+"""A staircase of :func:`_plan_one_small`: front index, rest, width and ``c`` of each entry."""
+
 # Scored (arcs.py): (p, cost, action types, width) of the best plan of a length; angles last.
 
 
 def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -> PlanResult:
     """:func:`plan_exact` for one action type of at most :data:`~bayesgrasp.sizes.SMALL` states.
 
-    The same steps on plain lists, without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`:
-    the front (its plain-Python path); the widths ``W_k`` of each length, which for one
-    action type are one sequence, ``W_1`` the widest single basin and ``W_k`` the front's
-    widest under ``W_{k-1}`` less twice the margin
-    (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the search
-    to the first length that reaches its probability, as :func:`_search` does with one
-    type); the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right);
-    and the angles on the front's lists (:func:`~bayesgrasp.planning.arcs.small_options`).
-    The same plans, bit for bit (the tests run both).
+    The same steps on plain lists, without an :class:`~bayesgrasp.planning.arcs.ArcPlanner`
+    nor any :class:`~bayesgrasp.planning.arcs.ArcFront`, staircase or arc object, and the
+    same plans, bit for bit (the tests run both):
+
+    - the front (:class:`~bayesgrasp.planning.arcs.SpanFront`), taken in order of span only
+      as far as the widths and the staircases below ask;
+    - the widths ``W_k`` of each length, which for one action type are one sequence: ``W_1``
+      the widest single basin, ``W_k`` the front's widest under ``W_{k-1}`` less twice the
+      margin (:func:`~bayesgrasp.planning.arcs.widest_reachable` runs it to its end, the
+      search to the first length that reaches its probability, as :func:`_search` does with
+      one type); they ask for arcs of spans below ``cap - 2 max(tol, accuracy)`` only
+      (``W < cap`` before each step);
+    - the attempt costs as :meth:`CostModel.attempt_cost` sums them (left to right), the
+      expected costs as :meth:`CostModel.expected_from_attempt` makes them, and the Bayes
+      and the most certain plans (:func:`~bayesgrasp.planning.result.choose_among`, as
+      :func:`_choose`);
+    - the angles of the reported plans (:meth:`~bayesgrasp.planning.arcs.ArcPlanner.witnesses`,
+      :meth:`~bayesgrasp.planning.arcs.Staircase.pick` and
+      :func:`~bayesgrasp.planning.arcs.chain_option`, as
+      :func:`~bayesgrasp.planning.arcs.small_options` runs them for any action set): the
+      staircase of the last ``m`` actions, ``m = 1, 2, ..`` (for one action type it depends
+      on ``m`` only), and its ``tau`` at the front's arcs, up to the longest reported plan.
+
+    Exact prunings (each keeps every float operation that decides a plan):
+
+    - *The front as far as asked.* Each width asks for the front's arcs of spans below its
+      bound, and each staircase for those below ``Wmax - 2 T + slack`` (next item);
+      :class:`~bayesgrasp.planning.arcs.SpanFront` takes its arcs in order of span up to
+      there and no further, the same arcs the whole front holds below that span.
+    - *tau where it can be finite.* Let ``T`` be ``max(tol, accuracy - _ROUNDING)``: a
+      ``tau`` is ``-inf`` unless above ``tol`` and at least ``accuracy - _ROUNDING``, so
+      every entry of a staircase has a rest of at least ``T`` (or ``inf``), and let
+      ``Wmax`` be its widest entry. An entry ``r`` with ``c_r = fl(w_r - 2 rest_r) >= x``
+      needs ``x <= Wmax - 2 T`` but for a rounding; so for ``x >= Wmax - 2 T + slack`` the
+      first entry with ``c >= x`` is past the last and ``tau(x) = (Wmax - x) / 2 < T``
+      (again but for a rounding, far below the slack) is ``-inf``.
+    - *tau only falls.* ``tau`` is non-increasing in ``x``, exactly in floats: for
+      ``x < x'`` with the same first entry ``r`` (``c_r >= x``) both terms fall (rounding
+      is monotone); with a later one ``r' > r``, ``rest_{r'} < rest_r`` and the entry
+      ``e = r' - 1 >= r`` has ``fl(w_e - 2 rest_e) < x'``, hence ``w_e - 2 rest_e < x'``
+      exactly (``x'`` is a float), ``fl(w_e - x') <= 2 rest_e`` and
+      ``0.5 fl(w_e - x') <= rest_e <= rest_r``. So along the front (spans increasing) the
+      first ``-inf`` ends the ``tau`` of a staircase; and the first witness of a plan of
+      ``k`` actions, the first arc whose ``tau`` is within ``tol`` of the best among the
+      arcs at least ``W_k - tol`` wide, is the first of those arcs.
+    - *The last action.* Its staircase is the widest single basin, front arc 0 (span 0,
+      rest ``inf``, ``c = -inf``): its ``tau`` is ``(W_0 - x) / 2`` where that passes, and
+      it picks arc 0 for every span.
+    - *The angles of the reported plans only* (``report="best"``: the Bayes and the most
+      certain), and the staircases up to the longest of them.
     """
     (action,) = problem.actions
     kind = action.name
     f = problem.transfers[kind]
     tol = problem.states.angle_tol
     group = problem.goal_group
-    cap = arcs.period_cap(problem)  # ArcPlanner.period
-    front = arcs.arc_front(f, f.period + tol)  # ArcPlanner.max_span
-    spans, widths = front.span_list, front.width_list
+    accuracy = problem.accuracy
+    cap = TWO_PI / group  # arcs.period_cap for one action type
+    if f.period < cap:
+        cap = f.period
+    margin2 = 2.0 * (tol if tol >= accuracy else accuracy)  # max(tol, accuracy)
+    floor = accuracy - _ROUNDING  # Staircase.tau: margins from accuracy (less the rounding)
+    low = tol if tol >= floor else floor  # T: every finite tau is at least this
+    stable, lo, hi = f.values
+    # ArcPlanner.max_span; the widths ask for spans below cap - margin2 <= cap - 2 T only.
+    front = arcs.SpanFront(stable, lo, hi, f.period + tol, cap - 2.0 * low + 2.0 * _SPAN_SLACK)
+    spans, widths, rows = front.spans, front.widths, front.rows
+    cover = front.cover
     left = bisect.bisect_left
-    margin2 = 2.0 * (tol if tol >= problem.accuracy else problem.accuracy)  # max(tol, accuracy)
     limit_hard = max_plan_length(problem)
     prior, cost = problem.prior, problem.cost
+    uniform = type(prior) is UniformPrior  # its max_arc_mass: group * length / (2 pi)
 
+    cover(tol)
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
     width = grown[0]
     for _ in range(limit_hard - 1):  # widest_reachable
         if width >= cap:
             break
-        n = left(spans, width - margin2) - 1
-        wider = widths[n] if n >= 0 else 0.0
+        bound = width - margin2
+        if bound > front.covered:  # (> tol >= 0) then the front holds just the arcs below
+            cover(bound)
+            wider = widths[-1]
+        else:
+            n = left(spans, bound) - 1
+            wider = widths[n] if n >= 0 else 0.0
         grown.append(wider)
         if wider <= width + tol:
             break
         width = wider
     # The prior mass of the success arc, placed best (capped at the period; memoised).
-    masses = {}
+    masses: dict[float, float] = {}
     x = width if width <= cap else cap  # min(width, cap)
-    p_best = masses[x] = prior.max_arc_mass(x, group)[0]
+    if uniform:
+        p_best = group * x / TWO_PI
+    else:
+        p_best = masses[x] = prior.max_arc_mass(x, group)[0]
     p_tol = problem.part.hull.tol.probability
+    stop = p_best - p_tol
+    cut = limit_hard if max_actions is None else max_actions
     step = cost.action_cost(kind)
     run = 0 + cost.action_cost(kind, True)  # the actions' costs summed left to right
-    options: list[Scored] = []
+    verify, retry = cost.verify, cost.retry
     costs: list[float] = []
     probs: list[float] = []
     k = 0
-    while True:
+    # The widths reach p_best within `grown` (p_best is the mass of one of them), and
+    # Goldberg 1993 bounds plans by O(n).
+    for width in grown:
         k += 1
-        if k > 1:
-            run = run + step
-        if k > len(grown):  # pragma: no cover - the widths reach p_best within `grown`
-            n = left(spans, grown[-1] - margin2) - 1
-            grown.append(widths[n] if n >= 0 else 0.0)
-        width = grown[k - 1]
         x = width if width <= cap else cap
-        p = masses.get(x)
-        if p is None:
-            p = masses[x] = prior.max_arc_mass(x, group)[0]
-        c = cost.expected_from_attempt(cost.verify + run, p)
-        options.append((p, c, (kind,) * k, width))
-        costs.append(c)
+        if uniform:
+            p = group * x / TWO_PI
+        else:
+            known = masses.get(x)
+            p = masses[x] = prior.max_arc_mass(x, group)[0] if known is None else known
+        # CostModel.expected_from_attempt
+        costs.append((verify + run) / p + retry * (1.0 / p - 1.0) if p > 0.0 else math.inf)
         probs.append(p)
-        if p >= p_best - p_tol or (max_actions is not None and k >= max_actions):
+        if p >= stop or k >= cut:
             break
-        if k >= limit_hard:  # pragma: no cover - Goldberg 1993 bounds plans by O(n)
-            raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
-    options, bayes, most = _choose(options, p_tol, report, costs, probs)
-    if k * len(front) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
-        plans = ArcPlanner.for_problem(problem).plan_options(options)
-    else:
-        plans = arcs.small_options(problem, {kind: front}, tol, options)
-    return new_result(problem, tuple(plans), bayes, most, "exact")
-
-
-def _choose(
-    options: list[Scored],
-    p_tol: float,
-    report: Report,
-    costs: list[float] | None = None,
-    probs: list[float] | None = None,
-) -> tuple[list[Scored], int, int]:
-    """The options to report, and the indices of the Bayes and the most certain among them.
-
-    ``costs`` and ``probs`` are the options' expected costs and probabilities, if at hand.
-    """
-    if costs is None or probs is None:
-        costs, probs = [o[1] for o in options], [o[0] for o in options]
+        run = run + step
+    else:  # pragma: no cover - see above
+        raise PlanningError(f"no plan reached probability {p_best:.6f} in {k} actions")
     bayes, most = choose_among(costs, probs, p_tol)
+    if report == "best":  # as PlanResult.best_only, before the angles are computed
+        keep = [bayes] if bayes == most else sorted((bayes, most))
+        bayes, most = keep.index(bayes), keep.index(most)
+    else:
+        keep = list(range(k))
+    longest = keep[-1] + 1
+    if longest * len(widths) > arcs.STAIR_CELLS:  # pragma: no cover - not with few states
+        options = [(probs[n], costs[n], (kind,) * (n + 1), grown[n]) for n in keep]
+        plans = ArcPlanner.for_problem(problem).plan_options(options)
+        return new_result(problem, tuple(plans), bayes, most, "exact")
+
+    # The staircases of the last m = 1, 2, .. actions and their tau at the front's arcs (as
+    # far as it is finite; -inf after). A staircase is its entries' front index, rest
+    # (then -inf), width (after -inf) and c: rest[r] and 0.5 * (width[r] - x) are then
+    # Staircase.tau's rest[r] (-inf past the last) and 0.5 * (width[r - 1] - x) (-inf
+    # before the first). "v > tol and v >= floor" is v >= passing. The tau of the longest
+    # plan's staircase is asked at one arc only (its first witness), so not made here.
+    last = longest - 1
+    inf = math.inf
+    passing = math.nextafter(tol, inf)
+    if floor > passing:
+        passing = floor
+    w0 = widths[0]
+    bound = w0 - 2.0 * low + _SPAN_SLACK
+    if bound > front.covered:
+        cover(bound)
+    tau = []
+    for x in spans if last > 1 else ():  # the last action's staircase: (W_0 - x) / 2
+        v = 0.5 * (w0 - x)
+        if v >= passing:
+            tau.append(v)
+        else:
+            break
+    taus = [[], tau]  # by m (none for m = 0)
+    top_tau = tau  # the tau the longest plan's staircase is made from
+    # by m; none for m = 0, and the last action's (arc 0) is never looked up
+    stairs: list[_Stair] = [([], [], [], [])] * 2
+    for m in range(2, longest):
+        if m == last:  # the longest plan's staircase: asked at two spans only, _stair_top
+            if tau:
+                bound = widths[len(tau) - 1] - 2.0 * low + _SPAN_SLACK
+                if bound > front.covered:
+                    cover(bound)
+            top_tau = tau
+            break
+        # The staircase of m actions from the tau of m - 1 (arcs.staircase: every arc whose
+        # rest exceeds the rest of each wider arc, one scan from the widest down; a finite
+        # tau is above tol), then its tau.
+        idx: list[int] = []
+        rest = [-inf]
+        wid: list[float] = []
+        c: list[float] = []
+        best = -inf
+        for n in range(len(tau) - 1, -1, -1):
+            v = tau[n]
+            if v > best:
+                best = v
+                w = widths[n]
+                idx.append(n)
+                rest.append(v)
+                wid.append(w)
+                c.append(w - 2.0 * v)
+        wid.append(-inf)
+        idx.reverse()
+        rest.reverse()
+        wid.reverse()
+        c.reverse()
+        stairs.append((idx, rest, wid, c))
+        tau = []
+        if c:
+            bound = wid[-1] - 2.0 * low + _SPAN_SLACK
+            if bound > front.covered:
+                cover(bound)
+            for x in spans:  # Staircase.tau, as far as it passes
+                r = left(c, x)
+                at = rest[r]
+                before = 0.5 * (wid[r] - x)
+                value = at if at >= before else before
+                if value >= passing:
+                    tau.append(value)
+                else:
+                    break
+        taus.append(tau)
+
+    remainder, pi, two_pi = math.remainder, math.pi, TWO_PI
+    g = action.gripper_period
+    half = g / 2.0
+    neg_pi, neg_half = -pi, -half
+    new = object.__new__  # PlanStep and PlanOption made as short_turns and new_option do
+    set_kind, set_alpha = result.slot_setters(PlanStep)
+    set_steps, set_final, set_p, set_cost, set_tolerance, set_arc = result.slot_setters(PlanOption)
+    zero = new(PlanStep)  # the first step of every plan under the uniform prior
+    set_kind(zero, kind)
+    set_alpha(zero, 0.0)
+    out = []
+    for n in keep:
+        length = grown[n]
+        at = left(widths, length - tol)  # the arcs at..end are wide enough
+        if n == 0:  # one action: a single basin
+            tolerance = None
+            while spans[at] > 0.0:
+                at += 1
+        else:  # the best tau of the arcs at..end (and the first within tol of it): at's
+            if n < last:
+                vals = taus[n]
+                tolerance = vals[at] if at < len(vals) else -inf
+            elif at < len(spans):  # the longest plan: its staircase's tau at arc `at`
+                x = spans[at]
+                tolerance = 0.5 * (w0 - x) if n == 1 else _stair_top(top_tau, widths, x)[0]
+            else:
+                tolerance = -inf
+            if not tolerance >= passing:  # pragma: no cover - the lengths guarantee a chain
+                raise PlanningError("internal error: no witness chain for a plan the lengths allow")
+        # chain_option, witness by witness: the first placed by the prior, each later one
+        # picked by its staircase for the span of the one before (Arc.span: s_last - s),
+        # the turn centring that image in it; each turn made short as short_turns makes
+        # it (wrap, then wrap_period of the gripper's period, the rest carried on).
+        i = rows[at]
+        a = lo[i]
+        if uniform:  # the first turn, start - a, is a - a = +0.0: already short, carry 0.0
+            start = a
+            steps = [zero]
+            carry = 0.0
+        else:
+            start = prior.max_arc_mass(length if length < cap else cap, group, prefer=a)[1]
+            steps, carry = short_turns((action,), (start - a,))
+        arc = (a + widths[at]) - a  # Arc.width
+        m = n
+        while m:
+            s = stable[i]
+            s_last = s + spans[at]
+            if m == 1:
+                at = 0  # the last action's staircase picks arc 0
+            elif m == last:
+                at = _stair_top(top_tau, widths, s_last - s)[1]
+            else:
+                idx, rest, wid, c = stairs[m]
+                x = s_last - s
+                r = left(c, x)
+                at = idx[r if rest[r] >= 0.5 * (wid[r] - x) else r - 1]
+            i = rows[at]
+            a = lo[i]
+            turn = 0.5 * (s + s_last) - 0.5 * (a + (a + widths[at])) + carry
+            if neg_half < turn < half:  # as short as it gets: wrap and wrap_period keep it
+                short = turn
+                carry = 0.0  # turn - turn
+            else:
+                wrapped = remainder(turn, two_pi)
+                if wrapped == neg_pi:
+                    wrapped = pi
+                short = remainder(wrapped, g)
+                if short == neg_half:
+                    short = half
+                carry = wrapped - short
+            made = new(PlanStep)
+            set_kind(made, kind)
+            set_alpha(made, short)
+            steps.append(made)
+            m -= 1
+        final = math.fmod(stable[i] + carry + two_pi, two_pi)
+        option = new(PlanOption)
+        set_steps(option, tuple(steps))
+        set_final(option, final)
+        set_p(option, probs[n])
+        set_cost(option, costs[n])
+        set_tolerance(option, tolerance)
+        set_arc(option, (start, start + arc))
+        out.append(option)
+    return new_result(problem, tuple(out), bayes, most, "exact")
+
+
+def _stair_top(tau: list[float], widths: list[float], x: float) -> tuple[float, int]:
+    """``tau`` at span ``x`` of the staircase made from ``tau``, and the front arc it picks.
+
+    ``tau`` is the (finite, non-increasing) ``tau`` of the staircase after it at the front's
+    arcs ``0, 1, ..``, ``widths`` the front's widths. That staircase's entries are the arcs
+    ``n`` with ``tau[n] > tau[n + 1]`` and the last (arcs.staircase's scan from the widest
+    down keeps an arc whose rest exceeds every wider arc's), with ``c = w - 2 tau``
+    non-decreasing along them; its ``tau(x)`` and pick are decided by the first entry with
+    ``c >= x`` and the one before (:meth:`~bayesgrasp.planning.arcs.Staircase.tau`,
+    :meth:`~bayesgrasp.planning.arcs.Staircase.pick`). Found from the widest entry down,
+    for spans near the widest (the longest plan's first witness and its image) in a few
+    steps, without the staircase: the same floats and the same arc.
+    """
+    n = len(tau) - 1
+    if n < 0:  # pragma: no cover - the lengths guarantee a chain
+        return -math.inf, -1
+    if widths[n] - 2.0 * tau[n] < x:  # past the widest entry: (W - x) / 2 of the widest
+        return 0.5 * (widths[n] - x), n
+    cur = n  # the least entry so far with c >= x
+    m = n - 1
+    while m >= 0:
+        v = tau[m]
+        if v > tau[m + 1]:  # an entry
+            if widths[m] - 2.0 * v < x:  # the entry before the first with c >= x
+                before = 0.5 * (widths[m] - x)
+                value = tau[cur]
+                return (value, cur) if value >= before else (before, m)
+            cur = m
+        m -= 1
+    return tau[cur], cur
+
+
+def _choose(options: list[Scored], p_tol: float, report: Report) -> tuple[list[Scored], int, int]:
+    """The options to report, and the indices of the Bayes and the most certain among them."""
+    bayes, most = choose_among([o[1] for o in options], [o[0] for o in options], p_tol)
     if report == "best":  # as PlanResult.best_only, before the angles are computed
         keep = sorted({bayes, most})
         return [options[i] for i in keep], keep.index(bayes), keep.index(most)

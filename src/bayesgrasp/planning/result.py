@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Literal, Protocol, runtime_checkable
+from typing import Any, Literal, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -329,29 +329,24 @@ def choose_among(
     """
     if not costs:
         raise ValueError("no plans to choose among")
-    # Loops, not min/max and generators: the exact planner calls this for every part.
-    cost = []
+    # Loops, not min/max and generators: the exact planner calls this for every part. The
+    # values are floats (or numpy's, which compare and subtract as floats do).
     m = math.inf
-    for x in costs:
-        c = float(x)
-        cost.append(c)
+    for c in costs:
         if c < m:
             m = c
     bayes = 0
     if math.isfinite(m):
         slack = COST_RTOL * abs(m)
-        while cost[bayes] - m > slack:
+        while costs[bayes] - m > slack:
             bayes += 1
-    prob = []
     top = -math.inf
-    for x in probs:
-        q = float(x)
-        prob.append(q)
+    for q in probs:
         if q > top:
             top = q
     top -= tol
     most = 0
-    while not prob[most] >= top:
+    while not probs[most] >= top:
         most += 1
     return bayes, most
 
@@ -437,6 +432,15 @@ _set_kind, _set_alpha = (vars(PlanStep)[name].__set__ for name in ("kind", "alph
 _set_option = [vars(PlanOption)[name].__set__ for name in PlanOption.__slots__]
 
 
+def slot_setters(cls: type[PlanStep | PlanOption | PlanResult]) -> list[Callable[[Any, Any], None]]:
+    """The setters of the fields of a plan step, option or result, in field order.
+
+    For a planner that makes these objects in its own loop, as :func:`short_turns` does:
+    ``object.__new__(cls)``, then every field set.
+    """
+    return _SETTERS[cls]
+
+
 def new_option(
     steps: tuple[PlanStep, ...],
     final_orientation: float,
@@ -458,6 +462,11 @@ def new_option(
 
 
 _set_result = [vars(PlanResult)[name].__set__ for name in PlanResult.__slots__]
+_SETTERS: dict[type, list[Callable[[Any, Any], None]]] = {
+    PlanStep: [_set_kind, _set_alpha],
+    PlanOption: _set_option,
+    PlanResult: _set_result,
+}
 
 
 def new_result(
@@ -469,10 +478,15 @@ def new_result(
 ) -> PlanResult:
     """``PlanResult(problem, options, bayes, most_certain, method)``, made faster."""
     out = _new(PlanResult)
-    for setter, value in zip(
-        _set_result, (problem, options, bayes, most_certain, method, None, "ok", None), strict=True
-    ):
-        setter(out, value)
+    a, b, c, d, e, f, g, h = _set_result
+    a(out, problem)
+    b(out, options)
+    c(out, bayes)
+    d(out, most_certain)
+    e(out, method)
+    f(out, None)
+    g(out, "ok")
+    h(out, None)
     return out
 
 
