@@ -119,6 +119,11 @@ _ClickException: type[Exception] = next(
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     args = sys.argv[1:] if argv is None else list(argv)
+    from .batch import fast_main
+
+    code = fast_main(args)  # plan --batch FILE with problem options: without typer
+    if code is not None:
+        return code
     try:
         rv = app(args=args or ["--help"], prog_name="bayesgrasp", standalone_mode=False)
     except _ClickException as exc:  # bad usage: one line, exit 2
