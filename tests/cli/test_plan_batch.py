@@ -178,25 +178,3 @@ def test_batch_lines_are_json_dumps_of_each_document(
         assert (code, err) == (0, "")
         expected = [json.dumps(single(capsys, p, *options), allow_nan=False) for p in parts]
         assert out.splitlines() == expected
-
-
-def test_a_line_appends_the_shared_provenance_text() -> None:
-    """``_line`` is ``json.dumps`` whatever the document, its provenance encoded once."""
-    from bayesgrasp.cli.plan import _line
-
-    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
-    shared = {"version": "0", "prior": {"kind": "uniform"}, "accuracy_rad": 0.0}
-    other = {**shared, "flatten_tolerance": 0.01}
-    docs: list[dict[str, Any]] = [
-        {"schema": "s", "bayes": 1, "provenance": shared},
-        {"schema": "s", "options": [{"a": 0.1}], "provenance": shared},
-        {"schema": "s", "provenance": other},
-        {"part": "b.jsonl:3", "error": "bad", "exit_code": 2},  # no provenance
-        {"provenance": shared},  # alone
-        {"provenance": shared, "schema": "s"},  # not last
-        {"schema": "s", "provenance": shared},
-    ]
-    texts: dict[str, Any] = {}
-    for doc in docs:
-        expected = json.dumps(doc, allow_nan=False)
-        assert _line(dict(doc), encode, texts) == expected

@@ -164,11 +164,22 @@ _CHOICES = {
 }
 
 
-def _options() -> dict[str, str]:
-    """The valued options the batch parser reads: each option and its parameter's name."""
+def _cost_kinds() -> list[str] | None:
+    """The kinds with cost options: the registry's, as ``plan`` would be decorated now.
+
+    ``None`` when ``plan`` was loaded with other kinds (an action registered since): its
+    options are typer's to read.
+    """
     from ..model.actions import ACTIONS
 
-    names = list(ACTIONS)  # as problem_options: one cost option per registered kind
+    names = list(ACTIONS)
+    options = sys.modules.get(f"{__package__}.options")
+    made = None if options is None else options.COST_KINDS.get(f"{__package__}.plan.plan")
+    return names if made is None or made == tuple(names) else None
+
+
+def _options(names: list[str]) -> dict[str, str]:
+    """The valued options the batch parser reads: each option and its parameter's name."""
     out = {"--batch": "batch", "--prior": "prior", "--actions": "actions"}
     out |= {"--goal": "goal", "--method": "method", "--only": "only"}
     out |= {"--accuracy": "accuracy", "--max-squeezes": "max_squeezes"}
@@ -191,12 +202,12 @@ def parse_batch_args(args: list[str]) -> tuple[Path, ProblemSpec, bool, bool] | 
 
     The spec is the one ``plan`` builds from the same arguments (:func:`problem_spec`).
     """
-    from ..model.actions import ACTIONS
     from ..model.cost import MAX_COST
 
-    if not args or args[0] != "plan":
+    names = _cost_kinds()
+    if not args or args[0] != "plan" or names is None:
         return None
-    options = _options()
+    options = _options(names)
     given: dict[str, str] = {}
     flags: set[str] = set()
     rest = iter(args[1:])
@@ -217,7 +228,6 @@ def parse_batch_args(args: list[str]) -> tuple[Path, ProblemSpec, bool, bool] | 
     for key, choices in _CHOICES.items():
         if given.get(options[key], choices[0]) not in choices:
             return None
-    names = list(ACTIONS)
     values: dict[str, Any] = {"prior": given.get("prior"), "actions": given.get("actions")}
     values["actions"] = values["actions"] or "squeeze"
     defaults: dict[str, float | None] = {"verify_cost": 1.0, "retry_cost": 0.0}
