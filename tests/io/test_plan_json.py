@@ -124,6 +124,9 @@ def test_other_value_types_are_written_as_the_encoder_writes_them() -> None:
         _with_option(res, final_orientation=True),  # a bool: the general path
         _with_option(res, expected_cost=math.inf, tolerance=math.nan),  # null, null
         dataclasses.replace(res, nodes=17),
+        _with_option(res, final_orientation=-0.0),  # not the text of 0.0
+        _with_option(res, final_orientation=np.float64(res.problem.states.stable[1])),
+        _with_option(res, final_orientation=int(res.problem.states.stable[1])),
     ]
     for case in cases:
         same(case)

@@ -448,9 +448,15 @@ def _array(values: Any) -> str:
     return repr(values.tolist())
 
 
-def _option_text(option: PlanOption) -> str:
-    """:func:`option_document` as JSON text (each angle's repr made once)."""
+def _option_text(option: PlanOption, known: Mapping[float, str]) -> str:
+    """:func:`option_document` as JSON text (each angle's repr made once).
+
+    ``known``: texts already made of non-zero floats (the stable orientations, which the
+    final orientations are), by value.
+    """
     steps = option.steps
+    final = option.final_orientation
+    end = known.get(final) if type(final) is float and final else None
     alphas = [_float(s.alpha) for s in steps]
     walk = ", ".join(
         [
@@ -462,7 +468,7 @@ def _option_text(option: PlanOption) -> str:
     return (
         f'{{"squeezes": {len(steps)}, "actions_rad": [{", ".join(alphas[1:])}], '
         f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
-        f'"final_orientation_rad": {_float(option.final_orientation)}, '
+        f'"final_orientation_rad": {end or _float(final)}, '
         f'"success_probability": {_float(option.success_probability)}, '
         f'"expected_cost": {"null" if cost is None else _float(cost)}, '
         f'"tolerance_rad": {"null" if tol is None else _float(tol)}}}'
@@ -486,17 +492,22 @@ def _document_text(
     hull = part.hull
     units = "" if part.units is None else f', "units": {_text(part.units)}'
     probs = pb.state_distribution(bayes.first_angle, bayes.steps[0].kind)
+    if pb.states.stable.dtype.char != "d":
+        return None
+    stable = pb.states.stable.tolist()
+    texts = [_float(x) for x in stable]  # (0.0 and -0.0 are equal keys: zero is left out)
+    known = {x: t for x, t in zip(stable, texts, strict=True) if x}
     text = [
         f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
         f'"vertices": {_array(hull.vertices)}, "n_sides": {_int(hull.n_sides)}, '
         f'"symmetry_order": {_int(hull.symmetry_order)}{units}, '
         f'"center_of_mass": {_array(part.center_of_mass)}, "id": {_text(part_id(part))}}}, '
         f'"method": {_text(result.method)}, '
-        f'"stable_orientations_rad": {_array(pb.states.stable)}, '
+        f'"stable_orientations_rad": [{", ".join(texts)}], '
         f'"stable_probabilities": {_array(probs)}, '
         f'"period_rad": {_float(float(pb.states.period))}, '
         f'"first_squeeze_rad": {_float(bayes.first_angle)}, '
-        f'"options": [{", ".join([_option_text(o) for o in result.options])}], '
+        f'"options": [{", ".join([_option_text(o, known) for o in result.options])}], '
         f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
     ]
     if result.nodes is not None:
