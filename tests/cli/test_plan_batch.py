@@ -178,3 +178,21 @@ def test_batch_lines_are_json_dumps_of_each_document(
         assert (code, err) == (0, "")
         expected = [json.dumps(single(capsys, p, *options), allow_nan=False) for p in parts]
         assert out.splitlines() == expected
+
+
+def test_a_line_that_is_not_utf8_is_reported_in_its_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    batch = tmp_path / "latin.jsonl"
+    batch.write_bytes(
+        b'"house"\n{"name": "caf\xe9", "vertices": [[0, 0], [1, 0], [0, 1]]}\n"key"\n'
+    )
+    code, out, err = run(capsys, "plan", "--batch", str(batch))
+    docs = lines(out)
+    assert (code, err, len(docs)) == (2, "", 3)
+    assert docs[1] == {
+        "part": f"{batch}:2",
+        "error": f"{batch}:2: not UTF-8 text; save the file as UTF-8",
+        "exit_code": 2,
+    }
+    assert docs[0] == single(capsys, "house") and docs[2] == single(capsys, "key")

@@ -120,8 +120,8 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
     if batch is None:
         return
     stream = sys.stdin if str(batch) == "-" else None
-    try:
-        handle = stream or batch.open(encoding="utf-8")
+    try:  # a byte that is not UTF-8 is kept (as a lone surrogate) for its line to report
+        handle = stream or batch.open(encoding="utf-8", errors="surrogateescape")
     except OSError as exc:
         raise BatchFileError(f"cannot read {batch}: {exc.strerror or exc}") from None
     with handle:
@@ -132,6 +132,8 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
             label = f"{batch}:{number}"
 
             def load(text: str = text, label: str = label) -> Part:
+                if not text.isascii() and not _utf8(text):
+                    raise PartFileError(f"{label}: not UTF-8 text; save the file as UTF-8")
                 found = json_line_part(text, label)  # a part object, parsed once
                 if found is not None:
                     return found
@@ -148,6 +150,15 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
                 )
 
             yield label, load
+
+
+def _utf8(text: str) -> bool:
+    """Whether the text was read from UTF-8 (holds no byte kept as a lone surrogate)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 # The batch's own parser: a value it accepts is one typer would accept and convert to the
