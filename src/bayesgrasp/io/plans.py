@@ -40,11 +40,11 @@ Examples
 
 from __future__ import annotations
 
-import array
 import hashlib
 import json
 import math
 import os
+import struct
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -157,7 +157,8 @@ def _small_id_bytes(part: Part, q: float) -> bytes | None:
             return None
         pts.append((round(u), round(v)))
     start = pts.index(min(pts))  # the first lexicographically least, as numpy's path
-    return array.array("q", [c for p in pts[start:] + pts[:start] for c in p]).tobytes()
+    # int64 in the machine's order, as array("q", ...).tobytes() (long long, 8 bytes)
+    return struct.pack(f"{2 * len(pts)}q", *[c for p in pts[start:] + pts[:start] for c in p])
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
@@ -314,9 +315,13 @@ def guaranteed_document(plan: GuaranteedPlan) -> dict[str, Any]:
 
 def plan_schema(problem: Problem, guaranteed: bool = False) -> str:
     """The schema of a plan document: plan/1 for squeezes alone, else plan/2."""
-    if guaranteed or any(name != SQUEEZE.name for name in problem.action_kinds):
+    kinds = problem.action_kinds
+    if guaranteed or (kinds != _SQUEEZES and any(name != SQUEEZE.name for name in kinds)):
         return PLAN_SCHEMA_2
     return PLAN_SCHEMA_1
+
+
+_SQUEEZES = (SQUEEZE.name,)
 
 
 def plan_document(
@@ -458,21 +463,27 @@ def _option_text(option: PlanOption, known: Mapping[float, str]) -> str:
     final = option.final_orientation
     end = known.get(final) if type(final) is float and final else None
     alphas = [_float(s.alpha) for s in steps]
-    walk = ", ".join(
-        [
-            f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}'
-            for s, a in zip(steps, alphas, strict=True)
-        ]
-    )
-    cost, tol = json_float(option.expected_cost), json_float(option.tolerance)
+    if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
+        walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
+    else:
+        pairs = zip(steps, alphas, strict=True)
+        walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
+    # json_float's null for a missing or non-finite value (a non-float: the general path)
+    cost, tol = option.expected_cost, option.tolerance
     return (
         f'{{"squeezes": {len(steps)}, "actions_rad": [{", ".join(alphas[1:])}], '
         f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
         f'"final_orientation_rad": {end or _float(final)}, '
         f'"success_probability": {_float(option.success_probability)}, '
-        f'"expected_cost": {"null" if cost is None else _float(cost)}, '
-        f'"tolerance_rad": {"null" if tol is None else _float(tol)}}}'
+        f'"expected_cost": {"null" if cost is None or not math.isfinite(cost) else _float(cost)}, '
+        f'"tolerance_rad": {"null" if tol is None or not math.isfinite(tol) else _float(tol)}}}'
     )
+
+
+# A squeeze step's text but its angle: before the first angle, and between two angles.
+_SQUEEZE_KIND = {SQUEEZE.name}
+_SQUEEZE_STEP = f'{{"type": {_text(SQUEEZE.name)}, "alpha_rad": '
+_SQUEEZE_NEXT = f"}}, {_SQUEEZE_STEP}"
 
 
 def _document_text(
@@ -539,11 +550,14 @@ def _shared_provenance(
     if memo is None:
         return provenance(pb, method, **dict(inputs or {}))
     same = (pb.prior, pb.cost, pb.goal, inputs)  # frozen values: compared as objects
-    alike = (pb.actions, pb.accuracy, method, getattr(pb.part, "curve_error", 0.0))
+    used = 0.0 if type(pb.part) is Part else getattr(pb.part, "curve_error", 0.0)
+    alike = (pb.actions, pb.accuracy, method, used)
     last = memo.get("provenance")
-    if last is not None and all(a is b for a, b in zip(last[0], same, strict=True)):
-        if last[1] == alike:
-            return last[2]  # type: ignore[no-any-return]
+    if last is not None:
+        (prior, cost, goal, given), was, doc = last
+        if prior is same[0] and cost is same[1] and goal is same[2] and given is inputs:
+            if was == alike:
+                return doc  # type: ignore[no-any-return]
     doc = provenance(pb, method, **dict(inputs or {}))
     memo["provenance"] = (same, alike, doc)
     return doc
