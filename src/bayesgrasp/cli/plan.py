@@ -163,7 +163,14 @@ def plan(
     if batch is not None or more_parts:
         if plot_file is not None:
             raise typer.BadParameter("--plot takes one PART", param_hint="--plot")
-        _many(part, more_parts or [], batch, spec, guaranteed, only is Only.best)
+        from .batch import BatchFileError, run_batch
+
+        try:
+            code = run_batch(part, more_parts or [], batch, spec, guaranteed, only is Only.best)
+        except BatchFileError as exc:
+            raise typer.BadParameter(str(exc), param_hint="--batch") from None
+        if code:
+            raise typer.Exit(code)
         return
     if part.part is None:
         raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
@@ -197,22 +204,3 @@ def plan(
         typer.echo(f"bayesgrasp: wrote {export}", err=True)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)
-
-
-def _many(
-    part: PartSpec,
-    more: list[str],
-    batch: Path | None,
-    spec: ProblemSpec,
-    guaranteed: bool,
-    best_only: bool,
-) -> None:
-    """:func:`~bayesgrasp.cli.batch.run_batch`, its usage error and exit code typer's."""
-    from .batch import BatchFileError, run_batch
-
-    try:
-        code = run_batch(part, more, batch, spec, guaranteed, best_only)
-    except BatchFileError as exc:
-        raise typer.BadParameter(str(exc), param_hint="--batch") from None
-    if code:
-        raise typer.Exit(code)
