@@ -5,8 +5,7 @@ One module per command group: :mod:`.parts` (squeeze, push), :mod:`.plan`, :mod:
 :mod:`.options`, the helpers in :mod:`.common`. A command's module is imported only when
 the command runs (or shows its help), and the library only inside the command's body, so
 ``bayesgrasp --help`` loads no planner, figure or simulation code. The typer app is
-:mod:`._typer`, imported when first needed: ``plan --batch FILE`` with problem options only
-runs without typer (:func:`.batch.fast_main`).
+:mod:`._typer`, imported when first needed.
 
 Exit codes: 0 success, 1 no plan reached the requested goal, 2 bad input (one line on
 stderr, never a traceback). Bare ``bayesgrasp`` prints the help, as ``--help`` does.
@@ -38,19 +37,13 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 """Each command: the module that defines it, and its line in the command list."""
 
-# The typer app (and typer) are imported when first needed: plan --batch runs without them.
+# The typer app (and typer) are imported when first needed.
 __getattr__, __dir__ = lazy_names(__name__, {"app": "_typer"})
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; return the exit code."""
     args = sys.argv[1:] if argv is None else list(argv)
-    if args[:1] == ["plan"] and any(a.partition("=")[0] == "--batch" for a in args):
-        from .batch import fast_main
-
-        code = fast_main(args)  # plan --batch FILE with problem options: without typer
-        if code is not None:
-            return code
     from ._typer import run
 
     return run(args)

@@ -256,13 +256,7 @@ def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:
         from ..model.actions import ACTIONS
 
         names = list(ACTIONS)  # the kinds registered now: one cost option each
-        COST_KINDS[f"{func.__module__}.{func.__qualname__}"] = tuple(names)
         params = _problem_params(names, push_grasp_alias)
         return _replace(func, "spec", params, functools.partial(problem_spec, names))
 
     return decorate
-
-
-COST_KINDS: dict[str, tuple[str, ...]] = {}
-"""The action kinds each command got cost options for when it was decorated (its module's
-loading), by the command function's dotted name (the batch's own parser checks its own)."""
