@@ -93,9 +93,9 @@ def test_help_loads_no_command_module() -> None:
         )
         return list(json.loads(proc.stdout.replace("'", '"')))
 
-    assert loaded("--help") == []
+    assert loaded("--help") == ["bayesgrasp.cli._typer"]  # the app itself
     assert loaded("plan", "--help") == [
-        f"bayesgrasp.cli.{m}" for m in ("common", "options", "plan", "specs")
+        f"bayesgrasp.cli.{m}" for m in ("_typer", "common", "options", "plan", "specs")
     ]
 
 
@@ -297,7 +297,7 @@ def test_a_registered_action_gets_cost_options(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Options are made from the registry when a command module loads (README, Architecture)."""
-    import bayesgrasp.cli as cli
+    import bayesgrasp.cli._typer as cli_typer
     import bayesgrasp.cli.plan as plan_module
     from bayesgrasp.model.actions import Action, register_action, unregister_action
 
@@ -313,7 +313,7 @@ def test_a_registered_action_gets_cost_options(
     register_action(station)
     try:
         importlib.reload(plan_module)
-        cli._commands_of.cache_clear()
+        cli_typer._commands_of.cache_clear()
         doc = run_json(
             capsys, "plan", "house", "--actions", "squeeze,station-x", "--station-x-cost", "0.5"
         )
@@ -325,6 +325,6 @@ def test_a_registered_action_gets_cost_options(
     finally:
         unregister_action("station-x")
         importlib.reload(plan_module)
-        cli._commands_of.cache_clear()
+        cli_typer._commands_of.cache_clear()
     code, _, err = run(capsys, "plan", "house", "--station-x-cost", "1")
     assert code == 2 and "No such option: --station-x-cost" in err

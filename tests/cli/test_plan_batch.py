@@ -180,23 +180,19 @@ def test_batch_lines_are_json_dumps_of_each_document(
         assert out.splitlines() == expected
 
 
-def test_a_line_appends_the_shared_provenance_text() -> None:
-    """``_line`` is ``json.dumps`` whatever the document, its provenance encoded once."""
-    from bayesgrasp.cli.plan import _line
-
-    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
-    shared = {"version": "0", "prior": {"kind": "uniform"}, "accuracy_rad": 0.0}
-    other = {**shared, "flatten_tolerance": 0.01}
-    docs: list[dict[str, Any]] = [
-        {"schema": "s", "bayes": 1, "provenance": shared},
-        {"schema": "s", "options": [{"a": 0.1}], "provenance": shared},
-        {"schema": "s", "provenance": other},
-        {"part": "b.jsonl:3", "error": "bad", "exit_code": 2},  # no provenance
-        {"provenance": shared},  # alone
-        {"provenance": shared, "schema": "s"},  # not last
-        {"schema": "s", "provenance": shared},
-    ]
-    texts: dict[str, Any] = {}
-    for doc in docs:
-        expected = json.dumps(doc, allow_nan=False)
-        assert _line(dict(doc), encode, texts) == expected
+def test_a_line_that_is_not_utf8_is_reported_in_its_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    batch = tmp_path / "latin.jsonl"
+    batch.write_bytes(
+        b'"house"\n{"name": "caf\xe9", "vertices": [[0, 0], [1, 0], [0, 1]]}\n"key"\n'
+    )
+    code, out, err = run(capsys, "plan", "--batch", str(batch))
+    docs = lines(out)
+    assert (code, err, len(docs)) == (2, "", 3)
+    assert docs[1] == {
+        "part": f"{batch}:2",
+        "error": f"{batch}:2: not UTF-8 text; save the file as UTF-8",
+        "exit_code": 2,
+    }
+    assert docs[0] == single(capsys, "house") and docs[2] == single(capsys, "key")

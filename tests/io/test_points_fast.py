@@ -207,3 +207,71 @@ def test_firm_convexity_against_the_pair_test(
     with pytest.MonkeyPatch.context() as mp:
         fast, general = _both(pts_list, mp)
     assert fast == general
+
+
+# Lines of the shape the batch reads without the strict decoder, and near it: numbers of
+# every kind (beyond a float, big integers, booleans, constants), names and extra members.
+_plain_number = st.one_of(
+    st.floats(-1e6, 1e6, allow_nan=False).map(repr), st.integers(-9, 9).map(str)
+)
+_odd_number = st.one_of(
+    st.integers(-(2**60), 2**60).map(str),
+    st.sampled_from(["1e400", "-1e999", "NaN", "Infinity", "true", "null", "1" * 301, "2e-320"]),
+)
+_number_text = st.one_of(_plain_number, _plain_number, _plain_number, _odd_number)
+_point_text = st.one_of(
+    st.tuples(_number_text, _number_text).map(lambda p: f"[{p[0]}, {p[1]}]"),
+    st.lists(_number_text, min_size=1, max_size=3).map(lambda p: f"[{', '.join(p)}]"),
+)
+
+
+_clean_points = st.lists(
+    st.tuples(_plain_number, _plain_number).map(lambda p: f"[{p[0]}, {p[1]}]"),
+    min_size=3,
+    max_size=10,
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    points=st.one_of(_clean_points, st.lists(_point_text, min_size=0, max_size=10)),
+    name=st.sampled_from(['"a"', '"caf\\u00e9"', "5", None]),
+    extra=st.sampled_from([None, '"units": "mm"', '"center_of_mass": [0.1, 0.2]', '"x": 1e400']),
+)
+def test_json_lines_read_as_parse_json(
+    points: list[str], name: str | None, extra: str | None
+) -> None:
+    from bayesgrasp.io._common import ReadOptions
+    from bayesgrasp.io.points import json_line_part, parse_json
+
+    members = [f'"vertices": [{", ".join(points)}]']
+    members += [f'"name": {name}'] if name is not None else []
+    members += [extra] if extra is not None else []
+    line = "{" + ", ".join(members) + "}"
+    fast = _read(json_line_part, line, "b.jsonl:3")
+    general = _read(parse_json, line.encode(), Path("b.jsonl:3"), ReadOptions())
+    if fast is not None:  # None: the batch reads the line the general way
+        assert fast == general
+
+
+def test_simple_lines_skip_the_strict_decoder(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The comparison above sees the C-number path: simple lines never reach _DECODER."""
+    from bayesgrasp.io.points import json_line_part
+
+    used: list[str] = []
+    strict = points_module._DECODER
+
+    class Recording:
+        def decode(self, text: str) -> object:
+            used.append(text)
+            return strict.decode(text)
+
+    monkeypatch.setattr(points_module, "_DECODER", Recording())
+    part = json_line_part('{"name": "w", "vertices": [[0, 0], [3, 0.5], [0, 1]]}', "b.jsonl:1")
+    assert part is not None and part.name == "w"
+    assert json_line_part('{"vertices": [[0, 0], [3, 0], [0, 1]]}', "b.jsonl:2").name == "b"
+    assert used == []
+    # a number beyond a float, or another member: the strict decoder reads the line
+    assert json_line_part('{"vertices": [[0, 0], [3, 0], [0, 1e400]]}', "b.jsonl:3") is None
+    json_line_part('{"vertices": [[0, 0], [3, 0], [0, 1]], "units": "mm"}', "b.jsonl:4")
+    assert len(used) == 2

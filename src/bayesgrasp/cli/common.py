@@ -19,12 +19,14 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
+from .specs import guaranteed_plan as guaranteed_plan  # (re-exported: the web uses them)
+from .specs import run_inputs as run_inputs
+
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
     from ..model.problem import Problem
-    from ..planning.guaranteed import GuaranteedPlan
     from ..planning.result import PlanOption
-    from .specs import PartSpec, ProblemSpec
+    from .specs import ProblemSpec
 
 IMAGE_FORMATS = ("png", "svg", "pdf")
 PLAN_NAMES = {"bayes": "Bayes", "most-certain": "most certain", "guaranteed": "guaranteed"}
@@ -213,14 +215,6 @@ def list_files(files: Sequence[Path], as_json: bool) -> None:
             typer.echo(str(f))
 
 
-def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
-    """The guaranteed plan of a problem, or the reason none exists (a string)."""
-    from ..planning import guaranteed
-
-    found = guaranteed.plan_guaranteed(problem)
-    return found if found.status == "ok" else str(found.reason or "no guaranteed plan")
-
-
 def chosen_plan(
     which: str, spec: ProblemSpec, part: Part, force: bool = False
 ) -> tuple[Problem, PlanOption, str]:
@@ -276,19 +270,6 @@ def _plan_file(
     plan = src.option
     missing = tuple(k for k in plan.kinds if k not in spec.actions)
     return spec.build(part, missing, prior), plan, path.name
-
-
-def run_inputs(part: PartSpec | None, spec: ProblemSpec) -> dict[str, Any]:
-    """What a command adds to a document's provenance: the longest plan, the part-file options.
-
-    Options not given are ``None`` (left out of the document); the web service, which
-    reads no part files, gives ``part=None``.
-    """
-    out: dict[str, Any] = {"max_actions": spec.max_actions}
-    if part is not None:
-        out |= {"format": part.fmt.value if part.fmt else None, "element": part.element}
-        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol, "com": part.com}
-    return out
 
 
 def simulate_inputs(

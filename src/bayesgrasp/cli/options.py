@@ -20,7 +20,7 @@ from typing import Annotated, Any, TypeVar
 import typer
 
 from .common import accuracy_value, cost_value
-from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec
+from .specs import GoalKind, Method, PartFormat, PartSpec, problem_spec
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -219,29 +219,6 @@ def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Pa
     return params
 
 
-def _problem_spec(names: list[str], values: dict[str, Any]) -> ProblemSpec:
-    from ..model.actions import PUSH_GRASP, SQUEEZE
-
-    actions = [a.strip() for a in values["actions"].split(",") if a.strip()]
-    if values.get("push_grasp"):  # exactly --actions squeeze,push-grasp (order breaks ties)
-        actions = [SQUEEZE.name, PUSH_GRASP.name, *actions]
-    first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
-    given = frozenset(k for k in ("prior", "goal") if values[k] is not None)
-    return ProblemSpec(
-        prior=values["prior"] or "uniform",
-        costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
-        first={n: c for n, c in first.items() if c is not None},
-        verify=values["verify_cost"],
-        retry=values["retry_cost"],
-        goal=values["goal"] or GoalKind.single,
-        actions=tuple(dict.fromkeys(actions)),
-        accuracy_deg=values["accuracy"],
-        method=values["method"],
-        max_actions=values["max_squeezes"],
-        given=given,
-    )
-
-
 def _replace(func: F, name: str, params: list[inspect.Parameter], make: Callable[..., Any]) -> F:
     """``func`` with its parameter ``name`` replaced by ``params``, whose values ``make`` joins."""
     sig = inspect.signature(func, eval_str=True)
@@ -280,6 +257,6 @@ def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:
 
         names = list(ACTIONS)  # the kinds registered now: one cost option each
         params = _problem_params(names, push_grasp_alias)
-        return _replace(func, "spec", params, functools.partial(_problem_spec, names))
+        return _replace(func, "spec", params, functools.partial(problem_spec, names))
 
     return decorate

@@ -4,11 +4,8 @@ from __future__ import annotations
 
 import enum
 import functools
-import json
-import sys
-from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated
 
 import typer
 
@@ -38,9 +35,6 @@ from .options import (
     problem_options,
 )
 from .specs import PartSpec, ProblemSpec, SenseSpec
-
-if TYPE_CHECKING:
-    from ..geometry.polygon import Part
 
 app = command_app()
 
@@ -169,7 +163,14 @@ def plan(
     if batch is not None or more_parts:
         if plot_file is not None:
             raise typer.BadParameter("--plot takes one PART", param_hint="--plot")
-        _many(part, more_parts or [], batch, spec, guaranteed, only is Only.best)
+        from .batch import BatchFileError, run_batch
+
+        try:
+            code = run_batch(part, more_parts or [], batch, spec, guaranteed, only is Only.best)
+        except BatchFileError as exc:
+            raise typer.BadParameter(str(exc), param_hint="--batch") from None
+        if code:
+            raise typer.Exit(code)
         return
     if part.part is None:
         raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
@@ -203,127 +204,3 @@ def plan(
         typer.echo(f"bayesgrasp: wrote {export}", err=True)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)
-
-
-def _many(
-    part: PartSpec,
-    more: list[str],
-    batch: Path | None,
-    spec: ProblemSpec,
-    guaranteed: bool,
-    best_only: bool,
-) -> None:
-    """Plan each part in turn, one JSON document a line; errors stay in their line.
-
-    Each line is what ``plan PART --json`` prints for the part, as ``json.dumps`` writes it
-    on one line. Everything made once per batch is made before the loop: the problem's
-    inputs, the planner, the encoder.
-    """
-    from ..errors import BayesGraspError
-    from ..io.plans import plan_document
-
-    code = 0
-    inputs = run_inputs(part, spec)
-    # json.dumps(doc, allow_nan=False); documents are trees, so no test for cycles
-    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
-    out = sys.stdout
-    build, plan = _builder(spec), spec.planner(best_only)
-    memo: dict[str, Any] = {}  # what the documents share (the provenance)
-    texts: dict[str, Any] = {}  # and its text
-    for label, load in _batch_parts(part, more, batch):
-        try:
-            pb = build(load())
-            result = plan(pb)
-            found = guaranteed_plan(pb) if guaranteed else None
-        except BayesGraspError as exc:
-            doc: dict[str, Any] = {"part": label, "error": str(exc), "exit_code": 2}
-            code = 2
-        else:
-            sure, missing = (None, found) if isinstance(found, str) else (found, None)
-            doc = plan_document(
-                result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs, memo=memo
-            )
-            if missing is not None:
-                code = max(code, 1)
-        out.write(_line(doc, encode, texts) + "\n")  # a line at a time, as typer.echo
-        out.flush()
-    if code:
-        raise typer.Exit(code)
-
-
-def _line(doc: dict[str, Any], encode: Any, texts: dict[str, Any]) -> str:
-    """``encode(doc)``, the provenance shared with the previous line encoded once.
-
-    The encoder writes an object as ``{"key": value, ...}`` (``", "`` and ``": "``), and the
-    provenance is a plan document's last member, so its text can be appended. (``doc`` loses
-    its provenance: it is written and dropped.)
-    """
-    if len(doc) < 2 or next(reversed(doc)) != "provenance":
-        return str(encode(doc))
-    shared = doc.pop("provenance")
-    if texts.get("of") is not shared:
-        texts["of"], texts["text"] = shared, encode(shared)
-    return f'{encode(doc)[:-1]}, "provenance": {texts["text"]}}}'
-
-
-def _builder(spec: ProblemSpec) -> Any:
-    """``spec.build`` for many parts: the prior, costs and goal made once (all immutable).
-
-    When making them fails, every part is built (and fails) the usual way, in its own line.
-    """
-    from ..model.problem import Problem
-
-    try:
-        made = spec.problem_inputs()
-    except Exception:  # any failure: each part meets it as spec.build would
-        return spec.build
-    return functools.partial(Problem.build, **made)
-
-
-def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterator[tuple[str, Any]]:
-    """(label, loader) of each part: PART, the more PARTs, then each line of ``batch``.
-
-    A loader returns the :class:`Part` or raises a BayesGraspError with its one-line reason.
-    """
-    import dataclasses
-
-    from ..errors import PartFileError
-    from ..io import read_part_bytes
-    from ..io.points import json_line_part
-
-    names = ([part.part] if part.part is not None else []) + more
-    for name in names:
-        yield name, dataclasses.replace(part, part=name).load
-    if batch is None:
-        return
-    stream = sys.stdin if str(batch) == "-" else None
-    try:
-        handle = stream or batch.open(encoding="utf-8")
-    except OSError as exc:
-        raise typer.BadParameter(
-            f"cannot read {batch}: {exc.strerror or exc}", param_hint="--batch"
-        ) from None
-    with handle:
-        for number, line in enumerate(handle, start=1):
-            text = line.strip()
-            if not text:
-                continue
-            label = f"{batch}:{number}"
-
-            def load(text: str = text, label: str = label) -> Part:
-                found = json_line_part(text, label)  # a part object, parsed once
-                if found is not None:
-                    return found
-                try:
-                    value = json.loads(text)
-                except ValueError as exc:
-                    raise PartFileError(f"{label}: not a JSON value: {exc}") from None
-                if isinstance(value, str):
-                    return dataclasses.replace(part, part=value).load()
-                if isinstance(value, dict):  # a .json part file on one line
-                    return read_part_bytes(text.encode(), "json", label)
-                raise PartFileError(
-                    f"{label}: expected a part object or a part name; got {type(value).__name__}"
-                )
-
-            yield label, load

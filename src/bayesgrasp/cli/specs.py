@@ -14,6 +14,7 @@ if TYPE_CHECKING:
     from ..model.prior import Prior
     from ..model.problem import Problem
     from ..model.sensing import WidthSensor
+    from ..planning.guaranteed import GuaranteedPlan
     from ..planning.policy import Policy
     from ..planning.result import PlanReport
 
@@ -172,6 +173,36 @@ class ProblemSpec:
         return functools.partial(plan_exact, max_actions=self.max_actions, report=report)
 
 
+def problem_spec(names: list[str], values: Mapping[str, Any]) -> ProblemSpec:
+    """The :class:`ProblemSpec` of the problem options' values, keyed as the parameters.
+
+    ``names``: the action kinds with a cost option each (``cost_0`` is ``--NAME-cost`` of
+    ``names[0]``, ``first_0`` its ``--first-NAME-cost``); ``None`` is an option not given.
+    The command line (:func:`bayesgrasp.cli.options.problem_options`) and the batch's own
+    parser (:mod:`bayesgrasp.cli.batch`) both make their spec here.
+    """
+    from ..model.actions import PUSH_GRASP, SQUEEZE
+
+    actions = [a.strip() for a in values["actions"].split(",") if a.strip()]
+    if values.get("push_grasp"):  # exactly --actions squeeze,push-grasp (order breaks ties)
+        actions = [SQUEEZE.name, PUSH_GRASP.name, *actions]
+    first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
+    given = frozenset(k for k in ("prior", "goal") if values[k] is not None)
+    return ProblemSpec(
+        prior=values["prior"] or "uniform",
+        costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
+        first={n: c for n, c in first.items() if c is not None},
+        verify=values["verify_cost"],
+        retry=values["retry_cost"],
+        goal=values["goal"] or GoalKind.single,
+        actions=tuple(dict.fromkeys(actions)),
+        accuracy_deg=values["accuracy"],
+        method=values["method"],
+        max_actions=values["max_squeezes"],
+        given=given,
+    )
+
+
 @dataclass(frozen=True, slots=True)
 class SenseSpec:
     """``--sense`` and the options of a sensing policy (plan, simulate and plot --sense)."""
@@ -203,3 +234,24 @@ class SenseSpec:
             part_prior=self.part_prior,
         )
         return problems, pol
+
+
+def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
+    """The guaranteed plan of a problem, or the reason none exists (a string)."""
+    from ..planning import guaranteed
+
+    found = guaranteed.plan_guaranteed(problem)
+    return found if found.status == "ok" else str(found.reason or "no guaranteed plan")
+
+
+def run_inputs(part: PartSpec | None, spec: ProblemSpec) -> dict[str, Any]:
+    """What a command adds to a document's provenance: the longest plan, the part-file options.
+
+    Options not given are ``None`` (left out of the document); the web service, which
+    reads no part files, gives ``part=None``.
+    """
+    out: dict[str, Any] = {"max_actions": spec.max_actions}
+    if part is not None:
+        out |= {"format": part.fmt.value if part.fmt else None, "element": part.element}
+        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol, "com": part.com}
+    return out

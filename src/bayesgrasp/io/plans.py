@@ -40,11 +40,11 @@ Examples
 
 from __future__ import annotations
 
-import array
 import hashlib
 import json
 import math
 import os
+import struct
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -76,6 +76,7 @@ __all__ = [
     "part_document",
     "part_id",
     "plan_document",
+    "plan_document_json",
     "plan_schema",
     "prior_document",
     "prior_from_document",
@@ -156,7 +157,8 @@ def _small_id_bytes(part: Part, q: float) -> bytes | None:
             return None
         pts.append((round(u), round(v)))
     start = pts.index(min(pts))  # the first lexicographically least, as numpy's path
-    return array.array("q", [c for p in pts[start:] + pts[:start] for c in p]).tobytes()
+    # int64 in the machine's order, as array("q", ...).tobytes() (long long, 8 bytes)
+    return struct.pack(f"{2 * len(pts)}q", *[c for p in pts[start:] + pts[:start] for c in p])
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
@@ -313,9 +315,13 @@ def guaranteed_document(plan: GuaranteedPlan) -> dict[str, Any]:
 
 def plan_schema(problem: Problem, guaranteed: bool = False) -> str:
     """The schema of a plan document: plan/1 for squeezes alone, else plan/2."""
-    if guaranteed or any(name != SQUEEZE.name for name in problem.action_kinds):
+    kinds = problem.action_kinds
+    if guaranteed or (kinds != _SQUEEZES and any(name != SQUEEZE.name for name in kinds)):
         return PLAN_SCHEMA_2
     return PLAN_SCHEMA_1
+
+
+_SQUEEZES = (SQUEEZE.name,)
 
 
 def plan_document(
@@ -384,6 +390,159 @@ def plan_document(
     return out
 
 
+# json.dumps(doc, allow_nan=False) without its argument checks (documents are trees).
+_encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
+# What json.dumps writes a str and a float with (ensure_ascii; a float's repr, as the C
+# encoder's, subclasses such as numpy's float64 too; anything else raises TypeError).
+_text = json.encoder.encode_basestring_ascii
+_float = float.__repr__
+
+
+def plan_document_json(
+    result: PlanReport,
+    *,
+    guaranteed: GuaranteedPlan | None = None,
+    guaranteed_missing: str | None = None,
+    inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
+) -> str:
+    """``json.dumps(plan_document(...), allow_nan=False)``, written without the dicts.
+
+    The same text, byte for byte (``plan --batch`` writes one a line), made from the
+    result's values: each float by its ``repr`` as the encoder writes it, each list of
+    floats by the list's ``repr`` (the same text for finite Python floats), the provenance
+    shared through ``memo`` encoded once. A value the template does not know (a non-float
+    where it writes floats, a curved part, a non-finite number the encoder refuses) makes
+    :func:`plan_document` and the encoder decide, so their result or error is this one's.
+
+    Examples
+    --------
+    >>> from bayesgrasp.model.problem import Problem
+    >>> from bayesgrasp.planning import plan_exact
+    >>> res = plan_exact(Problem.build(Part.from_points([(0, 0), (3, 0), (3, 2), (0, 2)])))
+    >>> plan_document_json(res) == json.dumps(plan_document(res), allow_nan=False)
+    True
+    """
+    try:
+        text = _document_text(result, guaranteed, guaranteed_missing, inputs, memo)
+    except TypeError:  # a value of another type than the template writes
+        text = None
+    if text is None:
+        doc = plan_document(
+            result,
+            guaranteed=guaranteed,
+            guaranteed_missing=guaranteed_missing,
+            inputs=inputs,
+            memo=memo,
+        )
+        return str(_encode(doc))
+    return text
+
+
+def _int(value: Any) -> str:
+    """An int as JSON writes it (``TypeError`` for anything else, a bool too)."""
+    if type(value) is not int:
+        raise TypeError(f"not an int: {value!r}")
+    return str(value)
+
+
+def _array(values: Any) -> str:
+    """A float64 array as JSON writes its ``tolist()``: the list's ``repr`` (Python floats)."""
+    if values.dtype.char != "d":
+        raise TypeError(f"not a float64 array: {values.dtype}")
+    return repr(values.tolist())
+
+
+def _option_text(option: PlanOption, known: Mapping[float, str]) -> str:
+    """:func:`option_document` as JSON text (each angle's repr made once).
+
+    ``known``: texts already made of non-zero floats (the stable orientations, which the
+    final orientations are), by value.
+    """
+    steps = option.steps
+    final = option.final_orientation
+    end = known.get(final) if type(final) is float and final else None
+    alphas = [_float(s.alpha) for s in steps]
+    if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
+        walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
+    else:
+        pairs = zip(steps, alphas, strict=True)
+        walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
+    # json_float's null for a missing or non-finite value (a non-float: the general path)
+    cost, tol = option.expected_cost, option.tolerance
+    return (
+        f'{{"squeezes": {len(steps)}, "actions_rad": [{", ".join(alphas[1:])}], '
+        f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
+        f'"final_orientation_rad": {end or _float(final)}, '
+        f'"success_probability": {_float(option.success_probability)}, '
+        f'"expected_cost": {"null" if cost is None or not math.isfinite(cost) else _float(cost)}, '
+        f'"tolerance_rad": {"null" if tol is None or not math.isfinite(tol) else _float(tol)}}}'
+    )
+
+
+# A squeeze step's text but its angle: before the first angle, and between two angles.
+_SQUEEZE_KIND = {SQUEEZE.name}
+_SQUEEZE_STEP = f'{{"type": {_text(SQUEEZE.name)}, "alpha_rad": '
+_SQUEEZE_NEXT = f"}}, {_SQUEEZE_STEP}"
+
+
+def _document_text(
+    result: PlanReport,
+    guaranteed: GuaranteedPlan | None,
+    guaranteed_missing: str | None,
+    inputs: Mapping[str, Any] | None,
+    memo: dict[str, Any] | None,
+) -> str | None:
+    """The text of :func:`plan_document_json`; ``None`` where the template does not apply."""
+    pb: Problem = result.problem
+    part = pb.part
+    if type(part) is not Part:  # a curved part's member: the general path
+        return None
+    asked = guaranteed is not None or guaranteed_missing is not None
+    bayes = result.bayes_plan
+    hull = part.hull
+    units = "" if part.units is None else f', "units": {_text(part.units)}'
+    probs = pb.state_distribution(bayes.first_angle, bayes.steps[0].kind)
+    if pb.states.stable.dtype.char != "d":
+        return None
+    stable = pb.states.stable.tolist()
+    texts = [_float(x) for x in stable]  # (0.0 and -0.0 are equal keys: zero is left out)
+    known = {x: t for x, t in zip(stable, texts, strict=True) if x}
+    text = [
+        f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
+        f'"vertices": {_array(hull.vertices)}, "n_sides": {_int(hull.n_sides)}, '
+        f'"symmetry_order": {_int(hull.symmetry_order)}{units}, '
+        f'"center_of_mass": {_array(part.center_of_mass)}, "id": {_text(part_id(part))}}}, '
+        f'"method": {_text(result.method)}, '
+        f'"stable_orientations_rad": [{", ".join(texts)}], '
+        f'"stable_probabilities": {_array(probs)}, '
+        f'"period_rad": {_float(float(pb.states.period))}, '
+        f'"first_squeeze_rad": {_float(bayes.first_angle)}, '
+        f'"options": [{", ".join([_option_text(o, known) for o in result.options])}], '
+        f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
+    ]
+    if result.nodes is not None:
+        text.append(f', "nodes": {_int(result.nodes)}')
+    if pb.accuracy > 0:
+        text.append(f', "accuracy_rad": {_float(pb.accuracy)}')
+    if guaranteed is not None:
+        text.append(f', "guaranteed": {_encode(guaranteed_document(guaranteed))}')
+    elif guaranteed_missing is not None:
+        text.append(f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}')
+    done = "".join(text)
+    # A float that is not finite is written nan, inf or -inf, which the encoder refuses; no
+    # key above holds these letters, so a string that does (a name) only costs the general
+    # path.
+    if "nan" in done or "inf" in done:
+        return None
+    provenance = _shared_provenance(pb, result.method, inputs, memo)
+    if memo is None:
+        return f'{done}, "provenance": {_encode(provenance)}}}'
+    if memo.get("provenance_of") is not provenance:  # encoded once for the documents sharing it
+        memo["provenance_of"], memo["provenance_text"] = provenance, _encode(provenance)
+    return f'{done}, "provenance": {memo["provenance_text"]}}}'
+
+
 def _shared_provenance(
     pb: Problem, method: str, inputs: Mapping[str, Any] | None, memo: dict[str, Any] | None
 ) -> dict[str, Any]:
@@ -391,11 +550,14 @@ def _shared_provenance(
     if memo is None:
         return provenance(pb, method, **dict(inputs or {}))
     same = (pb.prior, pb.cost, pb.goal, inputs)  # frozen values: compared as objects
-    alike = (pb.actions, pb.accuracy, method, getattr(pb.part, "curve_error", 0.0))
+    used = 0.0 if type(pb.part) is Part else getattr(pb.part, "curve_error", 0.0)
+    alike = (pb.actions, pb.accuracy, method, used)
     last = memo.get("provenance")
-    if last is not None and all(a is b for a, b in zip(last[0], same, strict=True)):
-        if last[1] == alike:
-            return last[2]  # type: ignore[no-any-return]
+    if last is not None:
+        (prior, cost, goal, given), was, doc = last
+        if prior is same[0] and cost is same[1] and goal is same[2] and given is inputs:
+            if was == alike:
+                return doc  # type: ignore[no-any-return]
     doc = provenance(pb, method, **dict(inputs or {}))
     memo["provenance"] = (same, alike, doc)
     return doc

@@ -27,6 +27,7 @@ import dataclasses
 import json
 import math
 import numbers
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -168,6 +169,17 @@ def _turns(ring: list[tuple[float, float]]) -> list[tuple[float, float, float]]:
     return out
 
 
+def _bends(ring: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """(cross, dot) at each vertex of the ring: :func:`_turns` without the edge lengths."""
+    n = len(ring)
+    out = []
+    for i in range(n):
+        (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
+        ux, uy, wx, wy = bx - ax, by - ay, cx - bx, cy - by
+        out.append((ux * wy - uy * wx, ux * wx + uy * wy))
+    return out
+
+
 def _near(value: float, threshold: float) -> bool:
     """Whether ``value`` is too close to ``threshold`` for math.hypot to decide."""
     return abs(value - threshold) <= _BAND * abs(threshold)
@@ -230,11 +242,12 @@ def _small_is_convex(
 _FIRM = 2e-12
 
 
-def _convex_once(ring: list[tuple[float, float]], turns: list[tuple[float, float, float]]) -> bool:
+def _convex_once(ring: list[tuple[float, float]], turns: Sequence[tuple[float, ...]]) -> bool:
     """Whether the ring is firmly convex: every turn one way, by a margin, winding once.
 
     Then :func:`_small_is_simple` and :func:`_small_is_convex` both return True, found in
     O(N) rather than their O(N^2) pairs of edges; ``False`` means only "not shown here".
+    ``turns``: the (cross, dot, ...) of :func:`_bends` or :func:`_turns` at each vertex.
 
     Why: a ring that turns one way at every vertex and once in all (exterior angles in
     (0, pi) summing to 2 pi) is a convex polygon. Every vertex R off an edge PQ then lies at
@@ -254,7 +267,7 @@ def _convex_once(ring: list[tuple[float, float]], turns: list[tuple[float, float
     crosses = [t[0] for t in turns]
     if not (min(crosses) > firm or max(crosses) < -firm):
         return False
-    winding = sum(math.atan2(abs(cross), dot) for cross, dot, _ in turns)
+    winding = sum([math.atan2(abs(t[0]), t[1]) for t in turns])
     return winding < 3 * math.pi  # 2 pi once, 4 pi or more for a star
 
 
@@ -291,30 +304,58 @@ def point_list_part(
     """
     small = _small_floats(points)
     if small is not None:  # the same decisions on Python floats
-        pts = np.array(small, dtype=np.float64)
-        sring = _small_ring(small)
-        turns = _turns(sring) if len(sring) >= 3 else []
-        if turns and _convex_once(sring, turns):  # most files: the answer in O(N)
-            simple, concave = True, False
-        else:
-            simple = len(sring) >= 3 and _small_is_simple(sring, turns)
-            concave = simple and not _small_is_convex(sring, turns)
-        ring = np.array(sring, dtype=np.float64) if concave else pts
+        return _small_point_list_part(path, small, name, center_of_mass, units)
+    try:
+        pts = as_points(points)
+    except PartError as exc:
+        raise fail(path, str(exc)) from None
+    check_coordinates(path, pts, "the point list")
+    ring = _ring(pts)
+    simple = len(ring) >= 3 and _is_simple(ring)
+    concave = simple and not _is_convex(ring)
+    return _outline_or_cloud(path, pts, ring, simple, concave, name, center_of_mass, units)
+
+
+def _small_point_list_part(
+    path: Path | str,
+    small: list[tuple[float, float]],
+    name: str,
+    center_of_mass: Any = None,
+    units: str | None = None,
+) -> Part:
+    """:func:`point_list_part` of the points :func:`_small_floats` gave."""
+    pts = np.array(small, dtype=np.float64)
+    sring = _small_ring(small)
+    if len(sring) >= 3 and _convex_once(sring, _bends(sring)):  # most files: O(N)
+        simple, concave = True, False
     else:
-        try:
-            pts = as_points(points)
-        except PartError as exc:
-            raise fail(path, str(exc)) from None
-        check_coordinates(path, pts, "the point list")
-        ring = _ring(pts)
-        simple = len(ring) >= 3 and _is_simple(ring)
-        concave = simple and not _is_convex(ring)
+        turns = _turns(sring) if len(sring) >= 3 else []
+        simple = len(sring) >= 3 and _small_is_simple(sring, turns)
+        concave = simple and not _small_is_convex(sring, turns)
+    ring = np.array(sring, dtype=np.float64) if concave else pts
+    return _outline_or_cloud(path, pts, ring, simple, concave, name, center_of_mass, units)
+
+
+def _outline_or_cloud(
+    path: Path | str,
+    pts: FloatArray,
+    ring: FloatArray,
+    simple: bool,
+    concave: bool,
+    name: str,
+    center_of_mass: Any,
+    units: str | None,
+) -> Part:
+    """The part of the decisions: a non-convex outline, or the points' hull.
+
+    ``path`` names the file in a message (a string: as ``Path(path)`` prints).
+    """
     try:
         if concave:
             return Part.from_outline(ring, name=name, center_of_mass=center_of_mass, units=units)
         part = Part.from_points(pts, name=name, center_of_mass=center_of_mass, units=units)
     except PartError as exc:
-        raise fail(path, str(exc)) from None
+        raise fail(Path(path), str(exc)) from None
     if not simple:  # a point cloud: its outline is its hull, not a self-crossing path
         part = dataclasses.replace(part, outline=part.hull.vertices)
     return part
@@ -361,6 +402,10 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
 
 # load_json's parser (numbers too large refused) and the default options, made once.
 _DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
+# Numbers by the C scanner: a line whose every number proves to be a coordinate in range reads
+# the same as by _DECODER (whose checks refuse numbers beyond a float or with 300 digits).
+_PLAIN = json.JSONDecoder()
+_NAMED_POINTS = {"name", "vertices"}
 _DEFAULTS = ReadOptions()  # frozen
 
 
@@ -381,6 +426,19 @@ def json_line_part(text: str, name: str) -> Part | None:
     """
     if len(text) > MAX_BYTES // 4:  # UTF-8 may take 4 bytes a character: check the bytes
         return None
+    try:
+        doc = _PLAIN.decode(text)
+    except Exception:  # the strict decoder fails too: the general path gives its error
+        return None
+    if type(doc) is dict and doc.keys() <= _NAMED_POINTS:  # most lines: one look at them
+        points, label = doc.get("vertices"), doc.get("name", name)
+        small = _small_floats(points) if type(label) is str else None
+        if small is not None:
+            # Every number of the line is a coordinate within MAX_COORDINATE, so the strict
+            # decoder reads the same line; _json_document_part then reads the points so.
+            if "name" not in doc:
+                label = Path(name).stem
+            return _small_point_list_part(name, small, label)
     try:
         doc = _DECODER.decode(text)
     except Exception:  # any failure: the general path gives its error
