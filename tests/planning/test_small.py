@@ -36,6 +36,7 @@ from hypothesis import strategies as st
 import bayesgrasp.planning.arcs as arcs
 from bayesgrasp.errors import PartError
 from bayesgrasp.geometry.polygon import Part
+from bayesgrasp.geometry.transfer import TransferFunction
 from bayesgrasp.model.cost import CostModel
 from bayesgrasp.model.goal import Goal
 from bayesgrasp.model.prior import HistogramPrior, Prior, UniformPrior, von_mises
@@ -262,17 +263,24 @@ def test_many_states_at_the_cut_off(n: int) -> None:
     assert res.ok
 
 
+def small_transfer(pts: np.ndarray, kind: str) -> TransferFunction | None:
+    """The ``kind`` transfer function of the hull of ``pts``, if it has at most SMALL states
+    (``None`` for no part or more states)."""
+    try:
+        part = Part.from_points(pts)
+    except PartError:
+        return None
+    f = Problem.build(part, actions=(kind,)).transfers[kind]
+    return f if f.n_states <= SMALL else None
+
+
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(pts=clouds(), kind=st.sampled_from(["squeeze", "push-grasp"]), extra=st.floats(-0.5, 7.0))
 def test_list_front_is_the_enumerated_front(pts: np.ndarray, kind: str, extra: float) -> None:
     """The plain-list front is numpy's enumeration of every arc, bit for bit, for any span
     bound."""
-    try:
-        part = Part.from_points(pts)
-    except PartError:
-        return
-    f = Problem.build(part, actions=(kind,)).transfers[kind]
-    if f.n_states > SMALL:
+    f = small_transfer(pts, kind)
+    if f is None:
         return
     fast = arcs.arc_front(f, f.period + extra)
     slow = arcs.arc_front(f, f.period + extra, prune=False)
@@ -300,12 +308,8 @@ def test_span_front_is_a_prefix_of_the_enumerated_front(
 
     An integer ``n`` stands for the span of front arc ``n`` (the batches' and the bounds'
     edges on an arc), and a bound for the next float above it."""
-    try:
-        part = Part.from_points(pts)
-    except PartError:
-        return
-    f = Problem.build(part, actions=(kind,)).transfers[kind]
-    if f.n_states > SMALL:
+    f = small_transfer(pts, kind)
+    if f is None:
         return
     max_span = f.period + extra
     slow = arcs.arc_front(f, max_span, prune=False)

@@ -19,8 +19,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
-from .specs import guaranteed_plan as guaranteed_plan  # (re-exported: the web uses them)
-from .specs import run_inputs as run_inputs
+from .specs import guaranteed_plan
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part

@@ -14,9 +14,7 @@ from .common import (
     check_figure_path,
     check_outputs,
     emit_json,
-    guaranteed_plan,
     input_files,
-    run_inputs,
     save_figure,
 )
 from .options import (
@@ -34,7 +32,7 @@ from .options import (
     part_options,
     problem_options,
 )
-from .specs import PartSpec, ProblemSpec, SenseSpec
+from .specs import PartSpec, ProblemSpec, SenseSpec, guaranteed_plan, run_inputs
 
 app = command_app()
 

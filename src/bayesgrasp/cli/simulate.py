@@ -8,7 +8,7 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import chosen_plan, emit_json, run_inputs, simulate_inputs, with_progress
+from .common import chosen_plan, emit_json, simulate_inputs, with_progress
 from .options import (
     AlsoOpt,
     JsonOpt,
@@ -21,7 +21,7 @@ from .options import (
     part_options,
     problem_options,
 )
-from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
+from .specs import Engine, PartSpec, ProblemSpec, SenseSpec, run_inputs
 
 app = command_app()
 

@@ -362,7 +362,8 @@ def _chosen(
     which: str, opts: ProblemOptions, part: Part, spec: Any
 ) -> tuple[Problem, PlanOption, str]:
     """The problem and the plan ``which`` names (as ``--plan`` does)."""
-    from ..cli.common import PLAN_NAMES, guaranteed_plan
+    from ..cli.common import PLAN_NAMES
+    from ..cli.specs import guaranteed_plan
 
     problem = build_problem(part, opts, spec)
     if which == "guaranteed":
@@ -402,7 +403,7 @@ def push_document(service: Service, req: PartRequest) -> dict[str, Any]:
 
 def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     """``bayesgrasp plan PART [options] [--guaranteed] --json``."""
-    from ..cli.common import guaranteed_plan, run_inputs
+    from ..cli.specs import guaranteed_plan, run_inputs
     from ..io.plans import plan_document
 
     spec = problem_spec(req)
@@ -445,7 +446,8 @@ def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
     pb, option, _ = _chosen(req.plan, req, p, spec)
     err = GripperNoise(req.noise_kind, math.radians(req.noise))
     res = simulate_kinematic(pb, option, req.trials, err, rng=req.seed)
-    from ..cli.common import run_inputs, simulate_inputs
+    from ..cli.common import simulate_inputs
+    from ..cli.specs import run_inputs
     from ..io.plans import provenance
 
     doc = report.simulate_json(res, p)  # with the provenance the command line writes
