@@ -36,11 +36,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.curved import CurvedDiameter, squeeze_model
 from ..geometry.diameter import DiameterFunction
 from ..geometry.polygon import Part
 from ..geometry.transfer import TransferFunction
+from ..sizes import SMALL
 from .actions import SQUEEZE, Action, get_action, parse_actions
 from .cost import CostModel
 from .goal import Goal
@@ -350,6 +352,16 @@ class Problem:
         function that end there, shifted by ``first_angle``.
         """
         f = self.transfer(kind)
+        uniform = type(self.prior) is UniformPrior and type(first_angle) is float
+        if uniform and f is self.states and f.n_states <= SMALL:
+            # The uniform cdf's operations one element at a time on Python floats (a few
+            # states): the same IEEE additions, divisions and subtractions as numpy's.
+            _, lo, hi = f.values
+            a = first_angle
+            return np.array(
+                [(h + a) / TWO_PI - (b + a) / TWO_PI for b, h in zip(lo, hi, strict=True)],
+                dtype=np.float64,
+            )
         masses = self.prior.mass(f.basin_lo + first_angle, f.basin_hi + first_angle)
         if f is self.states:
             return np.asarray(masses, dtype=np.float64)
