@@ -13,7 +13,10 @@ from dataclasses import dataclass, fields
 
 from .errors import PartError
 
-__all__ = ["DEFAULT_TOLERANCE", "Tolerance"]
+__all__ = ["DEFAULT_TOLERANCE", "MIN_ANGLE", "Tolerance"]
+
+MIN_ANGLE = 1e-12
+"""The smallest angle tolerance (radians), a thousand rounding errors of ``2 pi``."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -27,7 +30,9 @@ class Tolerance:
         to the line through its neighbours is collinear and dropped.
     angle : float
         Angles (radians) closer than this are equal: parallel edges, a chord perpendicular
-        to an edge, the margin that keeps a plan away from an unstable equilibrium.
+        to an edge, the margin that keeps a plan away from an unstable equilibrium. At
+        least ``MIN_ANGLE`` (1e-12): angles are computed to about 1e-15 rad, so below that
+        the edges a symmetry makes parallel, or the extrema it repeats, compare unequal.
     symmetry : float
         A rotation maps the part onto itself when every vertex lands within
         ``symmetry * size`` of a vertex; looser than ``length`` because symmetric parts
@@ -52,7 +57,7 @@ class Tolerance:
     Raises
     ------
     PartError
-        A tolerance that is not a finite real number >= 0.
+        A tolerance that is not a finite real number >= 0, or an angle below ``MIN_ANGLE``.
 
     Examples
     --------
@@ -77,6 +82,11 @@ class Tolerance:
             ):
                 raise PartError(f"`{f.name}` must be a finite number >= 0; got {x!r}")
             object.__setattr__(self, f.name, float(x))
+        if self.angle < MIN_ANGLE:
+            raise PartError(
+                f"`angle` must be at least {MIN_ANGLE:g} rad (angles are computed to about "
+                f"1e-15 rad, so smaller tolerances call equal angles unequal); got {self.angle!r}"
+            )
 
     def length_for(self, size: float) -> float:
         """Absolute length tolerance for a part of the given size."""

@@ -27,7 +27,7 @@ from bayesgrasp.geometry.curved import squeeze_model
 from bayesgrasp.geometry.diameter import DiameterFunction, diameter_function
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part, hull_contains
 from bayesgrasp.geometry.transfer import TransferFunction, _period_count, squeeze_function
-from bayesgrasp.tolerance import Tolerance
+from bayesgrasp.tolerance import MIN_ANGLE, Tolerance
 from reference import regular_polygon
 from strategies import convex_points, lattice_points
 
@@ -209,14 +209,6 @@ def test_half_turn_needs_no_test(pts: FloatArray) -> None:
     assert s.period == TWO_PI / full
 
 
-def test_half_turn_is_tested_when_the_tolerance_is_zero() -> None:
-    poly = ConvexPolygon.from_points([(0, 0), (2, 0), (2.5, 1), (0.2, 1.3)], Tolerance(angle=0.0))
-    s = squeeze_function(poly)
-    stable, _, hi = (list(x) for x in s.values)
-    bounds = sorted(x % TWO_PI for x in hi)
-    assert s.period == TWO_PI / _period_count(stable, bounds, len(stable), 1, 0.0)
-
-
 # --------------------------------------------------------------------------- lazy arrays
 
 
@@ -351,7 +343,12 @@ def general_diameter(poly: ConvexPolygon) -> DiameterFunction:
         diameter._in_order = saved
 
 
-TOLERANCES = [Tolerance(), Tolerance(angle=0.0), Tolerance(angle=1e-6), Tolerance(barrier=1e-3)]
+TOLERANCES = [
+    Tolerance(),
+    Tolerance(angle=MIN_ANGLE),
+    Tolerance(angle=1e-6),
+    Tolerance(barrier=1e-3),
+]
 
 
 @settings(max_examples=300, deadline=None)
@@ -371,7 +368,7 @@ def test_one_pass_extrema_are_the_general_paths(pts: FloatArray, tol: Tolerance)
         assert a.tolist() == b.tolist()
     outcome = []
     for d in (fast, general):
-        try:  # (an equilateral triangle under angle=0 fails alike on both: a known bug)
+        try:
             s = squeeze_function(d)
             outcome.append((s.values, s.period))
         except BayesGraspError as e:

@@ -32,7 +32,7 @@ from bayesgrasp.geometry.polygon import ConvexPolygon, Part, as_points
 from bayesgrasp.geometry.push import push_function, push_grasp_function
 from bayesgrasp.geometry.transfer import TransferFunction, squeeze_function
 from bayesgrasp.model.problem import Problem
-from bayesgrasp.tolerance import DEFAULT_TOLERANCE, Tolerance
+from bayesgrasp.tolerance import DEFAULT_TOLERANCE, MIN_ANGLE, Tolerance
 from reference import TWO_PI, circle_distance, descend, local_minima, regular_polygon
 
 FloatArray = NDArray[np.float64]
@@ -422,6 +422,27 @@ def test_a_regular_99999_gon_has_the_period_of_its_symmetry() -> None:
     assert shift_error(s, theta) <= poly.tol.angle
 
 
+@pytest.mark.parametrize("n", [3, 4, 6, 8, 12])
+@pytest.mark.parametrize("angle", [MIN_ANGLE, DEFAULT_TOLERANCE.angle])
+def test_symmetric_parts_far_from_the_origin_keep_their_period(n: int, angle: float) -> None:
+    # Reproducers: a square of size 0.007 at 5e5 from the origin (default tolerance), and a
+    # triangle under the smallest angle tolerance, failed with "internal error: ... do not
+    # alternate / differ": the symmetrized vertices were rounded to the coordinates' ulp.
+    rng = np.random.default_rng(n)
+    tol = Tolerance(angle=angle)
+    for offset, size in ((0.0, 1.0), (1e4, 0.1), (5e5, 0.007), (1e8, 1.0)):
+        a = rng.uniform(0, TWO_PI)
+        turn = np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]])
+        pts = offset + size * regular_polygon(n) @ turn
+        part = Part.from_points(pts, tol=tol)
+        poly = part.hull
+        assert poly.symmetry_order == n
+        s = squeeze_function(poly)
+        assert_allclose(s.period, period_formula(n), rtol=1e-12)
+        assert shift_error(s, rng.uniform(0, TWO_PI, 500)) <= angle
+        assert_allclose(push_function(part).period, TWO_PI / n, rtol=1e-12)
+
+
 def test_not_quite_symmetric_parts_have_the_period_pi() -> None:
     # Beyond the symmetry tolerance the part is not symmetric, however periodic its extrema
     # look: the period is the one the extrema have to the angle tolerance (pi here).
@@ -474,6 +495,8 @@ def test_symmetry_order_from_skips_the_lower_orders() -> None:
         ({"symmetry": float("inf")}, "`symmetry` must be a finite number >= 0"),
         ({"barrier": "1e-9"}, "`barrier` must be a finite number >= 0; got '1e-9'"),
         ({"probability": True}, "`probability` must be a finite number >= 0; got True"),
+        ({"angle": 0.0}, "`angle` must be at least 1e-12 rad .*; got 0.0"),
+        ({"angle": 1e-13}, "`angle` must be at least 1e-12 rad"),
     ],
 )
 def test_tolerances_are_validated(kwargs: dict[str, Any], match: str) -> None:

@@ -311,7 +311,7 @@ def diameter_function(polygon: ConvexPolygon) -> DiameterFunction:
         # One period of the exactly symmetric part, simplified as a periodic function and
         # repeated: the shallow pairs go in every period or in none.
         period = math.pi / periods
-        sym = polygon.symmetrized()
+        sym = polygon.symmetrized(centred=True)  # translation-free: see its docstring
         if small:
             one = _pieces_python(sym[:, 0].tolist(), sym[:, 1].tolist(), tol, period)
         else:
@@ -633,9 +633,20 @@ def _in_order(
 
 
 def _window(breaks: list[float], period: float, tol: float) -> int:
-    """How many pieces start within one period of the first break (all of them for pi)."""
+    """How many pieces start within one period of the first break (all of them for pi).
+
+    The breaks of an exactly symmetric polygon repeat every ``period``, so ``pi / period``
+    windows of equal count hold them all: that count, when it divides. Otherwise (a gap
+    that the angle tolerance merges in one period and not in another) those below
+    ``breaks[0] + period - tol``; rounding can put a break a few ulps below that, which is
+    why the count comes first (under ``tol = 0`` the bisection alone took two windows).
+    """
+    n = len(breaks)
     if period >= math.pi:
-        return len(breaks)
+        return n
+    windows = round(math.pi / period)
+    if n % windows == 0:
+        return n // windows
     return max(1, bisect.bisect_left(breaks, breaks[0] + period - tol))
 
 

@@ -200,7 +200,7 @@ def radius_function(part: Part | ConvexPolygon) -> RadiusFunction:
         # symmetric, like the diameter function (its extrema over one period 2 pi / r of
         # the symmetrized hull, repeated; vertex i + k n / r is vertex i turned k times).
         step, period = n // r, TWO_PI / r
-        at, is_max, angle = _push_extrema(poly.symmetrized(), poly.centroid, ltol, step)
+        at, is_max, angle = _push_extrema(poly.symmetrized(centred=True), np.zeros(2), ltol, step)
         turns = np.arange(r)
         minima = (angle[~is_max][:, None] + period * turns).ravel()
         # Turning the part by 2 pi k / r brings edge i - k n / r where edge i was.

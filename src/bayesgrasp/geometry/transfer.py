@@ -367,12 +367,6 @@ def _from_sorted(
     return TransferFunction._of_floats(kind, (tuple(stable), lo, hi), period, angle_tol)
 
 
-# A half turn maps a squeeze function's lists onto themselves to within a few rounding errors
-# of 2 pi (they are the extrema over [0, pi) and the same plus pi): below this tolerance the
-# half turn is tested like any other shift.
-_HALF_TURN_TOL = 1e-12
-
-
 def squeeze_function(
     part: ConvexPolygon | DiameterFunction,
 ) -> TransferFunction:
@@ -423,5 +417,6 @@ def squeeze_function(
         stable.sort()
     if not ordered or (bounds and bounds[-1] < pi):
         bounds.sort()
-    half_turn = 2 if tol >= _HALF_TURN_TOL else 1
-    return _from_sorted("squeeze", stable, bounds, tol, tol, half_turn)
+    # A half turn maps the lists onto themselves to a few rounding errors of 2 pi, well
+    # within any angle tolerance (>= MIN_ANGLE): two equal shifts are known.
+    return _from_sorted("squeeze", stable, bounds, tol, tol, 2)
