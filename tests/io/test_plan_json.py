@@ -172,3 +172,22 @@ def test_random_parts(pts: list[tuple[float, float]], kw: dict[str, Any]) -> Non
     except BayesGraspError:
         return
     same(plan_exact(pb))
+
+
+def test_stable_orientations_held_as_arrays_or_floats() -> None:
+    """The template writes the states' own floats; the general path their array's tolist()."""
+    from bayesgrasp.geometry.transfer import TransferFunction
+
+    for made in ("arrays", "float64 scalars"):
+        res = plan_exact(Problem.build(resolve_part("house")))
+        pb, f = res.problem, res.problem.states
+        cols = [f.stable.copy(), f.basin_lo.copy(), f.basin_hi.copy()]
+        if made != "arrays":
+            cols = [[np.float64(x) for x in c] for c in cols]
+        other = TransferFunction(f.kind, *cols, period=f.period, angle_tol=f.angle_tol)
+        assert (other._values is None) == (made == "arrays")
+        object.__setattr__(pb, "states", other)  # the same values, held another way
+        assert pb.states is other
+        expected = dumps(res)
+        assert plan_document_json(res) == expected
+        assert '"stable_orientations_rad": [' + ", ".join(map(repr, f.values[0])) in expected

@@ -503,9 +503,9 @@ def _document_text(
     hull = part.hull
     units = "" if part.units is None else f', "units": {_text(part.units)}'
     probs = pb.state_distribution(bayes.first_angle, bayes.steps[0].kind)
-    if pb.states.stable.dtype.char != "d":
-        return None
-    stable = pb.states.stable.tolist()
+    # The stable orientations as the states hold them (their array, which the general path
+    # writes, is made of these floats): float's repr of each, a TypeError for another type.
+    stable = pb.states.values[0]
     texts = [_float(x) for x in stable]  # (0.0 and -0.0 are equal keys: zero is left out)
     known = {x: t for x, t in zip(stable, texts, strict=True) if x}
     text = [
