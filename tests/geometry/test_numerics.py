@@ -431,9 +431,7 @@ def test_symmetric_parts_far_from_the_origin_keep_their_period(n: int, angle: fl
     rng = np.random.default_rng(n)
     tol = Tolerance(angle=angle)
     for offset, size in ((0.0, 1.0), (1e4, 0.1), (5e5, 0.007), (1e8, 1.0)):
-        a = rng.uniform(0, TWO_PI)
-        turn = np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]])
-        pts = offset + size * regular_polygon(n) @ turn
+        pts = regular_polygon(n, size, rng.uniform(0, TWO_PI), (offset, offset))
         part = Part.from_points(pts, tol=tol)
         poly = part.hull
         assert poly.symmetry_order == n

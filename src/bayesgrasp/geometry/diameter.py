@@ -638,8 +638,8 @@ def _window(breaks: list[float], period: float, tol: float) -> int:
     The breaks of an exactly symmetric polygon repeat every ``period``, so ``pi / period``
     windows of equal count hold them all: that count, when it divides. Otherwise (a gap
     that the angle tolerance merges in one period and not in another) those below
-    ``breaks[0] + period - tol``; rounding can put a break a few ulps below that, which is
-    why the count comes first (under ``tol = 0`` the bisection alone took two windows).
+    ``breaks[0] + period - tol``. The count comes first because rounding can put the first
+    break of the next period below that bound when ``tol`` is only a few rounding errors.
     """
     n = len(breaks)
     if period >= math.pi:
