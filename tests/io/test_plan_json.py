@@ -191,3 +191,33 @@ def test_stable_orientations_held_as_arrays_or_floats() -> None:
         expected = dumps(res)
         assert plan_document_json(res) == expected
         assert '"stable_orientations_rad": [' + ", ".join(map(repr, f.values[0])) in expected
+
+
+# Floats of every kind orjson might spell otherwise than repr: tiny, huge, subnormal, the
+# exponent boundaries 1e-4 and 1e16, zeros of both signs, and the non-finite values.
+_any_float = st.one_of(
+    st.floats(),
+    st.floats(-1e-3, 1e-3),
+    st.floats(-1e17, 1e17),
+    st.sampled_from([1e-4, 9.999999999999999e-05, 1e-05, 5e-324, 1e16, 9999999999999998.0, -0.0]),
+)
+
+
+@settings(max_examples=500, deadline=None)
+@given(values=st.lists(_any_float, max_size=12))
+def test_orjson_float_text_is_repr(values: list[float]) -> None:
+    """The float texts the template writes by orjson are each float's repr, as json.dumps."""
+    assert plans_module._floats(values) == [repr(x) for x in values]
+    pairs = np.array(values[: len(values) // 2 * 2], dtype=np.float64).reshape(-1, 2)
+    assert plans_module._array(pairs) == repr(pairs.tolist())
+    assert plans_module._array(np.array(values, dtype=np.float64)) == repr(values)
+
+
+def test_float_texts_refuse_what_float_repr_refuses() -> None:
+    """A value that is not a float is a TypeError (the document's general path), as before."""
+    for values in ([0.5, 1], [True], [None], [0.5, "0.5"]):
+        with pytest.raises(TypeError):
+            plans_module._floats(values)
+    assert plans_module._floats([np.float64(0.1), 0.2]) == ["0.1", "0.2"]  # a float subclass
+    with pytest.raises(TypeError):
+        plans_module._array(np.array([1, 2]))

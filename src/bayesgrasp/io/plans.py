@@ -45,12 +45,13 @@ import json
 import math
 import os
 import struct
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import orjson
 
 from ..errors import BayesGraspError, SimulationError
 from ..geometry.polygon import ConvexPolygon, Part
@@ -450,7 +451,40 @@ def _array(values: Any) -> str:
     """A float64 array as JSON writes its ``tolist()``: the list's ``repr`` (Python floats)."""
     if values.dtype.char != "d":
         raise TypeError(f"not a float64 array: {values.dtype}")
-    return repr(values.tolist())
+    floats = values.tolist()
+    data = orjson.dumps(floats)
+    if _as_repr(data):  # then the text of a list of lists too, but for its separators
+        return data.decode().replace(",", ", ")
+    return repr(floats)
+
+
+def _floats(values: Sequence[float]) -> list[str]:
+    """``float.__repr__`` of each value (as ``json.dumps`` writes it): by one orjson call.
+
+    A ``TypeError`` for a value that is not a float, as ``float.__repr__`` gives.
+    """
+    for x in values:
+        if type(x) is not float:  # an int, a float subclass...: each by float.__repr__
+            return [_float(x) for x in values]
+    data = orjson.dumps(values)
+    if _as_repr(data):
+        text = data.decode()[1:-1]
+        return text.split(",") if text else []
+    return [_float(x) for x in values]
+
+
+def _as_repr(data: bytes) -> bool:
+    """Whether orjson's text of a list of floats is each float's ``repr`` (but the spaces).
+
+    orjson writes a finite float with the shortest digits that read back to it, the digits
+    ``repr`` writes (both are "shortest round-trip, nearest", Steele & White / Gay), but
+    spells some differently: a magnitude below 1e-4 positionally (``0.00001`` for
+    ``1e-05``), exponents without their zero (``1e-7``), and NaN and the infinities as
+    ``null``. A text without an ``e``, ``0.0000`` or ``null`` holds none of these (a float
+    below 1e-4 written positionally has four zeros after its point); test:
+    ``tests/io/test_plan_json.py::test_orjson_float_text_is_repr``.
+    """
+    return not (b"e" in data or b"0.0000" in data or b"null" in data)
 
 
 def _option_text(option: PlanOption, known: Mapping[float, str]) -> str:
@@ -462,21 +496,34 @@ def _option_text(option: PlanOption, known: Mapping[float, str]) -> str:
     steps = option.steps
     final = option.final_orientation
     end = known.get(final) if type(final) is float and final else None
-    alphas = [_float(s.alpha) for s in steps]
+    # json_float's null for a missing or non-finite value (a non-float: the general path)
+    cost, tol = option.expected_cost, option.tolerance
+    no_cost = cost is None or not math.isfinite(cost)
+    no_tol = tol is None or not math.isfinite(tol)
+    values: list[Any] = [s.alpha for s in steps]
+    values.append(option.success_probability)
+    if not no_cost:
+        values.append(cost)
+    if not no_tol:
+        values.append(tol)
+    if end is None:
+        values.append(final)
+    texts = _floats(values)  # then taken from the end
+    end = end or texts.pop()
+    tol_text = "null" if no_tol else texts.pop()
+    cost_text = "null" if no_cost else texts.pop()
+    probability = texts.pop()
+    alphas = texts
     if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
         walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
     else:
         pairs = zip(steps, alphas, strict=True)
         walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
-    # json_float's null for a missing or non-finite value (a non-float: the general path)
-    cost, tol = option.expected_cost, option.tolerance
     return (
         f'{{"squeezes": {len(steps)}, "actions_rad": [{", ".join(alphas[1:])}], '
         f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
-        f'"final_orientation_rad": {end or _float(final)}, '
-        f'"success_probability": {_float(option.success_probability)}, '
-        f'"expected_cost": {"null" if cost is None or not math.isfinite(cost) else _float(cost)}, '
-        f'"tolerance_rad": {"null" if tol is None or not math.isfinite(tol) else _float(tol)}}}'
+        f'"final_orientation_rad": {end}, "success_probability": {probability}, '
+        f'"expected_cost": {cost_text}, "tolerance_rad": {tol_text}}}'
     )
 
 
@@ -504,9 +551,12 @@ def _document_text(
     units = "" if part.units is None else f', "units": {_text(part.units)}'
     probs = pb.state_distribution(bayes.first_angle, bayes.steps[0].kind)
     # The stable orientations as the states hold them (their array, which the general path
-    # writes, is made of these floats): float's repr of each, a TypeError for another type.
+    # writes, is made of these floats): float's repr of each, a TypeError for another type;
+    # the period and the first angle with them.
     stable = pb.states.values[0]
-    texts = [_float(x) for x in stable]  # (0.0 and -0.0 are equal keys: zero is left out)
+    texts = _floats([*stable, float(pb.states.period), bayes.first_angle])
+    first, period = texts.pop(), texts.pop()
+    # (0.0 and -0.0 are equal keys: zero is left out)
     known = {x: t for x, t in zip(stable, texts, strict=True) if x}
     text = [
         f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
@@ -516,8 +566,7 @@ def _document_text(
         f'"method": {_text(result.method)}, '
         f'"stable_orientations_rad": [{", ".join(texts)}], '
         f'"stable_probabilities": {_array(probs)}, '
-        f'"period_rad": {_float(float(pb.states.period))}, '
-        f'"first_squeeze_rad": {_float(bayes.first_angle)}, '
+        f'"period_rad": {period}, "first_squeeze_rad": {first}, '
         f'"options": [{", ".join([_option_text(o, known) for o in result.options])}], '
         f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
     ]

@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import orjson
 from numpy.typing import NDArray
 
 from ..errors import PartError
@@ -120,14 +121,14 @@ _BAND = 1e-9
 _EXACT_INT = 2**53
 
 
-def _small_floats(points: Any) -> list[tuple[float, float]] | None:
+def _small_floats(points: Any, limit: float = MAX_COORDINATE) -> list[tuple[float, float]] | None:
     """A short plain list of ``[x, y]`` numbers as Python floats; ``None`` for any other input.
 
     The fast path of :func:`point_list_part` (at most :data:`bayesgrasp.sizes.SMALL` points):
-    only lists whose every coordinate is an ``int`` or ``float``, finite and within
-    :data:`MAX_COORDINATE`, so these are exactly the values ``np.asarray`` would give. Anything
-    else (booleans, text, big integers, bad shapes, non-finite values) returns ``None`` and takes
-    the general path, which gives its errors.
+    only lists whose every coordinate is an ``int`` or ``float``, finite and within ``limit``
+    (at most :data:`MAX_COORDINATE`), so these are exactly the values ``np.asarray`` would
+    give. Anything else (booleans, text, big integers, bad shapes, non-finite values) returns
+    ``None`` and takes the general path, which gives its errors.
     """
     if not isinstance(points, list) or not 3 <= len(points) <= SMALL:
         return None
@@ -143,7 +144,7 @@ def _small_floats(points: Any) -> list[tuple[float, float]] | None:
             return None
         fx, fy = float(x), float(y)
         # abs(nan) <= M is False: NaN and infinities take the general path too.
-        if not (abs(fx) <= MAX_COORDINATE and abs(fy) <= MAX_COORDINATE):
+        if not (abs(fx) <= limit and abs(fy) <= limit):
             return None
         out.append((fx, fy))
     return out
@@ -402,9 +403,11 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
 
 # load_json's parser (numbers too large refused) and the default options, made once.
 _DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
-# Numbers by the C scanner: a line whose every number proves to be a coordinate in range reads
-# the same as by _DECODER (whose checks refuse numbers beyond a float or with 300 digits).
-_PLAIN = json.JSONDecoder()
+# The first reading of a batch line, by orjson: it reads a number as json does (the nearest
+# float, or the int), but an integer beyond 64 bits as a float, where json keeps the int; so a
+# line read by it takes the fast path only when every coordinate is within 2^53, and a float
+# there is what the strict decoder reads too (an integer literal would have stayed an int).
+_FIRST_LIMIT = float(_EXACT_INT)
 _NAMED_POINTS = {"name", "vertices"}
 _DEFAULTS = ReadOptions()  # frozen
 
@@ -427,15 +430,15 @@ def json_line_part(text: str, name: str) -> Part | None:
     if len(text) > MAX_BYTES // 4:  # UTF-8 may take 4 bytes a character: check the bytes
         return None
     try:
-        doc = _PLAIN.decode(text)
-    except Exception:  # the strict decoder fails too: the general path gives its error
-        return None
+        doc = orjson.loads(text)
+    except orjson.JSONDecodeError:  # NaN, a number beyond a float...: the strict decoder's
+        doc = None
     if type(doc) is dict and doc.keys() <= _NAMED_POINTS:  # most lines: one look at them
         points, label = doc.get("vertices"), doc.get("name", name)
-        small = _small_floats(points) if type(label) is str else None
+        small = _small_floats(points, _FIRST_LIMIT) if type(label) is str else None
         if small is not None:
-            # Every number of the line is a coordinate within MAX_COORDINATE, so the strict
-            # decoder reads the same line; _json_document_part then reads the points so.
+            # Every number of the line is a coordinate within 2^53, so the strict decoder
+            # reads the same line; _json_document_part then reads the points so.
             if "name" not in doc:
                 label = Path(name).stem
             return _small_point_list_part(name, small, label)
