@@ -9,6 +9,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from bayesgrasp import CostError, CostModel, Goal, Part, PlanningError, Problem, von_mises
+from bayesgrasp.model.prior import UniformPrior
 from bayesgrasp.model.problem import action_classes, nearest_state
 from bayesgrasp.shapes import load
 from reference import regular_polygon
@@ -266,3 +267,24 @@ def test_build_rejects_bad_accuracy(bad: object) -> None:
     part = Part.from_points([(0, 0), (2, 0), (2.2, 1), (0, 1.1)])
     with pytest.raises(PlanningError, match="`accuracy` must be a finite number"):
         Problem.build(part, accuracy=bad)  # type: ignore[arg-type]
+
+
+def test_shared_defaults_replace_only_equal_inputs() -> None:
+    """Inputs equal to build's defaults become its shared objects; others are kept as given."""
+    from bayesgrasp.model import problem as problem_module
+    from bayesgrasp.model.problem import shared_defaults
+
+    given = {"prior": UniformPrior(), "cost": CostModel(), "goal": Goal(), "accuracy": 0.0}
+    out = shared_defaults(given)
+    assert out["prior"] is problem_module._DEFAULT_PRIOR
+    assert out["cost"] is problem_module._DEFAULT_COST
+    assert out["goal"] is problem_module._DEFAULT_GOAL
+    assert out["accuracy"] == 0.0 and given["cost"] is not out["cost"]  # the input is kept
+    other = {"cost": CostModel(retry=-0.0), "prior": von_mises(1.0, 2.0), "goal": None}
+    assert shared_defaults(other) == other  # -0.0 is written otherwise than 0.0
+    assert shared_defaults(other)["cost"] is other["cost"]
+    sq = Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)])
+    a, b = Problem.build(sq, **out), Problem.build(sq)
+    assert (a.prior, a.cost, a.goal) == (b.prior, b.cost, b.goal)
+    with pytest.raises(CostError):  # a cost that is not the default is still checked
+        Problem.build(sq, **shared_defaults({"cost": CostModel({"squeeze": 0.0}, verify=0.0)}))

@@ -136,19 +136,26 @@ class ProblemSpec:
     def problem_inputs(
         self, more_actions: tuple[str, ...] = (), prior: Prior | None = None
     ) -> dict[str, Any]:
-        """The keywords of ``Problem.build`` but the part (immutable: a batch makes them once)."""
+        """The keywords of ``Problem.build`` but the part (immutable: a batch makes them once).
+
+        A prior, cost or goal equal to build's default is build's shared one
+        (:func:`~bayesgrasp.model.problem.shared_defaults`).
+        """
         from ..model.cost import CostModel
         from ..model.goal import Goal
         from ..model.prior import parse_prior
+        from ..model.problem import shared_defaults
 
         cost = CostModel(self.costs or {}, self.verify, self.first or {}, self.retry)
-        return {
-            "prior": parse_prior(self.prior) if prior is None else prior,
-            "cost": cost,
-            "goal": Goal(self.goal.value),
-            "actions": tuple(dict.fromkeys((*self.actions, *more_actions))),
-            "accuracy": math.radians(self.accuracy_deg),
-        }
+        return shared_defaults(
+            {
+                "prior": parse_prior(self.prior) if prior is None else prior,
+                "cost": cost,
+                "goal": Goal(self.goal.value),
+                "actions": tuple(dict.fromkeys((*self.actions, *more_actions))),
+                "accuracy": math.radians(self.accuracy_deg),
+            }
+        )
 
     def plan(self, problem: Problem, best_only: bool = False) -> PlanReport:
         """The best plan of every length, by the chosen planner.
