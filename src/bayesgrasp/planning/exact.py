@@ -183,10 +183,15 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
 
     Exact prunings (each keeps every float operation that decides a plan):
 
-    - *The front as far as asked.* Each width asks for the front's arcs of spans below its
-      bound, and each staircase for those below ``Wmax - 2 T + slack`` (next item);
+    - *The front as far as asked.* The widths ask for the front's arcs of spans below
+      ``W - 2 max(tol, accuracy) < cap - 2 T`` (``T`` below), so the front is taken up to
+      ``cap - 2 T + slack`` at once, in one pass before the widths (each width is then the
+      widest arc under its bound, a binary search); each staircase asks for those below
+      ``Wmax - 2 T + slack`` (next item), which may reach further.
       :class:`~bayesgrasp.planning.arcs.SpanFront` takes its arcs in order of span up to
-      there and no further, the same arcs the whole front holds below that span.
+      there and no further, the same arcs the whole front holds below that span. A loop
+      over the front's arcs that ends at the first ``-inf`` (next two items) ends at the
+      same arc however far beyond its bound the front was taken.
     - *tau where it can be finite.* Let ``T`` be ``max(tol, accuracy - _ROUNDING)``: a
       ``tau`` is ``-inf`` unless above ``tol`` and at least ``accuracy - _ROUNDING``, so
       every entry of a staircase has a rest of at least ``T`` (or ``inf``), and let
@@ -231,20 +236,16 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     prior, cost = problem.prior, problem.cost
     uniform = type(prior) is UniformPrior  # its max_arc_mass: group * length / (2 pi)
 
-    cover(tol)
+    # Every bound the widths ask, at once (one pass over the arcs; see the docstring).
+    cover(cap - 2.0 * low + _SPAN_SLACK)
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
     width = grown[0]
     for _ in range(limit_hard - 1):  # widest_reachable
         if width >= cap:
             break
-        bound = width - margin2
-        if bound > front.covered:  # (> tol >= 0) then the front holds just the arcs below
-            cover(bound)
-            wider = widths[-1]
-        else:
-            n = left(spans, bound) - 1
-            wider = widths[n] if n >= 0 else 0.0
+        n = left(spans, width - margin2) - 1
+        wider = widths[n] if n >= 0 else 0.0
         grown.append(wider)
         if wider <= width + tol:
             break
