@@ -379,6 +379,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     zero = new(PlanStep)  # the first step of every plan under the uniform prior
     set_kind(zero, kind)
     set_alpha(zero, 0.0)
+    top_x, top_at = math.nan, -1  # the longest plan's first witness: its span, the next one
     out = []
     for n in keep:
         length = grown[n]
@@ -391,9 +392,11 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             if n < last:
                 vals = taus[n]
                 tolerance = vals[at] if at < len(vals) else -inf
-            elif at < len(spans):  # the longest plan: its staircase's tau at arc `at`
-                x = spans[at]
-                tolerance = 0.5 * (w0 - x) if n == 1 else _stair_top(top_tau, widths, x)[0]
+            elif n == 1 and at < len(spans):  # the longest plan: its staircase's tau at `at`
+                tolerance = 0.5 * (w0 - spans[at])
+            elif at < len(spans):  # (and the arc it picks there: the next witness, below)
+                top_x = spans[at]
+                tolerance, top_at = _stair_top(top_tau, widths, top_x)
             else:
                 tolerance = -inf
             if not tolerance >= passing:  # pragma: no cover - the lengths guarantee a chain
@@ -418,8 +421,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             s_last = s + spans[at]
             if m == 1:
                 at = 0  # the last action's staircase picks arc 0
-            elif m == last:
-                at = _stair_top(top_tau, widths, s_last - s)[1]
+            elif m == last:  # picked at the span of the first witness (Arc.span)
+                x = s_last - s
+                at = top_at if x == top_x else _stair_top(top_tau, widths, x)[1]
             else:
                 idx, rest, wid, c = stairs[m]
                 x = s_last - s
