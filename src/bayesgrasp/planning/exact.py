@@ -237,14 +237,18 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     uniform = type(prior) is UniformPrior  # its max_arc_mass: group * length / (2 pi)
 
     # Every bound the widths ask, at once (one pass over the arcs; see the docstring).
-    cover(cap - 2.0 * low + _SPAN_SLACK)
+    bound = cap - 2.0 * low + _SPAN_SLACK
+    cover(bound if bound > tol else tol)
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
     width = grown[0]
     for _ in range(limit_hard - 1):  # widest_reachable
         if width >= cap:
             break
-        n = left(spans, width - margin2) - 1
+        bound = width - margin2
+        if bound > front.covered:  # pragma: no cover - not past the bound above (W < cap)
+            cover(bound)
+        n = left(spans, bound) - 1
         wider = widths[n] if n >= 0 else 0.0
         grown.append(wider)
         if wider <= width + tol:
