@@ -174,6 +174,20 @@ def test_every_study_polygon_fused_against_general(actions: tuple[str, ...]) -> 
         assert bits(fused) == bits(general)
 
 
+@pytest.mark.parametrize("accuracy", [0.3, 0.7, 0.78, 0.8, 1.2, 1.5, 1.57, 1.5708, 2.0])
+@pytest.mark.parametrize("goal", ["single", "symmetry"])
+def test_large_accuracies(accuracy: float, goal: str) -> None:
+    """Gripper accuracies up to and past a quarter turn, the fused planner against the
+    general one: the bound ``cap - 2 max(tol, accuracy - _ROUNDING)`` up to which the fused
+    one takes its front before the widths falls to and below ``tol`` here (it then takes
+    the arcs below ``tol``, and the widths stop at the widest basin)."""
+    rng = np.random.default_rng(4)
+    parts = [Part.from_points(regular(4) * [1.5, 1.0]), Part.from_points(regular(3))]
+    parts += [random_polygon(rng) for _ in range(12)]
+    for part in parts:
+        three_ways(lambda part=part: Problem.build(part, goal=Goal(goal), accuracy=accuracy))
+
+
 def regular(n: int, rotation: float = 0.0) -> np.ndarray:
     t = TWO_PI * np.arange(n) / n + rotation
     return np.column_stack([np.cos(t), np.sin(t)])

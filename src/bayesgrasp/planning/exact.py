@@ -183,10 +183,15 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
 
     Exact prunings (each keeps every float operation that decides a plan):
 
-    - *The front as far as asked.* Each width asks for the front's arcs of spans below its
-      bound, and each staircase for those below ``Wmax - 2 T + slack`` (next item);
+    - *The front as far as asked.* The widths ask for the front's arcs of spans below
+      ``W - 2 max(tol, accuracy) < cap - 2 T`` (``T`` below), so the front is taken up to
+      ``cap - 2 T + slack`` at once, in one pass before the widths (each width is then the
+      widest arc under its bound, a binary search); each staircase asks for those below
+      ``Wmax - 2 T + slack`` (next item), which may reach further.
       :class:`~bayesgrasp.planning.arcs.SpanFront` takes its arcs in order of span up to
-      there and no further, the same arcs the whole front holds below that span.
+      there and no further, the same arcs the whole front holds below that span. A loop
+      over the front's arcs that ends at the first ``-inf`` (next two items) ends at the
+      same arc however far beyond its bound the front was taken.
     - *tau where it can be finite.* Let ``T`` be ``max(tol, accuracy - _ROUNDING)``: a
       ``tau`` is ``-inf`` unless above ``tol`` and at least ``accuracy - _ROUNDING``, so
       every entry of a staircase has a rest of at least ``T`` (or ``inf``), and let
@@ -231,7 +236,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     prior, cost = problem.prior, problem.cost
     uniform = type(prior) is UniformPrior  # its max_arc_mass: group * length / (2 pi)
 
-    cover(tol)
+    # Every bound the widths ask, at once (one pass over the arcs; see the docstring).
+    bound = cap - 2.0 * low + _SPAN_SLACK
+    cover(bound if bound > tol else tol)
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
     width = grown[0]
@@ -239,12 +246,10 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         if width >= cap:
             break
         bound = width - margin2
-        if bound > front.covered:  # (> tol >= 0) then the front holds just the arcs below
+        if bound > front.covered:  # pragma: no cover - not past the bound above (W < cap)
             cover(bound)
-            wider = widths[-1]
-        else:
-            n = left(spans, bound) - 1
-            wider = widths[n] if n >= 0 else 0.0
+        n = left(spans, bound) - 1
+        wider = widths[n] if n >= 0 else 0.0
         grown.append(wider)
         if wider <= width + tol:
             break
@@ -378,6 +383,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     zero = new(PlanStep)  # the first step of every plan under the uniform prior
     set_kind(zero, kind)
     set_alpha(zero, 0.0)
+    top_x, top_at = math.nan, -1  # the longest plan's first witness: its span, the next one
     out = []
     for n in keep:
         length = grown[n]
@@ -390,9 +396,11 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             if n < last:
                 vals = taus[n]
                 tolerance = vals[at] if at < len(vals) else -inf
-            elif at < len(spans):  # the longest plan: its staircase's tau at arc `at`
-                x = spans[at]
-                tolerance = 0.5 * (w0 - x) if n == 1 else _stair_top(top_tau, widths, x)[0]
+            elif n == 1 and at < len(spans):  # the longest plan: its staircase's tau at `at`
+                tolerance = 0.5 * (w0 - spans[at])
+            elif at < len(spans):  # (and the arc it picks there: the next witness, below)
+                top_x = spans[at]
+                tolerance, top_at = _stair_top(top_tau, widths, top_x)
             else:
                 tolerance = -inf
             if not tolerance >= passing:  # pragma: no cover - the lengths guarantee a chain
@@ -417,8 +425,9 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
             s_last = s + spans[at]
             if m == 1:
                 at = 0  # the last action's staircase picks arc 0
-            elif m == last:
-                at = _stair_top(top_tau, widths, s_last - s)[1]
+            elif m == last:  # picked at the span of the first witness (Arc.span)
+                x = s_last - s
+                at = top_at if x == top_x else _stair_top(top_tau, widths, x)[1]
             else:
                 idx, rest, wid, c = stairs[m]
                 x = s_last - s
