@@ -465,11 +465,12 @@ def _floats(values: Sequence[float]) -> list[str]:
     """
     for x in values:
         if type(x) is not float:  # an int, a float subclass...: each by float.__repr__
-            return [_float(x) for x in values]
-    data = orjson.dumps(values)
-    if _as_repr(data):
-        text = data.decode()[1:-1]
-        return text.split(",") if text else []
+            break
+    else:
+        data = orjson.dumps(values)
+        if _as_repr(data):
+            text = data.decode()[1:-1]
+            return text.split(",") if text else []
     return [_float(x) for x in values]
 
 

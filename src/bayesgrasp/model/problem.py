@@ -137,11 +137,11 @@ _DEFAULT_GOAL = Goal()
 
 
 def shared_defaults(inputs: Mapping[str, Any]) -> dict[str, Any]:
-    """Keywords of :meth:`Problem.build`, a prior, cost or goal equal to its default build's own.
+    """The keywords of :meth:`Problem.build`, with build's own default objects where equal.
 
-    Equal and written alike (a -0.0 cost is not 0.0), each is replaced by the shared default
-    object. The same problem, built quicker: build need not check its default cost. For callers that
-    make their keywords once for many parts (``plan --batch``).
+    A prior, cost or goal equal to its default and written alike (a -0.0 cost is not 0.0) is
+    replaced by the shared default: the same problem, built quicker, since build need not
+    check its default cost. For callers that make their keywords once for many parts.
     """
     out = dict(inputs)
     for key, default in (
@@ -272,7 +272,7 @@ class Problem:
                 transfers[a.name] = f if f.kind == a.name else f.renamed(a.name)
         if cost is None:
             cost = _DEFAULT_COST
-        elif cost is not _DEFAULT_COST:  # (which no plan makes cost nothing)
+        elif cost is not _DEFAULT_COST:  # (its verification costs 1: no plan costs nothing)
             cost.check_positive(a.name for a in acts)
         prior = prior or _DEFAULT_PRIOR
         goal = goal or _DEFAULT_GOAL
