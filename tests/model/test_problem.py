@@ -161,6 +161,25 @@ def test_state_distribution_uniform_is_basin_widths(rng: np.random.Generator) ->
     assert_allclose(pb.state_distribution(1.234), pb.states.widths / TWO_PI, atol=1e-12)
 
 
+@pytest.mark.parametrize("prior", [None, von_mises(1.0, 3.0)], ids=["uniform", "von-mises"])
+def test_state_probabilities_are_the_distributions_floats(
+    rng: np.random.Generator, prior: object, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The list is the array's values, bit for bit; the few-states path is numpy's too."""
+    kw = {} if prior is None else {"prior": prior}
+    parts = [load("triangle"), load("house"), random_part(rng), random_part(rng)]
+    cases = [(Problem.build(p, **kw), a) for p in parts for a in (0.0, 0.7, -2.0, 9.5)]
+    got = [(pb.state_probabilities(a), pb.state_distribution(a)) for pb, a in cases]
+    for (pb, a), (floats, dist) in zip(cases, got, strict=True):
+        assert type(floats) is list and all(type(x) is float for x in floats)
+        assert floats == dist.tolist()
+        assert np.array(floats).tobytes() == dist.tobytes()  # -0.0 and NaN alike too
+        assert pb.state_probabilities(a, "squeeze") == floats
+    monkeypatch.setattr(Problem, "_small_distribution", lambda *_: None)  # numpy only
+    for (pb, a), (floats, _) in zip(cases, got, strict=True):
+        assert pb.state_distribution(a).tobytes() == np.array(floats).tobytes()
+
+
 def test_nearest_state() -> None:
     pb = Problem.build(Part.from_points(RECTANGLE))
     s = pb.states.stable

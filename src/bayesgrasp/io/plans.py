@@ -447,31 +447,20 @@ def _int(value: Any) -> str:
     return str(value)
 
 
-def _array(values: Any) -> str:
-    """A float64 array as JSON writes its ``tolist()``: the list's ``repr`` (Python floats)."""
-    if values.dtype.char != "d":
-        raise TypeError(f"not a float64 array: {values.dtype}")
-    floats = values.tolist()
-    data = orjson.dumps(floats)
-    if _as_repr(data):  # then the text of a list of lists too, but for its separators
-        return data.decode().replace(",", ", ")
-    return repr(floats)
-
-
 def _floats(values: Sequence[float]) -> list[str]:
     """``float.__repr__`` of each value (as ``json.dumps`` writes it): by one orjson call.
 
     A ``TypeError`` for a value that is not a float, as ``float.__repr__`` gives.
     """
-    for x in values:
-        if type(x) is not float:  # an int, a float subclass...: each by float.__repr__
-            break
-    else:
+    if {*map(type, values)} <= _FLOAT:  # else an int, a float subclass...: float.__repr__
         data = orjson.dumps(values)
         if _as_repr(data):
             text = data.decode()[1:-1]
             return text.split(",") if text else []
     return [_float(x) for x in values]
+
+
+_FLOAT = {float}
 
 
 def _as_repr(data: bytes) -> bool:
@@ -488,44 +477,62 @@ def _as_repr(data: bytes) -> bool:
     return not (b"e" in data or b"0.0000" in data or b"null" in data)
 
 
-def _option_text(option: PlanOption, known: Mapping[float, str]) -> str:
-    """:func:`option_document` as JSON text (each angle's repr made once).
+def _option_floats(option: PlanOption, values: list[Any]) -> tuple[int, bool, bool]:
+    """Append the floats :func:`option_document` writes to ``values``; what was appended.
 
-    ``known``: texts already made of non-zero floats (the stable orientations, which the
-    final orientations are), by value.
+    In order: each step's angle, the success probability, the expected cost and the
+    tolerance unless :func:`json_float` makes them null (missing or not finite), the final
+    orientation. Returns (steps, has cost, has tolerance), for :func:`_option_text`.
     """
     steps = option.steps
-    final = option.final_orientation
-    end = known.get(final) if type(final) is float and final else None
-    # json_float's null for a missing or non-finite value (a non-float: the general path)
     cost, tol = option.expected_cost, option.tolerance
-    no_cost = cost is None or not math.isfinite(cost)
-    no_tol = tol is None or not math.isfinite(tol)
-    values: list[Any] = [s.alpha for s in steps]
+    has_cost = cost is not None and math.isfinite(cost)
+    has_tol = tol is not None and math.isfinite(tol)
+    values += [s.alpha for s in steps]
     values.append(option.success_probability)
-    if not no_cost:
+    if has_cost:
         values.append(cost)
-    if not no_tol:
+    if has_tol:
         values.append(tol)
-    if end is None:
-        values.append(final)
-    texts = _floats(values)  # then taken from the end
-    end = end or texts.pop()
-    tol_text = "null" if no_tol else texts.pop()
-    cost_text = "null" if no_cost else texts.pop()
-    probability = texts.pop()
-    alphas = texts
+    values.append(option.final_orientation)
+    return len(steps), has_cost, has_tol
+
+
+def _option_text(
+    option: PlanOption, layout: tuple[int, bool, bool], texts: list[str], at: int
+) -> tuple[str, int]:
+    """:func:`option_document` as JSON text, from the float texts of :func:`_option_floats`.
+
+    ``texts[at:]`` starts with the option's floats; returns the text and where the next
+    option's start.
+    """
+    m, has_cost, has_tol = layout
+    alphas = texts[at : at + m]
+    at += m
+    probability = texts[at]
+    at += 1
+    cost_text = "null"
+    if has_cost:
+        cost_text = texts[at]
+        at += 1
+    tol_text = "null"
+    if has_tol:
+        tol_text = texts[at]
+        at += 1
+    end = texts[at]
+    steps = option.steps
     if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
         walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
     else:
         pairs = zip(steps, alphas, strict=True)
         walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
-    return (
-        f'{{"squeezes": {len(steps)}, "actions_rad": [{", ".join(alphas[1:])}], '
+    text = (
+        f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
         f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
         f'"final_orientation_rad": {end}, "success_probability": {probability}, '
         f'"expected_cost": {cost_text}, "tolerance_rad": {tol_text}}}'
     )
+    return text, at + 1
 
 
 # A squeeze step's text but its angle: before the first angle, and between two angles.
@@ -541,7 +548,15 @@ def _document_text(
     inputs: Mapping[str, Any] | None,
     memo: dict[str, Any] | None,
 ) -> str | None:
-    """The text of :func:`plan_document_json`; ``None`` where the template does not apply."""
+    """The text of :func:`plan_document_json`; ``None`` where the template does not apply.
+
+    Every float of the document is written by one :func:`_floats` call, in this order: the
+    hull's x and y coordinates, the centre of mass, the stable orientations, their
+    probabilities, the period, the first angle, then each option's (:func:`_option_floats`).
+    Each is the float the general path writes: the hull's vertices as its Python floats
+    (which its array is made of, or made from), the stable orientations as the states hold
+    them, the probabilities by :meth:`~bayesgrasp.model.problem.Problem.state_probabilities`.
+    """
     pb: Problem = result.problem
     part = pb.part
     if type(part) is not Part:  # a curved part's member: the general path
@@ -550,25 +565,38 @@ def _document_text(
     bayes = result.bayes_plan
     hull = part.hull
     units = "" if part.units is None else f', "units": {_text(part.units)}'
-    probs = pb.state_distribution(bayes.first_angle, bayes.steps[0].kind)
-    # The stable orientations as the states hold them (their array, which the general path
-    # writes, is made of these floats): float's repr of each, a TypeError for another type;
-    # the period and the first angle with them.
-    stable = pb.states.values[0]
-    texts = _floats([*stable, float(pb.states.period), bayes.first_angle])
-    first, period = texts.pop(), texts.pop()
-    # (0.0 and -0.0 are equal keys: zero is left out)
-    known = {x: t for x, t in zip(stable, texts, strict=True) if x}
+    xs, ys = hull._coords()
+    n = len(xs)
+    states = pb.states
+    stable = states.values[0]
+    k = len(stable)
+    probs = pb.state_probabilities(bayes.first_angle, bayes.steps[0].kind)
+    values = [*xs, *ys, *part.center_of_mass.tolist(), *stable, *probs]
+    values += [float(states.period), bayes.first_angle]
+    options = result.options
+    layouts = [_option_floats(o, values) for o in options]
+    texts = _floats(values)
+    i = 2 * n + 2  # where the stable orientations start
+    j = i + k + len(probs)  # where the probabilities end
+    period, first = texts[j], texts[j + 1]
+    at = j + 2
+    written = []
+    for option, layout in zip(options, layouts, strict=True):
+        option_text, at = _option_text(option, layout, texts, at)
+        written.append(option_text)
+    pairs = zip(texts[:n], texts[n : 2 * n], strict=True)
+    vertices = ", ".join([f"[{x}, {y}]" for x, y in pairs])
+    cx, cy = texts[2 * n], texts[2 * n + 1]
     text = [
         f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
-        f'"vertices": {_array(hull.vertices)}, "n_sides": {_int(hull.n_sides)}, '
+        f'"vertices": [{vertices}], "n_sides": {_int(hull.n_sides)}, '
         f'"symmetry_order": {_int(hull.symmetry_order)}{units}, '
-        f'"center_of_mass": {_array(part.center_of_mass)}, "id": {_text(part_id(part))}}}, '
+        f'"center_of_mass": [{cx}, {cy}], "id": {_text(part_id(part))}}}, '
         f'"method": {_text(result.method)}, '
-        f'"stable_orientations_rad": [{", ".join(texts)}], '
-        f'"stable_probabilities": {_array(probs)}, '
+        f'"stable_orientations_rad": [{", ".join(texts[i : i + k])}], '
+        f'"stable_probabilities": [{", ".join(texts[i + k : j])}], '
         f'"period_rad": {period}, "first_squeeze_rad": {first}, '
-        f'"options": [{", ".join([_option_text(o, known) for o in result.options])}], '
+        f'"options": [{", ".join(written)}], '
         f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
     ]
     if result.nodes is not None:

@@ -371,21 +371,44 @@ class Problem:
         function that end there, shifted by ``first_angle``.
         """
         f = self.transfer(kind)
-        uniform = type(self.prior) is UniformPrior and type(first_angle) is float
-        if uniform and f is self.states and f.n_states <= SMALL:
-            # The uniform cdf's operations one element at a time on Python floats (a few
-            # states): the same IEEE additions, divisions and subtractions as numpy's.
-            _, lo, hi = f.values
-            a = first_angle
-            return np.array(
-                [(h + a) / TWO_PI - (b + a) / TWO_PI for b, h in zip(lo, hi, strict=True)],
-                dtype=np.float64,
-            )
+        small = self._small_distribution(f, first_angle)
+        if small is not None:
+            return np.array(small, dtype=np.float64)
         masses = self.prior.mass(f.basin_lo + first_angle, f.basin_hi + first_angle)
         if f is self.states:
             return np.asarray(masses, dtype=np.float64)
         idx = nearest_state(self.states, f.stable)
         return np.bincount(idx, weights=masses, minlength=self.n_states).astype(np.float64)
+
+    def state_probabilities(
+        self, first_angle: float = 0.0, kind: str | Action = "squeeze"
+    ) -> list[float]:
+        """:meth:`state_distribution` as a list of Python floats (the same values).
+
+        For writers of a few states (a plan document), where the array is only read back.
+        """
+        small = self._small_distribution(self.transfer(kind), first_angle)
+        if small is not None:
+            return small
+        return self.state_distribution(first_angle, kind).tolist()  # type: ignore[no-any-return]
+
+    def _small_distribution(self, f: TransferFunction, first_angle: float) -> list[float] | None:
+        """:meth:`state_distribution` on Python floats, or ``None`` (numpy's case).
+
+        For a uniform prior, the states' own transfer function and a few states: the uniform
+        cdf's operations one element at a time, the same IEEE additions, divisions and
+        subtractions as numpy's.
+        """
+        if not (
+            type(self.prior) is UniformPrior
+            and type(first_angle) is float
+            and f is self.states
+            and f.n_states <= SMALL
+        ):
+            return None
+        _, lo, hi = f.values
+        a = first_angle
+        return [(h + a) / TWO_PI - (b + a) / TWO_PI for b, h in zip(lo, hi, strict=True)]
 
 
 (
