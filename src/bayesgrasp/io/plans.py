@@ -393,10 +393,8 @@ def plan_document(
 
 # json.dumps(doc, allow_nan=False) without its argument checks (documents are trees).
 _encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
-# What json.dumps writes a str and a float with (ensure_ascii; a float's repr, as the C
-# encoder's, subclasses such as numpy's float64 too; anything else raises TypeError).
+# What json.dumps writes a str with (ensure_ascii).
 _text = json.encoder.encode_basestring_ascii
-_float = float.__repr__
 
 
 def plan_document_json(
@@ -410,11 +408,11 @@ def plan_document_json(
     """``json.dumps(plan_document(...), allow_nan=False)``, written without the dicts.
 
     The same text, byte for byte (``plan --batch`` writes one a line), made from the
-    result's values: each float by its ``repr`` as the encoder writes it, each list of
-    floats by the list's ``repr`` (the same text for finite Python floats), the provenance
-    shared through ``memo`` encoded once. A value the template does not know (a non-float
-    where it writes floats, a curved part, a non-finite number the encoder refuses) makes
-    :func:`plan_document` and the encoder decide, so their result or error is this one's.
+    result's values: every float by one orjson call that writes each as its ``repr``, as
+    the encoder does (:func:`_float_texts`), the provenance shared through ``memo`` encoded
+    once. A value the template does not know (a non-float where it writes floats, a curved
+    part, a non-finite number the encoder refuses) makes :func:`plan_document` and the
+    encoder decide, so their result or error is this one's.
 
     Examples
     --------
@@ -447,17 +445,20 @@ def _int(value: Any) -> str:
     return str(value)
 
 
-def _floats(values: Sequence[float]) -> list[str]:
-    """``float.__repr__`` of each value (as ``json.dumps`` writes it): by one orjson call.
+def _float_texts(values: Sequence[Any]) -> list[str] | None:
+    """``float.__repr__`` of each value (as ``json.dumps`` writes it), by one orjson call.
 
-    A ``TypeError`` for a value that is not a float, as ``float.__repr__`` gives.
+    ``None`` when a value is not a float (an int, a float subclass, anything else) or orjson
+    spells one otherwise than ``repr`` (:func:`_as_repr`: a non-finite one among them): the
+    document then takes the general path, which writes or refuses it as the encoder does.
     """
-    if {*map(type, values)} <= _FLOAT:  # else an int, a float subclass...: float.__repr__
-        data = orjson.dumps(values)
-        if _as_repr(data):
-            text = data.decode()[1:-1]
-            return text.split(",") if text else []
-    return [_float(x) for x in values]
+    if not {*map(type, values)} <= _FLOAT:
+        return None
+    data = orjson.dumps(values)
+    if not _as_repr(data):
+        return None
+    text = data.decode()[1:-1]
+    return text.split(",") if text else []
 
 
 _FLOAT = {float}
@@ -550,9 +551,10 @@ def _document_text(
 ) -> str | None:
     """The text of :func:`plan_document_json`; ``None`` where the template does not apply.
 
-    Every float of the document is written by one :func:`_floats` call, in this order: the
-    hull's x and y coordinates, the centre of mass, the stable orientations, their
-    probabilities, the period, the first angle, then each option's (:func:`_option_floats`).
+    Every float of the document is written by one :func:`_float_texts` call, in this order:
+    the hull's x and y coordinates, the centre of mass, the stable orientations, their
+    probabilities, the period, the first angle, then each option's (:func:`_option_floats`),
+    and the accuracy when it is written.
     Each is the float the general path writes: the hull's vertices as its Python floats
     (which its array is made of, or made from), the stable orientations as the states hold
     them, the probabilities by :meth:`~bayesgrasp.model.problem.Problem.state_probabilities`.
@@ -575,7 +577,11 @@ def _document_text(
     values += [float(states.period), bayes.first_angle]
     options = result.options
     layouts = [_option_floats(o, values) for o in options]
-    texts = _floats(values)
+    if pb.accuracy > 0:
+        values.append(pb.accuracy)
+    texts = _float_texts(values)
+    if texts is None:  # a value of another type, or not finite
+        return None
     i = 2 * n + 2  # where the stable orientations start
     j = i + k + len(probs)  # where the probabilities end
     period, first = texts[j], texts[j + 1]
@@ -602,17 +608,12 @@ def _document_text(
     if result.nodes is not None:
         text.append(f', "nodes": {_int(result.nodes)}')
     if pb.accuracy > 0:
-        text.append(f', "accuracy_rad": {_float(pb.accuracy)}')
+        text.append(f', "accuracy_rad": {texts[-1]}')
     if guaranteed is not None:
         text.append(f', "guaranteed": {_encode(guaranteed_document(guaranteed))}')
     elif guaranteed_missing is not None:
         text.append(f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}')
     done = "".join(text)
-    # A float that is not finite is written nan, inf or -inf, which the encoder refuses; no
-    # key above holds these letters, so a string that does (a name) only costs the general
-    # path.
-    if "nan" in done or "inf" in done:
-        return None
     provenance = _shared_provenance(pb, result.method, inputs, memo)
     if memo is None:
         return f'{done}, "provenance": {_encode(provenance)}}}'
