@@ -257,11 +257,12 @@ class Problem:
             acts = parse_actions(actions)
         if not isinstance(part, Part):
             raise PlanningError(f"`part` must be a Part; got {type(part).__name__}")
-        if prior is not None and not isinstance(prior, Prior):
+        # (the shared defaults skip the checks: Prior is an ABC, whose isinstance is slow)
+        if prior is not None and prior is not _DEFAULT_PRIOR and not isinstance(prior, Prior):
             raise PlanningError(f"`prior` must be a Prior; got {type(prior).__name__}")
-        if cost is not None and not isinstance(cost, CostModel):
+        if cost is not None and cost is not _DEFAULT_COST and not isinstance(cost, CostModel):
             raise PlanningError(f"`cost` must be a CostModel; got {type(cost).__name__}")
-        if goal is not None and not isinstance(goal, Goal):
+        if goal is not None and goal is not _DEFAULT_GOAL and not isinstance(goal, Goal):
             raise PlanningError(f"`goal` must be a Goal; got {type(goal).__name__}")
         d, states = squeeze_model(part)  # a curved part: its exact model (geometry/curved.py)
         transfers = {SQUEEZE.name: states}
