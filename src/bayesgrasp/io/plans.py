@@ -481,21 +481,22 @@ def _as_repr(data: bytes) -> bool:
 def _option_floats(option: PlanOption, values: list[Any]) -> tuple[int, bool, bool]:
     """Append the floats :func:`option_document` writes to ``values``; what was appended.
 
-    In order: each step's angle, the success probability, the expected cost and the
-    tolerance unless :func:`json_float` makes them null (missing or not finite), the final
-    orientation. Returns (steps, has cost, has tolerance), for :func:`_option_text`.
+    In order: each step's angle, the success probability, the expected cost, the tolerance
+    and the final orientation; 0.0 in place of a cost or tolerance that :func:`json_float`
+    makes null (missing or not finite). Returns (steps, has cost, has tolerance), for
+    :func:`_option_text`.
     """
     steps = option.steps
     cost, tol = option.expected_cost, option.tolerance
     has_cost = cost is not None and math.isfinite(cost)
     has_tol = tol is not None and math.isfinite(tol)
     values += [s.alpha for s in steps]
-    values.append(option.success_probability)
-    if has_cost:
-        values.append(cost)
-    if has_tol:
-        values.append(tol)
-    values.append(option.final_orientation)
+    values += (
+        option.success_probability,
+        cost if has_cost else 0.0,
+        tol if has_tol else 0.0,
+        option.final_orientation,
+    )
     return len(steps), has_cost, has_tol
 
 
@@ -510,17 +511,7 @@ def _option_text(
     m, has_cost, has_tol = layout
     alphas = texts[at : at + m]
     at += m
-    probability = texts[at]
-    at += 1
-    cost_text = "null"
-    if has_cost:
-        cost_text = texts[at]
-        at += 1
-    tol_text = "null"
-    if has_tol:
-        tol_text = texts[at]
-        at += 1
-    end = texts[at]
+    probability, cost, tol, end = texts[at : at + 4]
     steps = option.steps
     if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
         walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
@@ -531,9 +522,10 @@ def _option_text(
         f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
         f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
         f'"final_orientation_rad": {end}, "success_probability": {probability}, '
-        f'"expected_cost": {cost_text}, "tolerance_rad": {tol_text}}}'
+        f'"expected_cost": {cost if has_cost else "null"}, '
+        f'"tolerance_rad": {tol if has_tol else "null"}}}'
     )
-    return text, at + 1
+    return text, at + 4
 
 
 # A squeeze step's text but its angle: before the first angle, and between two angles.
