@@ -406,38 +406,66 @@ def _hull_small(
         n == 3
         or (sure and sure_upper and _firm(hull, 0, eps, bound) and _firm(hull, last, eps, bound))
     ):
-        # _drop_and_measure with nothing to drop: the same sums in the same order, and the
-        # same scale, the largest |x - ox| and |y - oy| over the vertices (a rounded
-        # difference is monotone in its terms): the last point, of the largest x, is a
-        # vertex, and the least and largest y are checked to be.
-        ox, oy = hull[0]
-        scale = max(hull[last][0] - ox, y1 - oy, oy - y0)
-        xs, ys = [ox], [oy]
-        twice = cx = cy = qx = qy = 0.0
-        for bx, by in hull[1:]:
-            xs.append(bx)
-            ys.append(by)
-            rx = (bx - ox) / scale
-            ry = (by - oy) / scale
-            c = qx * ry - rx * qy
-            twice += c
-            cx += (qx + rx) * c
-            cy += (qy + ry) * c
-            qx = rx
-            qy = ry
-        c = qx * 0.0 - 0.0 * qy  # the edge back to the first vertex, at (0, 0)
-        twice += c
-        cx += (qx + 0.0) * c
-        cy += (qy + 0.0) * c
-        if twice != 0.0 and y0 in ys and y1 in ys and 0.0 < scale < math.inf:
-            unit = scale / (3.0 * twice)
-            cx = cx * unit + ox
-            cy = cy * unit + oy
-            return xs, ys, 0.5 * twice * scale * scale, cx, cy, _size(hull, cx, cy)
+        measured = _measure(hull, last, y0, y1)
+        if measured is not None:
+            return measured
     xs, ys, area, cx, cy = _drop_and_measure([p[0] for p in hull], [p[1] for p in hull], eps)
     if not xs:
         return xs, ys, area, cx, cy, 0.0
     return xs, ys, area, cx, cy, _size(zip(xs, ys, strict=True), cx, cy)
+
+
+def _measure(
+    hull: list[tuple[float, float]], last: int, y0: float, y1: float
+) -> tuple[list[float], list[float], float, float, float, float] | None:
+    """:func:`_drop_and_measure` of a hull chain with nothing to drop, and the hull's size.
+
+    ``hull``: the vertices counter-clockwise from the lexicographically least, ``last`` the
+    index of the largest, ``y0`` and ``y1`` the least and largest y of the points. The same
+    sums in the same order, and the same scale, the largest ``|x - ox|`` and ``|y - oy|``
+    over the vertices (a rounded difference is monotone in its terms): the last point, of
+    the largest x, is a vertex, and the least and largest y are checked to be. ``None``
+    when they are not, or the scale or area is degenerate: :func:`_drop_and_measure` decides.
+    """
+    ox, oy = hull[0]
+    scale = max(hull[last][0] - ox, y1 - oy, oy - y0)
+    xs, ys = [ox], [oy]
+    twice = cx = cy = qx = qy = 0.0
+    for bx, by in hull[1:]:
+        xs.append(bx)
+        ys.append(by)
+        rx = (bx - ox) / scale
+        ry = (by - oy) / scale
+        c = qx * ry - rx * qy
+        twice += c
+        cx += (qx + rx) * c
+        cy += (qy + ry) * c
+        qx = rx
+        qy = ry
+    c = qx * 0.0 - 0.0 * qy  # the edge back to the first vertex, at (0, 0)
+    twice += c
+    cx += (qx + 0.0) * c
+    cy += (qy + 0.0) * c
+    if not (twice != 0.0 and y0 in ys and y1 in ys and 0.0 < scale < math.inf):
+        return None
+    unit = scale / (3.0 * twice)
+    cx = cx * unit + ox
+    cy = cy * unit + oy
+    return xs, ys, 0.5 * twice * scale * scale, cx, cy, _size(hull, cx, cy)
+
+
+def _odd_magnitude(x0: float, x1: float, y0: float, y1: float, extent: float) -> bool:
+    """Whether :func:`_check_magnitude` must look: a coordinate or the extent out of range.
+
+    (The largest ``|coordinate|`` is the largest of max and -min.)
+    """
+    big = _MAX_COORD
+    return x1 > big or -x0 > big or y1 > big or -y0 > big or 0.0 < extent < _MIN_EXTENT
+
+
+# A ring whose every turn exceeds this fraction of the squared bounding-box diagonal is
+# decided by the hull's chains as in exact arithmetic (see ConvexPolygon._of_firm_ring).
+_RING_FIRM = 2e-13
 
 
 def _size(points: Iterable[tuple[float, float]], cx: float, cy: float) -> float:
@@ -792,8 +820,7 @@ class ConvexPolygon:
         by_y = sorted(py)  # (cheaper than min and max)
         x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], by_y[0], by_y[-1]
         extent = max(x1 - x0, y1 - y0)
-        big = _MAX_COORD  # the largest |coordinate| is the largest of max and -min
-        if x1 > big or -x0 > big or y1 > big or -y0 > big or 0.0 < extent < _MIN_EXTENT:
+        if _odd_magnitude(x0, x1, y0, y1, extent):
             _check_magnitude(pts, extent)
         eps = tol.length_for(extent)
         if extent == 0.0:
@@ -802,6 +829,53 @@ class ConvexPolygon:
         if len(xs) < 3 or area <= eps * extent:
             _refuse(pts, eps)
         return cls._of_floats(xs, ys, tol, area, cx, cy, size)
+
+    @classmethod
+    def _of_firm_ring(
+        cls, ring: list[tuple[float, float]], least: float, tol: Tolerance
+    ) -> ConvexPolygon | None:
+        """:meth:`_hull_of_floats` of a ring's points, when the ring is already their hull.
+
+        ``ring``: at most :data:`_SMALL` finite points in order round a polygon that turns
+        the same way at every vertex and winds once (``io.points._convex_once``); ``least``:
+        the cross product ``(b - a) x (c - b)`` of least magnitude over its vertices,
+        positive if the ring runs counter-clockwise. ``None`` when this cannot promise the
+        same polygon: the caller then takes the hull.
+
+        Why it is the same polygon, to the last bit: with ``D`` the bounding box's diagonal
+        and ``u`` the unit roundoff, a computed orientation of three of the points (the
+        chains' tests, the near-collinear test) or cross product of consecutive edges is
+        within ``8 u D^2`` of its exact value. The ring is a convex polygon, and the least
+        triangle on its vertices is one of three consecutive vertices (fix two vertices: the
+        distance of the third from their line is unimodal round each side, so the least is
+        next to one of them; again with that edge fixed). So when ``|least|`` exceeds
+        :data:`_RING_FIRM` ``D^2`` (10^2 times ``16 u D^2``), every test of the monotone
+        chains decides as exact arithmetic does: the hull's vertices are the ring's, every
+        one, counter-clockwise from the lexicographically least. And when ``|least|`` is
+        also above twice the chains' bound ``2 eps extent`` of :func:`_hull_small`, no vertex
+        is within ``eps`` of its neighbours' chord, so the near-collinear test drops none,
+        and :func:`_measure` of that order gives the same area, centroid and size as either
+        path of :func:`_hull_small`. Points met twice, odd magnitudes and degenerate areas
+        go to the hull, which words the refusals.
+        """
+        ys = [p[1] for p in ring]
+        start, top = min(ring), max(ring)  # the lexicographically least and largest
+        x0, x1, y0, y1 = start[0], top[0], min(ys), max(ys)
+        extent = max(x1 - x0, y1 - y0)
+        if _odd_magnitude(x0, x1, y0, y1, extent):
+            return None
+        eps = tol.length_for(extent)
+        bound = 2.0 * eps * extent
+        firm = _RING_FIRM * ((x1 - x0) ** 2 + (y1 - y0) ** 2)
+        if not (bound >= _TINY and abs(least) > 2.0 * bound and abs(least) > firm):
+            return None
+        turn = ring if least > 0 else ring[::-1]
+        i = turn.index(start)
+        hull = turn[i:] + turn[:i]
+        measured = _measure(hull, hull.index(top), y0, y1)
+        if measured is None or not measured[2] > eps * extent:
+            return None
+        return cls._of_floats(*measured[:2], tol, *measured[2:])
 
     @property
     def n_sides(self) -> int:
@@ -1091,6 +1165,24 @@ class Part:
             if tol is not DEFAULT_TOLERANCE:
                 _check_tolerance(tol)
             hull = ConvexPolygon._hull_of(outline, tol)
+        return cls._of_hull(hull, outline, name, center_of_mass, units)
+
+    @classmethod
+    def _of_hull(
+        cls,
+        hull: ConvexPolygon,
+        outline: FloatArray,
+        name: str,
+        center_of_mass: ArrayLike | None,
+        units: str | None,
+    ) -> Part:
+        """:meth:`from_points` of points whose hull is ``hull`` (``outline``: a fresh array).
+
+        Raises
+        ------
+        PartError
+            A centre of mass outside the hull.
+        """
         outline.setflags(write=False)
         if center_of_mass is None:  # the hull's centroid (the same read-only array)
             cx, cy = hull._centroid_xy()

@@ -36,8 +36,9 @@ import orjson
 from numpy.typing import NDArray
 
 from ..errors import PartError
-from ..geometry import Part, as_points, find_crossing
+from ..geometry import ConvexPolygon, Part, as_points, find_crossing
 from ..sizes import SMALL
+from ..tolerance import DEFAULT_TOLERANCE
 from ._common import (
     MAX_BYTES,
     MAX_COORDINATE,
@@ -243,12 +244,15 @@ def _small_is_convex(
 _FIRM = 2e-12
 
 
-def _convex_once(ring: list[tuple[float, float]], turns: Sequence[tuple[float, ...]]) -> bool:
+def _convex_once(ring: list[tuple[float, float]], turns: Sequence[tuple[float, ...]]) -> float:
     """Whether the ring is firmly convex: every turn one way, by a margin, winding once.
 
     Then :func:`_small_is_simple` and :func:`_small_is_convex` both return True, found in
-    O(N) rather than their O(N^2) pairs of edges; ``False`` means only "not shown here".
-    ``turns``: the (cross, dot, ...) of :func:`_bends` or :func:`_turns` at each vertex.
+    O(N) rather than their O(N^2) pairs of edges. Returns the cross product of least
+    magnitude (positive: the ring runs counter-clockwise), for
+    :meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`; ``0.0`` means only
+    "not shown here". ``turns``: the (cross, dot, ...) of :func:`_bends` or :func:`_turns`
+    at each vertex.
 
     Why: a ring that turns one way at every vertex and once in all (exterior angles in
     (0, pi) summing to 2 pi) is a convex polygon. Every vertex R off an edge PQ then lies at
@@ -266,10 +270,12 @@ def _convex_once(ring: list[tuple[float, float]], turns: Sequence[tuple[float, .
     ys = [p[1] for p in ring]
     firm = _FIRM * ((max(xs) - min(xs)) ** 2 + (max(ys) - min(ys)) ** 2)
     crosses = [t[0] for t in turns]
-    if not (min(crosses) > firm or max(crosses) < -firm):
-        return False
+    low, high = min(crosses), max(crosses)
+    least = low if low > firm else high if high < -firm else 0.0
+    if not least:
+        return 0.0
     winding = sum([math.atan2(abs(t[0]), t[1]) for t in turns])
-    return winding < 3 * math.pi  # 2 pi once, 4 pi or more for a star
+    return least if winding < 3 * math.pi else 0.0  # 2 pi once, 4 pi or more for a star
 
 
 def point_list_part(
@@ -324,10 +330,22 @@ def _small_point_list_part(
     center_of_mass: Any = None,
     units: str | None = None,
 ) -> Part:
-    """:func:`point_list_part` of the points :func:`_small_floats` gave."""
+    """:func:`point_list_part` of the points :func:`_small_floats` gave.
+
+    A firmly convex ring with no point repeated is its own hull, taken without the hull's
+    chains (:meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`).
+    """
     pts = np.array(small, dtype=np.float64)
     sring = _small_ring(small)
-    if len(sring) >= 3 and _convex_once(sring, _bends(sring)):  # most files: O(N)
+    least = _convex_once(sring, _bends(sring)) if len(sring) >= 3 else 0.0
+    if least:  # most files: O(N)
+        if len(sring) == len(small):
+            hull = ConvexPolygon._of_firm_ring(sring, least, DEFAULT_TOLERANCE)
+            if hull is not None:
+                try:
+                    return Part._of_hull(hull, pts, name, center_of_mass, units)
+                except PartError as exc:
+                    raise fail(Path(path), str(exc)) from None
         simple, concave = True, False
     else:
         turns = _turns(sring) if len(sring) >= 3 else []
