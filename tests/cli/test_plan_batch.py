@@ -7,6 +7,9 @@ part is reported in its line and the batch goes on.
 from __future__ import annotations
 
 import json
+import select
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -196,3 +199,95 @@ def test_a_line_that_is_not_utf8_is_reported_in_its_line(
         "exit_code": 2,
     }
     assert docs[0] == single(capsys, "house") and docs[2] == single(capsys, "key")
+
+
+def _study_rows(count: int, seed: int = 3) -> list[str]:
+    rng = np.random.default_rng(seed)
+    rows = []
+    for k in range(count):
+        pts = rng.random((10, 2))
+        c = pts.mean(axis=0)
+        outline = pts[np.argsort(np.arctan2(*(pts - c).T[::-1]))].tolist()  # angular order
+        rows.append(json.dumps({"name": f"r{k}", "vertices": outline}))
+    return rows
+
+
+def test_groups_give_the_lines_of_one_part_at_a_time(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Parts planned stage by stage in groups (bad ones among them, a large part ending a
+    group early) give the lines, in order, that one part at a time gives."""
+    from bayesgrasp.cli import batch as batch_module
+
+    rows = _study_rows(2 * batch_module.GROUP + 5)
+    rows[3] = '{"name": "segment", "vertices": [[0, 0], [1, 1]]}'  # fails when read
+    rows[7] = '"no-such-part"'
+    t = np.linspace(0.0, 2 * np.pi, 100, endpoint=False)
+    rows[20] = json.dumps({"name": "round", "vertices": np.c_[np.cos(t), np.sin(t)].tolist()})
+    path = tmp_path / "parts.jsonl"
+    path.write_text("\n".join(rows) + "\n")
+    seen: list[list[str]] = []
+    finish = batch_module._finish
+
+    def spy(group: list[tuple[str, Any]], *args: Any) -> int:
+        seen.append([label.rsplit(":", 1)[1] for label, _ in group])
+        return finish(group, *args)
+
+    monkeypatch.setattr(batch_module, "_finish", spy)
+    code, grouped, err = run(capsys, "plan", "--batch", str(path), "--guaranteed")
+    monkeypatch.setattr(batch_module, "GROUP", 1)
+    code_1, alone, err_1 = run(capsys, "plan", "--batch", str(path), "--guaranteed")
+    assert (code, err) == (code_1, err_1) == (2, "")
+    assert grouped == alone and len(grouped.splitlines()) == len(rows)
+    assert "3 distinct points" in json.loads(grouped.splitlines()[3])["error"]
+    # 16 lines, then the 100-gon (line 21) ends a group of 5, then 16; the run with
+    # GROUP = 1 adds its one-line groups after.
+    assert [len(g) for g in seen] == [16, 5, 16] + [1] * len(rows) and seen[1][-1] == "21"
+
+
+def test_a_bug_in_a_group_writes_the_lines_before_it(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A failure that is not a bad part still raises, after the lines of the parts before."""
+    from bayesgrasp.planning import exact
+
+    path = tmp_path / "parts.jsonl"
+    rows = _study_rows(12)
+    path.write_text("\n".join(rows) + "\n")
+    code, before, _ = run(capsys, "plan", "--batch", str(path))
+    plan = exact.plan_exact
+
+    def broken(problem: Any, **kwargs: Any) -> Any:
+        if problem.part.name == "r5":
+            raise RuntimeError("a bug")
+        return plan(problem, **kwargs)
+
+    monkeypatch.setattr(exact, "plan_exact", broken)
+    monkeypatch.setattr("bayesgrasp.planning.plan_exact", broken)
+    with pytest.raises(RuntimeError, match="a bug"):
+        main(["plan", "--batch", str(path)])
+    out, _ = capsys.readouterr()
+    assert code == 0 and out == "".join(before.splitlines(keepends=True)[:5])
+
+
+def test_lines_from_stdin_are_answered_as_they_come(tmp_path: Path) -> None:
+    """A program that writes a line and waits for its answer is answered (no grouping)."""
+    rows = _study_rows(3)
+    with subprocess.Popen(
+        [sys.executable, "-m", "bayesgrasp.cli", "plan", "--batch", "-"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    ) as proc:
+        assert proc.stdin is not None and proc.stdout is not None
+        try:
+            for k, row in enumerate(rows):
+                proc.stdin.write(row + "\n")
+                proc.stdin.flush()
+                ready, _, _ = select.select([proc.stdout], [], [], 60)
+                assert ready, f"no answer to line {k + 1} in 60 s"
+                assert json.loads(proc.stdout.readline())["part"]["name"] == f"r{k}"
+            proc.stdin.close()
+            assert proc.wait(timeout=60) == 0 and proc.stdout.read() == ""
+        finally:
+            proc.kill()
