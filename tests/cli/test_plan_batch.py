@@ -234,15 +234,17 @@ def test_groups_give_the_lines_of_one_part_at_a_time(
         return finish(group, *args)
 
     monkeypatch.setattr(batch_module, "_finish", spy)
+    size = batch_module.GROUP
     code, grouped, err = run(capsys, "plan", "--batch", str(path), "--guaranteed")
     monkeypatch.setattr(batch_module, "GROUP", 1)
     code_1, alone, err_1 = run(capsys, "plan", "--batch", str(path), "--guaranteed")
     assert (code, err) == (code_1, err_1) == (2, "")
     assert grouped == alone and len(grouped.splitlines()) == len(rows)
     assert "3 distinct points" in json.loads(grouped.splitlines()[3])["error"]
-    # 16 lines, then the 100-gon (line 21) ends a group of 5, then 16; the run with
-    # GROUP = 1 adds its one-line groups after.
-    assert [len(g) for g in seen] == [16, 5, 16] + [1] * len(rows) and seen[1][-1] == "21"
+    # The 100-gon (line 21) ends the first group, then full groups and the rest; the run
+    # with GROUP = 1 adds its one-line groups after.
+    assert [len(g) for g in seen] == [21, size, len(rows) - 21 - size] + [1] * len(rows)
+    assert seen[0][-1] == "21"
 
 
 def test_a_bug_in_a_group_writes_the_lines_before_it(

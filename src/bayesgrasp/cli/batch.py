@@ -35,9 +35,9 @@ class BatchFileError(Exception):
     """The ``--batch`` file cannot be opened (the message says why)."""
 
 
-#: Parts planned together, stage by stage (:func:`run_batch`): 15-20% less CPU than one part
-#: at a time on the study's 2000 hulls (4: 10%, 64: as 16; bench_limits.py, README).
-GROUP = 16
+#: Parts planned together, stage by stage (:func:`run_batch`). On the study's 2000 hulls,
+#: warm, against one part at a time: 8 parts 10% less CPU, 16 18%, 32 and 64 21%, 128 20%.
+GROUP = 32
 
 
 def run_batch(
@@ -58,7 +58,7 @@ def run_batch(
     The parts are planned in groups of up to :data:`GROUP`, stage by stage: every part of a
     group read, then every problem built, every plan made, every document written. The
     same work in another order, and the same lines, but each stage's code and data stay in
-    the processor's caches: 15-20% less time than one part at a time. A group ends early at
+    the processor's caches: about 20% less time than one part at a time. A group ends early at
     a part of more than ``sizes.SMALL`` hull vertices (or a curved part), so at most one
     large problem is held at a time; lines read from standard input are planned one at a
     time (each answered as it comes, for a program that writes a line and waits). A failure
