@@ -10,8 +10,10 @@ Cases:
 - ``study``: the seed's 2000-polygon study (hull, diameter, squeeze function, exact Bayes
   plans with angles), as ``run_study(2000, seed=1)`` runs it;
 - ``batch``: ``plan --batch`` of the study's 2000 hulls as JSON lines, in one process (the
-  command's ``main``; its first call imports the command's modules, so a second call is
-  timed too), beside the in-process study;
+  command's ``main``; its first call imports the command's modules, so later calls are
+  timed too), beside the in-process study; also the batch one part at a time and the study
+  planned in groups stage by stage, as the batch plans its lines (the like-for-like
+  comparison of that technique);
 - ``bfs``: the breadth-first baseline (``planning/bfs.py``) on the same 2000 polygons, beside
   the exact planner on the same problems (this branch only);
 - ``circle N``: N random points on the unit circle (N = 10^3, 10^4, 10^5);
@@ -103,25 +105,50 @@ elif case == "bfs":
 elif case == "batch":
     import contextlib, io, os, tempfile
     from bayesgrasp.cli import main
+    from bayesgrasp.planning.exact import plan_exact as exact
+    try:
+        import bayesgrasp.cli.batch as grouped
+    except ImportError:
+        grouped = None
     rng = np.random.default_rng(1)
     path = os.path.join(tempfile.mkdtemp(), "parts.jsonl")
     with open(path, "w") as fh:
         for k in range(n):
             hull = random_polygon(rng).hull.vertices.tolist()
             fh.write(json.dumps({"name": f"p{k}", "vertices": hull}) + "\n")
-    sink = io.StringIO()
-    c0 = time.process_time()
-    with contextlib.redirect_stdout(sink):
-        code = main(["plan", "--batch", path])
-    out["cpu"] = time.process_time() - c0
-    out["lines"] = sink.getvalue().count("\n")
-    c0 = time.process_time()  # again, the command's modules imported now
-    with contextlib.redirect_stdout(io.StringIO()):
-        main(["plan", "--batch", path])
-    out["warm"] = time.process_time() - c0
-    c0 = time.process_time()
-    run_study(n, 1)
-    out["study"] = time.process_time() - c0
+
+    def batch(group=None):
+        if group is not None and grouped is not None and hasattr(grouped, "GROUP"):
+            was, grouped.GROUP = grouped.GROUP, group
+        sink = io.StringIO()
+        c0 = time.process_time()
+        with contextlib.redirect_stdout(sink):
+            main(["plan", "--batch", path])
+        cpu = time.process_time() - c0
+        if group is not None and grouped is not None and hasattr(grouped, "GROUP"):
+            grouped.GROUP = was
+        return cpu, sink.getvalue().count("\n")
+
+    def study_in_groups(size=32):
+        # The study's work (hull, problem, exact plans) stage by stage in groups, as the
+        # batch plans its lines: what the same technique would give the study.
+        draws = np.random.default_rng(1).uniform(size=(n, 10, 2))
+        c0 = time.process_time()
+        for s in range(0, n, size):
+            parts = [Part.from_points(d, name="random") for d in draws[s : s + size]]
+            problems = [Problem.build(p) for p in parts]
+            plans = [exact(pb) for pb in problems]
+        return time.process_time() - c0
+
+    out["cpu"], out["lines"] = batch()  # the first call imports the command's modules
+    out["warm"], out["study"], out["one"], out["study_grouped"] = [], [], [], []
+    for _ in range(3):  # alternating, so that a change of load hits all alike
+        out["warm"].append(batch()[0])
+        c0 = time.process_time()
+        run_study(n, 1)
+        out["study"].append(time.process_time() - c0)
+        out["one"].append(batch(1)[0])
+        out["study_grouped"].append(study_in_groups())
 else:
     pts = points(case, n)
     if traced:
@@ -248,18 +275,38 @@ def bfs_case(args: argparse.Namespace) -> None:
 
 
 def batch_case(args: argparse.Namespace) -> None:
-    """``plan --batch`` beside the in-process study (this branch): the best of each."""
+    """``plan --batch`` beside the in-process study (this branch).
+
+    Each run: the first call (it imports the command's modules), then three rounds of a
+    second call, the study, the batch one part at a time (``GROUP = 1``) and the study in
+    groups; best of each over the runs, and the median of the rounds' ratios.
+    """
     runs = [run(HERE, "batch", args.polygons, False, args.timeout) for _ in range(args.repeat)]
     ok = [r for r in runs if "cpu" in r]
-    if ok:
-        cpu, study = min(r["cpu"] for r in ok), min(r["study"] for r in ok)
-        warm = min(r.get("warm", math.inf) for r in ok)
-        print(
-            f"plan --batch, {ok[0]['lines']} parts in one process: cpu {cpu:.3f} s (the "
-            f"command's imports included; {warm:.3f} s on a second call); the in-process "
-            f"study {study:.3f} s ({cpu / study:.2f}x; {warm / study:.2f}x); per run: "
-            + ", ".join(f"{r['cpu'] / r['study']:.2f}x" for r in ok)
-        )
+    if not ok:
+        print(f"plan --batch: {runs[0]}")
+        return
+
+    def best(key: str) -> float:
+        return min(min(r[key]) if isinstance(r[key], list) else r[key] for r in ok)
+
+    def median_ratio(key: str, of: str) -> float:
+        ratios = sorted(a / b for r in ok for a, b in zip(r[key], r[of], strict=True))
+        return ratios[len(ratios) // 2]
+
+    study, warm, cold = best("study"), best("warm"), best("cpu")
+    print(
+        f"plan --batch, {ok[0]['lines']} parts in one process: {warm:.3f} s warm, "
+        f"{cold:.3f} s the first call (the command's imports); the in-process study "
+        f"{study:.3f} s: warm {warm / study:.2f}x (median of the rounds "
+        f"{median_ratio('warm', 'study'):.2f}x), first call {cold / study:.2f}x"
+    )
+    one, grouped = best("one"), best("study_grouped")
+    print(
+        f"  one part at a time (GROUP = 1): {one:.3f} s ({one / study:.2f}x the study); "
+        f"the study in groups of 32: {grouped:.3f} s (the batch {warm / grouped:.2f}x it, "
+        f"median {median_ratio('warm', 'study_grouped'):.2f}x)"
+    )
 
 
 def large_cases(ref: Path | None, args: argparse.Namespace) -> None:
