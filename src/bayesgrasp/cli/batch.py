@@ -81,11 +81,11 @@ def run_batch(
     build, plan = _builder(spec), spec.planner(best_only)
     memo: dict[str, Any] = {}  # what the documents share (the provenance and its text)
 
-    def planned(pb: Problem) -> tuple[Problem, PlanReport, GuaranteedPlan | str | None]:
-        return pb, plan(pb), guaranteed_plan(pb) if guaranteed else None
+    def planned(pb: Problem) -> tuple[PlanReport, GuaranteedPlan | str | None]:
+        return plan(pb), guaranteed_plan(pb) if guaranteed else None
 
-    def document(done: tuple[Problem, PlanReport, GuaranteedPlan | str | None]) -> _Line:
-        _, result, found = done
+    def document(done: tuple[PlanReport, GuaranteedPlan | str | None]) -> _Line:
+        result, found = done
         sure, missing = (None, found) if isinstance(found, str) else (found, None)
         text = plan_document_json(
             result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs, memo=memo
@@ -134,7 +134,7 @@ def _finish(
     try:
         for stage in stages:
             for i, value in enumerate(values):
-                if not isinstance(value, BaseException):
+                if not isinstance(value, BayesGraspError):
                     try:
                         values[i] = stage(value)
                     except BayesGraspError as exc:
@@ -147,7 +147,7 @@ def _finish(
         raise  # (the failing part raised again above, unless it failed only once)
     text = []
     for (label, _), value in zip(group, values, strict=True):
-        if isinstance(value, BaseException):
+        if isinstance(value, BayesGraspError):
             line = encode({"part": label, "error": str(value), "exit_code": 2}), 2
         else:
             line = value
