@@ -129,6 +129,9 @@ def action_classes(
     # orientations only (the action's stable orientations, and the rare angle it leaves at
     # a basin boundary), not on all A K of them (A K^2 floats: 1.8 GB at K = 174).
     k = len(s)
+    if len(mid) * k * k <= _BLOCK:  # a small part: at once
+        transfer = nearest_state(states, action(s[None, :] - mid[:, None]))
+        return ActionClasses(action.kind, lo, hi, mid, transfer)
     transfer = np.empty((len(mid), k), dtype=np.intp)
     rows = max(1, _BLOCK // k)
     for i in range(0, len(mid), rows):
