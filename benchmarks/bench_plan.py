@@ -1,18 +1,26 @@
 """Planner speed: the seed's 2000-polygon study (exact planner vs the breadth-first baseline,
-same polygons, same run) and a 10,000-vertex part.
+same polygons, same run), a 10,000-vertex part, and the baseline's memory on large parts.
 
 Targets (issue 3): the study with the exact planner in under 2 s on one core; the exact
 planner at least 100x faster than the breadth-first baseline; a 10,000-vertex ellipse of
 aspect 2 planned in under 1 s. Prints wall and CPU times; the machine may be shared, so the
 exact figures are the best of several repeats.
 
-Run: ``.venv/bin/python benchmarks/bench_plan.py [--polygons 2000] [--seed 1] [--repeat 3]``
+The breadth-first baseline's memory grows with the number of states K (its action-class
+table has about K^3 / 4 entries): ``plan_bfs`` on N random points of the unit circle, each in
+a fresh process capped at 6 GB of address space, with its peak RSS and CPU time.
+
+Run: ``.venv/bin/python benchmarks/bench_plan.py [--polygons 2000] [--seed 1] [--repeat 3]
+[--circles 65,100,130,200,300] [--circles-only]``
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import resource
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from typing import Any
@@ -38,6 +46,46 @@ def timed(fn: Callable[[], Any], repeat: int = 1) -> tuple[float, float, Any]:
     return best_wall, best_cpu, out
 
 
+# plan_bfs on n random points of the unit circle; prints K, CPU seconds, peak RSS (KiB).
+_BFS_CIRCLE = r"""
+import resource, sys, time
+import numpy as np
+from bayesgrasp.geometry.polygon import Part
+from bayesgrasp.model.problem import Problem
+from bayesgrasp.planning import plan_bfs
+n = int(sys.argv[1])
+t = np.sort(np.random.default_rng(5).uniform(0, 2 * np.pi, n))
+pb = Problem.build(Part.from_points(np.column_stack([np.cos(t), np.sin(t)])))
+c0 = time.process_time()
+plan_bfs(pb)
+cpu = time.process_time() - c0
+print(pb.n_states, cpu, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+"""
+
+
+def _cap_memory() -> None:
+    """In the child: 6 GB of address space, so a runaway case fails instead of the machine."""
+    resource.setrlimit(resource.RLIMIT_AS, (6 << 30, 6 << 30))
+
+
+def bfs_circles(sizes: list[int]) -> None:
+    print("breadth-first baseline, plan_bfs on N random points of the unit circle:")
+    for n in sizes:
+        proc = subprocess.run(
+            [sys.executable, "-c", _BFS_CIRCLE, str(n)],
+            capture_output=True,
+            text=True,
+            preexec_fn=_cap_memory,
+            check=False,
+        )
+        if proc.returncode:
+            last = (proc.stderr.strip().splitlines() or ["killed"])[-1]
+            print(f"  N = {n}: {last}")
+            continue
+        k, cpu, rss = proc.stdout.split()
+        print(f"  N = {n} (K = {k}): cpu {float(cpu):.2f} s, peak RSS {int(rss) / 1024:.0f} MB")
+
+
 def ellipse(n: int, aspect: float) -> Part:
     t = 2 * math.pi * np.arange(n) / n
     return Part.from_points(np.column_stack([aspect * np.cos(t), np.sin(t)]), name="ellipse")
@@ -48,8 +96,14 @@ def main() -> None:
     ap.add_argument("--polygons", type=int, default=2000)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--circles", default="65,100,130,200,300", help="sizes N, comma-separated")
+    ap.add_argument("--circles-only", action="store_true", help="only the baseline's memory")
     args = ap.parse_args()
     n, seed = args.polygons, args.seed
+    sizes = [int(x) for x in args.circles.split(",") if x.strip()]
+    if args.circles_only:
+        bfs_circles(sizes)
+        return
 
     # 1. The study as the command runs it, exact planner (polygons drawn, built, planned).
     w, c, res = timed(lambda: run_study(n, seed, method="exact"), args.repeat)
@@ -125,6 +179,9 @@ def main() -> None:
         f"plan {cplan:.3f} s cpu); {len(rep.options)} options, "
         f"best p {rep.most_certain_plan.success_probability:.4f}"
     )
+
+    # 4. The breadth-first baseline's memory on large parts.
+    bfs_circles(sizes)
 
 
 if __name__ == "__main__":

@@ -9,8 +9,9 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from bayesgrasp import CostError, CostModel, Goal, Part, PlanningError, Problem, von_mises
+from bayesgrasp.model import problem as problem_module
 from bayesgrasp.model.prior import UniformPrior
-from bayesgrasp.model.problem import action_classes, nearest_state
+from bayesgrasp.model.problem import action_classes, critical_angles, nearest_state
 from bayesgrasp.shapes import load
 from reference import regular_polygon
 
@@ -216,6 +217,30 @@ def test_action_classes_of_a_square() -> None:
     assert_allclose(np.degrees(cls.lo), [45.0, 135.0], atol=1e-9)
     assert_array_equal(cls.transfer[0], [3, 0, 1, 2])
     assert_array_equal(cls.transfer[1], [2, 3, 0, 1])
+
+
+@pytest.mark.parametrize("block", [1, 50, 1 << 16])
+def test_action_classes_in_blocks_equal_the_whole_table(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch, block: int
+) -> None:
+    """Made a block of classes at a time (a large part's way), the table is the same.
+
+    The reference is nearest_state on all (A, K) orientations at once: an (A, K, K) array,
+    the old way (30 MB for the 60-point circle, K = 58).
+    """
+    t = np.sort(rng.uniform(0, TWO_PI, 60))
+    parts = [random_part(rng) for _ in range(5)]
+    parts += [Part.from_points(np.column_stack([np.cos(t), np.sin(t)]))]
+    parts += [Part.from_points(regular_polygon(12, 0.1))]
+    monkeypatch.setattr(problem_module, "_BLOCK", block)
+    for part in parts:
+        pb = Problem.build(part, actions=("squeeze", "push-grasp"))
+        for f, period in ((pb.states, math.pi), (pb.transfer("push-grasp"), TWO_PI)):
+            cls = action_classes(pb.states, f, period)
+            s = pb.states.stable
+            whole = nearest_state(pb.states, f(s[None, :] - cls.mid[:, None]))
+            assert_array_equal(cls.transfer, whole)
+            assert_array_equal(cls.lo, critical_angles(pb.states, f, period))
 
 
 def test_defaults_are_shared_and_equal_to_fresh_ones() -> None:

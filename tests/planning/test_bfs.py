@@ -5,7 +5,9 @@ from __future__ import annotations
 import itertools
 import json
 import math
+import tracemalloc
 from collections import deque
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,8 +23,8 @@ from bayesgrasp.geometry.transfer import transfer_from_extrema
 from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
 from bayesgrasp.model.prior import HistogramPrior, Prior, UniformPrior, von_mises
 from bayesgrasp.model.problem import CostModel, Goal, Problem
-from bayesgrasp.planning import PlanReport, execute_plan, plan_bfs, plan_exact
-from bayesgrasp.planning.bfs import search_bfs
+from bayesgrasp.planning import PlanReport, bfs, execute_plan, plan_bfs, plan_exact
+from bayesgrasp.planning.bfs import BfsResult, search_bfs
 from bayesgrasp.planning.result import PlanStep
 from bayesgrasp.shapes import load, names
 
@@ -375,3 +377,183 @@ def test_cli_plan_with_bfs(capsys: pytest.CaptureFixture[str]) -> None:
     assert [round(o["expected_cost"], 1) for o in doc["options"]] == [6.3, 6.0]
     assert main(["plan", "triangle", "--method", "bfs", "--max-squeezes", "2"]) == 0
     assert "breadth-first nodes generated" in capsys.readouterr().out
+
+
+def circle_part(n: int) -> Part:
+    """``n`` random points on the unit circle: a part of about ``n`` states (K ~ 0.9 n)."""
+    t = np.sort(np.random.default_rng(5).uniform(0, TWO_PI, n))
+    return Part.from_points(np.column_stack([np.cos(t), np.sin(t)]))
+
+
+def fingerprint(res: BfsResult) -> tuple[object, ...]:
+    """Every number of a search's result: its statistics and each option's floats."""
+    rep = res.report
+    options = tuple(
+        (
+            tuple((st.kind, st.alpha) for st in o.steps),
+            o.final_orientation,
+            o.success_probability,
+            o.expected_cost,
+            o.tolerance,
+            o.success_arc,
+        )
+        for o in rep.options
+    )
+    return res.stats, options, rep.bayes, rep.most_certain, rep.nodes
+
+
+# Recorded from the search before it made children a block at a time (d0eb3ad): the
+# statistics, the success probabilities and each plan's gripper angles, to the last bit.
+CIRCLES = {
+    20: (
+        (1386, 1000, 386, False, True, 8, 0.5000000000000001, None),
+        [
+            0.09901386447742311,
+            0.18881623964373895,
+            0.26510177444446725,
+            0.33349958172483596,
+            0.37277502929198003,
+            0.4242664952699051,
+            0.4242664952699051,
+            0.49999999999999994,
+        ],
+        [-0.2574890478137162, 0.14710629909225892, *[-0.2574890478137162] * 5],
+    ),
+    40: (
+        (2000, 1000, 1000, False, False, 5, 0.5000000000000002, None),
+        [
+            0.09250443262138208,
+            0.14469830435598918,
+            0.16149259100972024,
+            0.18388299353140175,
+            0.25237155920350196,
+        ],
+        [-0.7371111302263484, 0.7167749419465812, -1.2431654178388754, 0.7167749419465812],
+    ),
+    65: (
+        (2000, 1000, 1000, False, False, 3, 0.5000000000000006, None),
+        [0.0655335745633221, 0.10709342945312228, 0.12791525191089165],
+        [0.14727327821721548, 0.14727327821721548],
+    ),
+    130: (
+        (2000, 1000, 1000, False, False, 2, 0.5000000000000001, None),
+        [0.03994637045133925, 0.06423056401754668],
+        [0.12091505632872834],
+    ),
+}
+
+
+@pytest.mark.parametrize("n", sorted(CIRCLES))
+def test_results_on_circles_as_recorded(n: int) -> None:
+    stats, probs, alphas = CIRCLES[n]
+    res = search_bfs(Problem.build(circle_part(n)))
+    assert tuple(getattr(res.stats, f) for f in res.stats.__slots__) == stats
+    assert probabilities(res.report) == probs
+    assert [st.alpha for st in res.report.options[-1].steps] == [0.0, *alphas]
+
+
+def block_cases(rng: np.random.Generator) -> list[tuple[Problem, dict[str, object]]]:
+    """Searches that take every path: fallback, padding, two kinds, roots, the tree count."""
+    parts = random_parts(rng, 6)
+    cases: list[tuple[Problem, dict[str, object]]] = []
+    for j, part in enumerate(parts):
+        pb = Problem.build(part)
+        cases += [(pb, {}), (pb, {"node_limit": 5, "fallback_limit": 40})]
+        cases.append((pb, {"merge": False, "node_limit": 200, "max_actions": 3}))
+        cases.append((Problem.build(part, goal=Goal("symmetry")), {}))
+        cases.append((Problem.build(part, prior=von_mises(0.5 * j, 3.0)), {}))
+        push = Problem.build(part, actions=("push-grasp",))  # padded with push-grasps
+        cases += [(push, {}), (push, {"node_limit": 5, "fallback_limit": 60})]
+        if pb.n_states >= 6:
+            two = fake_push_grasp(Problem.build(part, cost=CostModel({"push-grasp": 0.7})), j % 2)
+            cases.append((two, {}))
+    cases += [(Problem.build(p), {}) for p in symmetric_parts(rng, 3)]
+    # Plans padded with push-grasps of the most certain class (found by seed).
+    padded = random_parts(np.random.default_rng(1), 11)
+    for part in (padded[1], padded[10]):
+        push = Problem.build(part, actions=("push-grasp",))
+        cases += [(push, {}), (push, {"node_limit": 2, "fallback_limit": 200})]
+    return cases
+
+
+@pytest.mark.parametrize("block", [1, 97])
+def test_children_blocks_change_no_result(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch, block: int
+) -> None:
+    """Children made a row at a time, or 97 entries at a time, give the same bits."""
+    cases = block_cases(rng)
+    whole = [fingerprint(search_bfs(pb, **kw)) for pb, kw in cases]  # type: ignore[arg-type]
+    assert any(len(pb.classes("squeeze").mid) * pb.n_states > block for pb, _ in cases)
+    monkeypatch.setattr(bfs, "_BLOCK", block)
+    for (pb, kw), want in zip(cases, whole, strict=True):
+        assert fingerprint(search_bfs(pb, **kw)) == want  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("block", [1, 29])
+def test_padding_class_is_the_first_most_certain(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch, block: int
+) -> None:
+    """Padding with push-grasps (not the squeeze): the first class of the highest success."""
+    monkeypatch.setattr(bfs, "_BLOCK", block)
+    checked = 0
+    for part in random_parts(rng, 10):
+        pb = Problem.build(part, actions=("push-grasp",))
+        s = bfs._Search(pb, bfs._make_roots(pb, None, None))
+        for dist in (s.dist[s.add_root(0)], rng.dirichlet(np.ones(s.k))):
+            probs = np.concatenate([s.goal_prob(ch) for _, ch in s.blocks(dist, 0)])
+            assert bfs._pad_class(s, 0, dist) == int(np.argmax(probs))
+            checked += int(np.argmax(probs) >= s.rows)  # not in the first block
+    assert checked >= 5
+
+
+def test_memory_of_a_part_with_174_states() -> None:
+    """The class table is made a block at a time; the search keeps O(K) a node.
+
+    Before, the table took an (A, K, K) array (A = 7569 classes: 1.8 GB) and the search
+    several (A, K) arrays at once.
+    """
+    pb = Problem.build(circle_part(200))
+    k = pb.n_states
+    assert k == 174
+    tracemalloc.start()
+    try:
+        table = pb.classes("squeeze").transfer
+        build_peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.reset_peak()
+        before = tracemalloc.get_traced_memory()[0]
+        res = search_bfs(pb)
+        search_peak = tracemalloc.get_traced_memory()[1] - before
+    finally:
+        tracemalloc.stop()
+    assert table.shape == (7569, k)
+    assert build_peak < table.nbytes + 8e6  # 16.5 MB, the table 10.5 MB
+    assert res.stats.nodes == 2000
+    assert search_peak < 6 * res.stats.nodes * k * 8 + 4e6  # 12 MB of 20.7 MB
+
+
+def test_table_limit() -> None:
+    pb = Problem.build(circle_part(40))
+    k = pb.n_states
+    entries = len(pb.classes("squeeze").mid) * k
+    assert search_bfs(pb, table_limit=entries).stats.nodes == 2000
+    with pytest.raises(PlanningError, match=rf"tables need {entries} entries .*use the exact"):
+        search_bfs(pb, table_limit=entries - 1)
+    with pytest.raises(PlanningError, match=rf"{k * k} critical angles, more than `table_limit`"):
+        search_bfs(pb, table_limit=k * k - 1)
+
+
+def test_cli_bfs_on_a_part_too_large_says_so(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """A 700-point circle (K = 724) would need 724 MiB of tables: one error line, no kill."""
+    batch = tmp_path / "parts.jsonl"
+    big = {"name": "circle-700", "vertices": circle_part(700).hull.vertices.tolist()}
+    batch.write_text(f'{json.dumps(big)}\n"rectangle"\n')
+    code = main(["plan", "--batch", str(batch), "--method", "bfs", "--only", "best"])
+    out, err = capsys.readouterr()
+    docs = [json.loads(x) for x in out.splitlines()]
+    assert code == 2 and err == "" and len(docs) == 2
+    assert docs[0]["exit_code"] == 2
+    assert "724 states), more than `table_limit`" in docs[0]["error"]
+    assert "(use the exact planner)" in docs[0]["error"]
+    assert "error" not in docs[1] and docs[1]["method"] == "bfs"

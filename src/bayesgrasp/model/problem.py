@@ -49,7 +49,17 @@ from .goal import Goal
 from .prior import Prior, UniformPrior
 from .states import nearest_state
 
-__all__ = ["ActionClasses", "CostModel", "Goal", "Problem", "action_classes", "nearest_state"]
+__all__ = [
+    "ActionClasses",
+    "CostModel",
+    "Goal",
+    "Problem",
+    "action_classes",
+    "critical_angles",
+    "nearest_state",
+]
+
+_BLOCK = 1 << 16  # entries of the (classes, K) blocks that action_classes makes at a time
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -111,6 +121,43 @@ def action_classes(
     (the pushing jaw is on one side).
     """
     s = states.stable
+    lo = critical_angles(states, action, gripper_period)
+    hi = np.append(lo[1:], lo[0] + gripper_period)
+    mid = 0.5 * (lo + hi)
+    # A is up to K^2 / 4 for a squeeze, so the table is O(K^3): made a block of classes at a
+    # time, and nearest_state (a (.., K) array per angle) runs on the block's distinct
+    # orientations only (the action's stable orientations, and the rare angle it leaves at
+    # a basin boundary), not on all A K of them (A K^2 floats: 1.8 GB at K = 174).
+    k = len(s)
+    if len(mid) * k * k <= _BLOCK:  # a small part: at once
+        transfer = nearest_state(states, action(s[None, :] - mid[:, None]))
+        return ActionClasses(action.kind, lo, hi, mid, transfer)
+    transfer = np.empty((len(mid), k), dtype=np.intp)
+    rows = max(1, _BLOCK // k)
+    for i in range(0, len(mid), rows):
+        after = action(s[None, :] - mid[i : i + rows, None])  # (rows, K) orientations after
+        values, inverse = np.unique(after, return_inverse=True)
+        transfer[i : i + rows] = nearest_state(states, values)[inverse].reshape(after.shape)
+    return ActionClasses(action.kind, lo, hi, mid, transfer)
+
+
+def critical_angles(
+    states: TransferFunction, action: TransferFunction, gripper_period: float
+) -> NDArray[np.float64]:
+    """Gripper rotations where the effect of ``action`` on the states changes, increasing.
+
+    The lower ends of the classes of :func:`action_classes` (so their number is ``A``):
+    the angles ``S_i - B_j`` modulo ``gripper_period``, those closer than the angle
+    tolerance merged. Takes K K_t floats, where the classes' table takes A K integers.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry import Part, squeeze_function
+    >>> s = squeeze_function(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]).hull)
+    >>> np.degrees(critical_angles(s, s, math.pi)).round(6).tolist()
+    [26.565051, 63.434949, 116.565051, 153.434949]
+    """
+    s = states.stable
     crit = np.unique(np.mod((s[:, None] - action.boundaries[None, :]).ravel(), gripper_period))
     # Merge critical angles closer than the angle tolerance: no rotation fits between them.
     tol = states.angle_tol
@@ -119,12 +166,7 @@ def action_classes(
         if gripper_period - crit[-1] + crit[0] <= tol:
             keep[0] = len(crit) == 1
         crit = crit[keep]
-    lo = crit
-    hi = np.append(crit[1:], crit[0] + gripper_period)
-    mid = 0.5 * (lo + hi)
-    after = action(s[None, :] - mid[:, None])  # (A, K) orientations after the action
-    transfer = nearest_state(states, after)
-    return ActionClasses(action.kind, lo, hi, mid, transfer)
+    return np.asarray(crit, dtype=np.float64)
 
 
 # The defaults of Problem.build, made once: they are frozen values (the study builds 2000

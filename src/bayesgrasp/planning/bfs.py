@@ -55,7 +55,7 @@ from __future__ import annotations
 import heapq
 import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import cast
 
@@ -66,7 +66,7 @@ from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.prior import UniformPrior
-from ..model.problem import Problem, nearest_state
+from ..model.problem import Problem, critical_angles, nearest_state
 from .result import PlanOption, PlanResult, choose_indices, plan_actions, short_turns
 
 __all__ = ["BfsResult", "SearchStats", "plan_bfs", "search_bfs"]
@@ -74,6 +74,8 @@ __all__ = ["BfsResult", "SearchStats", "plan_bfs", "search_bfs"]
 logger = logging.getLogger(__name__)
 
 _QUANT = float(2**40)  # distributions are compared after rounding to multiples of 2**-40
+_BLOCK = 1 << 16  # entries of the (classes, K) blocks of children made at a time
+TABLE_LIMIT = 1 << 25  # default `table_limit`: 256 MiB of action-class table (intp)
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 
@@ -143,6 +145,7 @@ class _Search:
         states = problem.states
         self.k = states.n_states
         self.classes = [problem.classes(a) for a in self.actions]
+        self.rows = max(1, _BLOCK // self.k)  # children made at a time
         self.roots = roots
         # Goal: fold states that the goal counts as one (orbits under 2 pi / g).
         g = problem.goal_group
@@ -201,14 +204,30 @@ class _Search:
         alt = cast(list[bytes], np.ascontiguousarray(q[:, self.turn]).view(row).ravel().tolist())
         return [min(a, b) for a, b in zip(plain, alt, strict=True)]
 
-    def children(self, dist: FloatArray, ti: int) -> FloatArray:
-        """Distributions after each class of action kind ``ti``: shape (A, K)."""
-        t = self.classes[ti].transfer  # (A, K)
-        a = t.shape[0]
-        idx = (t + self.k * np.arange(a)[:, None]).ravel()
+    def children(
+        self, dist: FloatArray, ti: int, start: int = 0, stop: int | None = None
+    ) -> FloatArray:
+        """Distributions after classes ``start:stop`` of action kind ``ti``: shape (B, K).
+
+        Each row is the bincount of the state masses in state order, the same sums whatever
+        rows are made together.
+        """
+        t = self.classes[ti].transfer[start:stop]  # (B, K)
+        b = t.shape[0]
+        idx = (t + self.k * np.arange(b)[:, None]).ravel()
         w = np.broadcast_to(dist, t.shape).ravel()
-        out = np.bincount(idx, weights=w, minlength=a * self.k).reshape(a, self.k)
+        out = np.bincount(idx, weights=w, minlength=b * self.k).reshape(b, self.k)
         return np.asarray(out, dtype=np.float64)
+
+    def blocks(self, dist: FloatArray, ti: int) -> Iterator[tuple[int, FloatArray]]:
+        """The children of action kind ``ti`` a block at a time: (first class, (B, K) rows).
+
+        A is up to K^2 / 4 for a squeeze: all children at once, with their keys, would take
+        several A K floats (280 MB at K = 282) where a block takes ``_BLOCK``.
+        """
+        n = len(self.classes[ti].mid)
+        for start in range(0, n, self.rows):
+            yield start, self.children(dist, ti, start, start + self.rows)
 
     # -- nodes --------------------------------------------------------------------------
     def add_root(self, r: int) -> int:
@@ -222,7 +241,10 @@ class _Search:
     def add_child(self, u: int, ti: int, a: int, dist: FloatArray, p: float) -> int:
         mapping = self.classes[ti].transfer[a][self.mapping[u]]
         kinds = (*self.kinds_of[u], self.kinds[ti])
-        return self._add(dist, mapping, u, (ti, a), self.root_of[u], self.depth[u] + 1, p, kinds)
+        # A copy: a row of a block is a view that would keep the whole block alive.
+        return self._add(
+            dist.copy(), mapping, u, (ti, a), self.root_of[u], self.depth[u] + 1, p, kinds
+        )
 
     def _add(
         self,
@@ -283,6 +305,33 @@ class _Search:
         return float(np.max(cum[last + 1] - cum[np.arange(n)]))
 
 
+def _check_tables(problem: Problem, limit: int) -> None:
+    """Raise a PlanningError if the action-class tables would hold more than ``limit`` entries.
+
+    Counts the classes from the critical angles (K K_t floats) without making the tables,
+    unless the critical angles alone pass the limit.
+    """
+    k = problem.states.n_states
+    entries = 0
+    for action in plan_actions(problem, problem.action_kinds):
+        f = problem.transfers[action.name]
+        if k * f.n_states > limit:
+            raise PlanningError(
+                f"the breadth-first baseline cannot plan this part: {k} states and "
+                f"{f.n_states} {action.name} basins make {k * f.n_states} critical angles, "
+                f"more than `table_limit` = {limit} (use the exact planner)"
+            )
+        n_classes = len(critical_angles(problem.states, f, action.gripper_period))
+        entries += n_classes * k
+        if entries > limit:
+            raise PlanningError(
+                f"the breadth-first baseline cannot plan this part: its action-class tables "
+                f"need {entries} entries ({entries * 8 / 2**20:.0f} MiB; {n_classes} "
+                f"{action.name} classes x {k} states), more than `table_limit` = {limit} "
+                "(use the exact planner)"
+            )
+
+
 def _orbits(stable: FloatArray, group: int, states: TransferFunction) -> IntArray:
     """Orbit id of each state under rotations by ``2 pi / group`` (0.. in order)."""
     k = len(stable)
@@ -337,6 +386,7 @@ def search_bfs(
     first_angles: Sequence[float] | None = None,
     tree_count: bool = True,
     merge: bool = True,
+    table_limit: int = TABLE_LIMIT,
 ) -> BfsResult:
     """The seed's breadth-first search, with its node limit and best-first fallback.
 
@@ -359,6 +409,11 @@ def search_bfs(
     merge : bool
         Merge identical hyperstates (default). ``False`` searches the literal tree: every
         node is kept, also in the fallback.
+    table_limit : int
+        Entries the action-class tables may hold (``A x K`` summed over the action kinds,
+        8 bytes each; default ``2**25``, 256 MiB). A squeeze has up to ``K^2 / 4`` classes,
+        so the tables grow as ``K^3``: about 8 MB at K = 100, 45 MB at K = 282, past the
+        default near K = 500.
 
     Returns
     -------
@@ -367,8 +422,18 @@ def search_bfs(
     Raises
     ------
     PlanningError
-        If ``max_actions``, ``node_limit`` or ``fallback_limit`` is less than 1, or the
-        problem has a gripper ``accuracy`` (the baseline assumes exact turns).
+        If ``max_actions``, ``node_limit`` or ``fallback_limit`` is less than 1, the
+        problem has a gripper ``accuracy`` (the baseline assumes exact turns), or its
+        action-class tables would pass ``table_limit`` (the exact planner needs none).
+
+    Notes
+    -----
+    Memory: the tables (at most ``table_limit`` entries), a block of ``2**16`` child
+    entries at a time, and ``O(K)`` for each node generated: both searches together keep
+    at most ``node_limit + fallback_limit`` nodes (plus the roots). The count of the
+    unmerged tree (``tree_nodes``) is a number, not a tree: it is found by a depth-first
+    walk that remembers the hyperstates (at a depth) that lead to no goal, hyperstates the
+    completed merged search has already met, and holds one block of children per depth.
 
     Examples
     --------
@@ -393,6 +458,7 @@ def search_bfs(
             f"`node_limit` and `fallback_limit` must be at least 1; got {node_limit} and "
             f"{fallback_limit}"
         )
+    _check_tables(problem, table_limit)
     s = _Search(problem, _make_roots(problem, max_actions, first_angles))
     target = max(s.attainable(r) for r in range(len(s.roots)))
     several_kinds = len(s.kinds) > 1
@@ -429,29 +495,35 @@ def search_bfs(
     bfs_nodes = len(level)
     limit_hit = False
     depth = 1
+    stop = False  # the level ends early: the node limit, or the target with one action kind
     while found is None and level and (max_actions is None or depth < max_actions):
         nxt: list[int] = []
         for u in level:
             for ti in range(len(s.kinds)):
-                ch = s.children(s.dist[u], ti)
-                probs = s.goal_prob(ch)
                 attempt = s.attempt[u] + s.step_cost[ti]
-                for a, key in enumerate(s.keys(ch)):
-                    if not is_new(key, depth + 1, attempt):
-                        continue
-                    v = s.add_child(u, ti, a, ch[a], float(probs[a]))
-                    nxt.append(v)
-                    bfs_nodes += 1
-                    if probs[a] >= target - s.eps and (found is None or s.prob[v] > s.prob[found]):
-                        found = v
-                    if found is not None and not several_kinds:
+                for start, ch in s.blocks(s.dist[u], ti):
+                    probs = s.goal_prob(ch)
+                    for j, key in enumerate(s.keys(ch)):
+                        if not is_new(key, depth + 1, attempt):
+                            continue
+                        v = s.add_child(u, ti, start + j, ch[j], float(probs[j]))
+                        nxt.append(v)
+                        bfs_nodes += 1
+                        if probs[j] >= target - s.eps and (
+                            found is None or s.prob[v] > s.prob[found]
+                        ):
+                            found = v
+                        if found is not None and not several_kinds:
+                            stop = True
+                            break
+                        if found is None and bfs_nodes >= node_limit:
+                            limit_hit = stop = True
+                            break
+                    if stop:
                         break
-                    if found is None and bfs_nodes >= node_limit:
-                        limit_hit = True
-                        break
-                if limit_hit or (found is not None and not several_kinds):
+                if stop:
                     break
-            if limit_hit or (found is not None and not several_kinds):
+            if stop:
                 break
         level = nxt
         depth += 1
@@ -475,19 +547,21 @@ def search_bfs(
             if max_actions is not None and d >= max_actions:
                 continue
             for ti in range(len(s.kinds)):
-                ch = s.children(s.dist[u], ti)
-                probs = s.goal_prob(ch)
-                for a, key in enumerate(s.keys(ch)):
-                    if key in seen2 and merge:
-                        continue
-                    seen2.add(key)
-                    v = s.add_child(u, ti, a, ch[a], float(probs[a]))
-                    fallback_nodes += 1
-                    heapq.heappush(heap, (-s.prob[v], s.depth[v], v))
-                    if s.prob[v] >= target - s.eps:
-                        found = v
-                        break
-                    if fallback_nodes >= fallback_limit:
+                for start, ch in s.blocks(s.dist[u], ti):
+                    probs = s.goal_prob(ch)
+                    for j, key in enumerate(s.keys(ch)):
+                        if key in seen2 and merge:
+                            continue
+                        seen2.add(key)
+                        v = s.add_child(u, ti, start + j, ch[j], float(probs[j]))
+                        fallback_nodes += 1
+                        heapq.heappush(heap, (-s.prob[v], s.depth[v], v))
+                        if s.prob[v] >= target - s.eps:
+                            found = v
+                            break
+                        if fallback_nodes >= fallback_limit:
+                            break
+                    if found is not None or fallback_nodes >= fallback_limit:
                         break
                 if found is not None or fallback_nodes >= fallback_limit:
                     break
@@ -600,7 +674,13 @@ def _pad_class(s: _Search, ti: int, dist: FloatArray) -> int:
         inside = np.mod(-cl.lo, s.actions[ti].gripper_period) < cl.hi - cl.lo
         if np.any(inside):
             return int(np.flatnonzero(inside)[0])
-    return int(np.argmax(s.goal_prob(s.children(dist, ti))))
+    best, pick = -math.inf, 0
+    for start, ch in s.blocks(dist, ti):
+        probs = s.goal_prob(ch)
+        j = int(np.argmax(probs))
+        if probs[j] > best:  # strictly: the first class of the highest, as one argmax
+            best, pick = float(probs[j]), start + j
+    return pick
 
 
 def _option(s: _Search, v: int, k: int) -> PlanOption:
@@ -612,7 +692,7 @@ def _option(s: _Search, v: int, k: int) -> PlanOption:
     ti_pad = _pad_kind(s)
     for _ in range(k - s.depth[v]):
         a = _pad_class(s, ti_pad, dist)
-        dist = s.children(dist, ti_pad)[a]
+        dist = s.children(dist, ti_pad, a, a + 1)[0]
         mapping = s.classes[ti_pad].transfer[a][mapping]
         path.append((ti_pad, a))
     kinds = [root.kind]
@@ -667,17 +747,20 @@ def _tree_nodes(s: _Search, depth: int, target: float) -> int:
         key = (s.keys(dist)[0], d)
         if key in dead:
             return None
-        ch = np.concatenate([s.children(dist, ti) for ti in range(len(s.kinds))])
-        if d + 1 == depth:
-            hits = np.flatnonzero(s.goal_prob(ch) >= target - s.eps)
-            if len(hits):
-                return int(hits[0])
-        else:
-            below = int(a_total ** (depth - d - 1))
-            for a in range(a_total):
-                pos = first(ch[a], d + 1)
-                if pos is not None:
-                    return a * below + pos
+        offset = 0  # children are numbered over all kinds, in order
+        for ti in range(len(s.kinds)):
+            for start, ch in s.blocks(dist, ti):
+                if d + 1 == depth:
+                    hits = np.flatnonzero(s.goal_prob(ch) >= target - s.eps)
+                    if len(hits):
+                        return offset + start + int(hits[0])
+                    continue
+                below = int(a_total ** (depth - d - 1))
+                for j in range(len(ch)):
+                    pos = first(ch[j], d + 1)
+                    if pos is not None:
+                        return (offset + start + j) * below + pos
+            offset += len(s.classes[ti].mid)
         dead.add(key)
         return None
 
@@ -695,5 +778,6 @@ def _tree_nodes(s: _Search, depth: int, target: float) -> int:
             break
     if pos is None:  # pragma: no cover - the merged search found one at this depth
         raise PlanningError("internal error: no goal node in the unmerged tree")
+    logger.debug("unmerged tree count: %d dead ends remembered", len(dead))
     before = sum(n_roots * int(a_total ** (d - 1)) for d in range(1, depth))
     return before + pos + 1
