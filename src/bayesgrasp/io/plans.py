@@ -44,7 +44,7 @@ import hashlib
 import json
 import math
 import os
-import struct
+from array import array
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -139,27 +139,32 @@ def part_id(part: Part) -> str:
     return "sha256:" + hashlib.sha256(data).hexdigest()[:16]
 
 
-# Rounded coordinates at most this large fit an int64 whichever way they are converted.
-_ID_LIMIT = 2.0**62
-
-
 def _small_id_bytes(part: Part, q: float) -> bytes | None:
     """The bytes :func:`part_id` hashes, on Python floats (a hull of at most ``SMALL`` vertices).
 
     The same subtraction and division as numpy's, then ``round`` (halves to even, as
-    ``np.rint``), and the int64 values in the machine's byte order as ``ndarray.tobytes``.
-    ``None`` (numpy decides) for values beyond :data:`_ID_LIMIT` or not finite.
+    ``np.rint``), and the int64 values in the machine's byte order, as ``ndarray.tobytes``
+    (``array("q")``: long long, 8 bytes). ``None`` (numpy decides) for a value ``round``
+    refuses (not finite) or beyond int64, which ``array`` refuses; every rounded value it
+    takes is an integral float within int64, which numpy's cast keeps exactly.
     """
     cx, cy = part.center_of_mass.tolist()
-    pts = []
-    for x, y in part.hull.vertices.tolist():
-        u, v = (x - cx) / q, (y - cy) / q
-        if not (abs(u) < _ID_LIMIT and abs(v) < _ID_LIMIT):  # NaN fails too
-            return None
-        pts.append((round(u), round(v)))
-    start = pts.index(min(pts))  # the first lexicographically least, as numpy's path
-    # int64 in the machine's order, as array("q", ...).tobytes() (long long, 8 bytes)
-    return struct.pack(f"{2 * len(pts)}q", *[c for p in pts[start:] + pts[:start] for c in p])
+    flat: list[int] = []  # x0, y0, x1, y1, ...
+    try:
+        for x, y in zip(*part.hull._coords(), strict=False):  # (as long by construction)
+            flat += (round((x - cx) / q), round((y - cy) / q))
+    except (OverflowError, ValueError):  # an infinity, NaN
+        return None
+    xs = flat[0::2]
+    least = min(xs)
+    start = xs.index(least)
+    if xs.count(least) > 1:  # a tie: the least y among them, the first such (as numpy's path)
+        start = min(range(len(xs)), key=lambda i: (xs[i], flat[2 * i + 1]))
+    start *= 2
+    try:
+        return array("q", flat[start:] + flat[:start]).tobytes()
+    except OverflowError:
+        return None
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
