@@ -96,3 +96,4 @@ def test_values_near_the_int64_limit() -> None:
     wide = Part.from_points([(0.0, 0.0), (4.0, 0.0), (4.0, 3.0), (0.0, 3.0)])
     assert plans._small_id_bytes(wide, step) is None  # 2^63: beyond int64
     assert plans._small_id_bytes(wide, 1e-320) is None  # an infinity
+    assert plans._small_id_bytes(wide, math.nan) is None

@@ -459,28 +459,30 @@ def _float_texts(values: Sequence[Any]) -> list[str] | None:
     """
     if not {*map(type, values)} <= _FLOAT:
         return None
-    data = orjson.dumps(values)
-    if not _as_repr(data):
+    text = orjson.dumps(values).decode()
+    if not _as_repr(text):
         return None
-    text = data.decode()[1:-1]
-    return text.split(",") if text else []
+    return text[1:-1].split(",") if values else []
 
 
 _FLOAT = {float}
 
 
-def _as_repr(data: bytes) -> bool:
+def _as_repr(text: str) -> bool:
     """Whether orjson's text of a list of floats is each float's ``repr`` (but the spaces).
 
     orjson writes a finite float with the shortest digits that read back to it, the digits
     ``repr`` writes (both are "shortest round-trip, nearest", Steele & White / Gay), but
     spells some differently: a magnitude below 1e-4 positionally (``0.00001`` for
     ``1e-05``), exponents without their zero (``1e-7``), and NaN and the infinities as
-    ``null``. A text without an ``e``, ``0.0000`` or ``null`` holds none of these (a float
-    below 1e-4 written positionally has four zeros after its point); test:
-    ``tests/io/test_plan_json.py::test_orjson_float_text_is_repr``.
+    ``null``. A text without an ``e``, ``n`` or ``0.0000`` holds none of these (no finite
+    float's text has an ``n``; one written positionally below 1e-4 has four zeros after its
+    point); test: ``tests/io/test_plan_json.py::test_orjson_float_text_is_repr``.
+
+    Searched in the decoded text: ``bytes.__contains__`` first tries its argument as an int,
+    and raises and clears a TypeError for each search (~1.7k instructions).
     """
-    return not (b"e" in data or b"0.0000" in data or b"null" in data)
+    return not ("e" in text or "n" in text or "0.0000" in text)
 
 
 def _option_floats(option: PlanOption, values: list[Any]) -> tuple[int, bool, bool]:
