@@ -149,22 +149,31 @@ def _small_id_bytes(part: Part, q: float) -> bytes | None:
     takes is an integral float within int64, which numpy's cast keeps exactly.
     """
     cx, cy = part.center_of_mass.tolist()
-    flat: list[int] = []  # x0, y0, x1, y1, ...
-    try:
-        for x, y in zip(*part.hull._coords(), strict=False):  # (as long by construction)
-            flat += (round((x - cx) / q), round((y - cy) / q))
+    units: list[float] = []  # x0, y0, x1, y1, ... in rounding steps from the centre of mass
+    for x, y in zip(*part.hull._coords()):  # noqa: B905 (as long; strict= costs)
+        units += ((x - cx) / q, (y - cy) / q)
+    try:  # round() by the method itself: half round()'s cost, which looks the method up
+        flat = [*map(float.__round__, units)]
     except (OverflowError, ValueError):  # an infinity, NaN
         return None
-    xs = flat[0::2]
-    least = min(xs)
-    start = xs.index(least)
-    if xs.count(least) > 1:  # a tie: the least y among them, the first such (as numpy's path)
-        start = min(range(len(xs)), key=lambda i: (xs[i], flat[2 * i + 1]))
-    start *= 2
+    start = 2 * _least(flat)
     try:
         return array("q", flat[start:] + flat[:start]).tobytes()
     except OverflowError:
         return None
+
+
+def _least(flat: list[int]) -> int:
+    """The index of the first lexicographically least (x, y) pair of ``[x0, y0, x1, ...]``.
+
+    (A function of its own: a closure in :func:`_small_id_bytes` would make cells of its
+    variables at every call, ties or not.)
+    """
+    xs = flat[0::2]
+    least = min(xs)
+    if xs.count(least) == 1:
+        return xs.index(least)
+    return min(range(len(xs)), key=lambda i: (xs[i], flat[2 * i + 1]))
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
@@ -586,10 +595,10 @@ def _document_text(
     period, first = texts[j], texts[j + 1]
     at = j + 2
     written = []
-    for option, layout in zip(options, layouts, strict=True):
+    for option, layout in zip(options, layouts):  # noqa: B905 (as long)
         option_text, at = _option_text(option, layout, texts, at)
         written.append(option_text)
-    pairs = zip(texts[:n], texts[n : 2 * n], strict=True)
+    pairs = zip(texts[:n], texts[n : 2 * n])  # noqa: B905 (as long)
     vertices = ", ".join([f"[{x}, {y}]" for x, y in pairs])
     cx, cy = texts[2 * n], texts[2 * n + 1]
     text = [

@@ -409,7 +409,8 @@ class Problem:
             return None
         _, lo, hi = f.values
         a = first_angle
-        return [(h + a) / TWO_PI - (b + a) / TWO_PI for b, h in zip(lo, hi, strict=True)]
+        # (zip's strict= parses keywords at every call: lo and hi are as long)
+        return [(h + a) / TWO_PI - (b + a) / TWO_PI for b, h in zip(lo, hi)]  # noqa: B905
 
 
 (
