@@ -47,6 +47,7 @@ import os
 from array import array
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -506,7 +507,7 @@ def _option_floats(option: PlanOption, values: list[Any]) -> tuple[int, bool, bo
     cost, tol = option.expected_cost, option.tolerance
     has_cost = cost is not None and math.isfinite(cost)
     has_tol = tol is not None and math.isfinite(tol)
-    values += [s.alpha for s in steps]
+    values += map(_ALPHA, steps)
     values += (
         option.success_probability,
         cost if has_cost else 0.0,
@@ -529,7 +530,7 @@ def _option_text(
     at += m
     probability, cost, tol, end = texts[at : at + 4]
     steps = option.steps
-    if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
+    if {*map(_KIND, steps)} == _SQUEEZE_KIND:  # every step the same text but its angle
         walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
     else:
         pairs = zip(steps, alphas, strict=True)
@@ -544,6 +545,8 @@ def _option_text(
     return text, at + 4
 
 
+# (attrgetter: no comprehension, which makes a function at every call)
+_ALPHA, _KIND = attrgetter("alpha"), attrgetter("kind")
 # A squeeze step's text but its angle: before the first angle, and between two angles.
 _SQUEEZE_KIND = {SQUEEZE.name}
 _SQUEEZE_STEP = f'{{"type": {_text(SQUEEZE.name)}, "alpha_rad": '
@@ -599,12 +602,12 @@ def _document_text(
         option_text, at = _option_text(option, layout, texts, at)
         written.append(option_text)
     pairs = zip(texts[:n], texts[n : 2 * n])  # noqa: B905 (as long)
-    vertices = ", ".join([f"[{x}, {y}]" for x, y in pairs])
+    vertices = "], [".join(map(", ".join, pairs))  # "x0, y0], [x1, y1], [..."
     cx, cy = texts[2 * n], texts[2 * n + 1]
     text = [
         f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
-        f'"vertices": [{vertices}], "n_sides": {_int(hull.n_sides)}, '
-        f'"symmetry_order": {_int(hull.symmetry_order)}{units}, '
+        f'"vertices": [[{vertices}]], "n_sides": {n}, '
+        f'"symmetry_order": {hull.symmetry_order}{units}, '
         f'"center_of_mass": [{cx}, {cy}], "id": {_text(part_id(part))}}}, '
         f'"method": {_text(result.method)}, '
         f'"stable_orientations_rad": [{", ".join(texts[i : i + k])}], '
