@@ -463,15 +463,19 @@ def _int(value: Any) -> str:
 def _float_texts(values: Sequence[Any]) -> list[str] | None:
     """``float.__repr__`` of each value (as ``json.dumps`` writes it), by one orjson call.
 
-    ``None`` when a value is not a float (an int, a float subclass, anything else) or orjson
-    spells one otherwise than ``repr`` (:func:`_as_repr`: a non-finite one among them): the
-    document then takes the general path, which writes or refuses it as the encoder does.
+    ``None`` when a value is not a float (an int, a float subclass, anything else) or not
+    finite (orjson's ``null``): the document then takes the general path, which writes or
+    refuses it as the encoder does. When orjson spells a finite float otherwise than
+    ``repr`` (:func:`_as_repr`), every text is the float's ``repr``, the encoder's own
+    spelling (the study's documents holding a float below 1e-4: 11 of 2000).
     """
     if not {*map(type, values)} <= _FLOAT:
         return None
     text = orjson.dumps(values).decode()
     if not _as_repr(text):
-        return None
+        if "n" in text:  # null: NaN or an infinity
+            return None
+        return [*map(float.__repr__, values)]
     return text[1:-1].split(",") if values else []
 
 
