@@ -499,54 +499,63 @@ def _as_repr(text: str) -> bool:
     return not ("e" in text or "n" in text or "0.0000" in text)
 
 
-def _option_floats(option: PlanOption, values: list[Any]) -> tuple[int, bool, bool]:
-    """Append the floats :func:`option_document` writes to ``values``; what was appended.
+def _options_floats(
+    options: Sequence[PlanOption], values: list[Any]
+) -> list[tuple[int, bool, bool]]:
+    """Append the floats :func:`option_document` writes of each option to ``values``.
 
-    In order: each step's angle, the success probability, the expected cost, the tolerance
-    and the final orientation; 0.0 in place of a cost or tolerance that :func:`json_float`
-    makes null (missing or not finite). Returns (steps, has cost, has tolerance), for
-    :func:`_option_text`.
+    For each option in turn: each step's angle, the success probability, the expected cost,
+    the tolerance and the final orientation; 0.0 in place of a cost or tolerance that
+    :func:`json_float` makes null (missing or not finite). Returns each option's (steps, has
+    cost, has tolerance), for :func:`_options_text`. (One call for all the options: a call
+    an option cost more than its work.)
     """
-    steps = option.steps
-    cost, tol = option.expected_cost, option.tolerance
-    has_cost = cost is not None and math.isfinite(cost)
-    has_tol = tol is not None and math.isfinite(tol)
-    values += map(_ALPHA, steps)
-    values += (
-        option.success_probability,
-        cost if has_cost else 0.0,
-        tol if has_tol else 0.0,
-        option.final_orientation,
-    )
-    return len(steps), has_cost, has_tol
+    layouts = []
+    for option in options:
+        steps = option.steps
+        cost, tol = option.expected_cost, option.tolerance
+        has_cost = cost is not None and math.isfinite(cost)
+        has_tol = tol is not None and math.isfinite(tol)
+        values += map(_ALPHA, steps)
+        values += (
+            option.success_probability,
+            cost if has_cost else 0.0,
+            tol if has_tol else 0.0,
+            option.final_orientation,
+        )
+        layouts.append((len(steps), has_cost, has_tol))
+    return layouts
 
 
-def _option_text(
-    option: PlanOption, layout: tuple[int, bool, bool], texts: list[str], at: int
-) -> tuple[str, int]:
-    """:func:`option_document` as JSON text, from the float texts of :func:`_option_floats`.
+def _options_text(
+    options: Sequence[PlanOption],
+    layouts: list[tuple[int, bool, bool]],
+    texts: list[str],
+    at: int,
+) -> str:
+    """The options as the JSON text of a list of :func:`option_document`.
 
-    ``texts[at:]`` starts with the option's floats; returns the text and where the next
-    option's start.
+    From the float texts of :func:`_options_floats`, ``texts[at:]`` starting with them.
     """
-    m, has_cost, has_tol = layout
-    alphas = texts[at : at + m]
-    at += m
-    probability, cost, tol, end = texts[at : at + 4]
-    steps = option.steps
-    if {*map(_KIND, steps)} == _SQUEEZE_KIND:  # every step the same text but its angle
-        walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
-    else:
-        pairs = zip(steps, alphas, strict=True)
-        walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
-    text = (
-        f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
-        f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
-        f'"final_orientation_rad": {end}, "success_probability": {probability}, '
-        f'"expected_cost": {cost if has_cost else "null"}, '
-        f'"tolerance_rad": {tol if has_tol else "null"}}}'
-    )
-    return text, at + 4
+    written = []
+    for option, (m, has_cost, has_tol) in zip(options, layouts):  # noqa: B905 (as long)
+        alphas = texts[at : at + m]
+        probability, cost, tol, end = texts[at + m : at + m + 4]
+        at += m + 4
+        steps = option.steps
+        if {*map(_KIND, steps)} == _SQUEEZE_KIND:  # every step the same text but its angle
+            walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
+        else:
+            pairs = zip(steps, alphas, strict=True)
+            walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
+        written.append(
+            f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
+            f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
+            f'"final_orientation_rad": {end}, "success_probability": {probability}, '
+            f'"expected_cost": {cost if has_cost else "null"}, '
+            f'"tolerance_rad": {tol if has_tol else "null"}}}'
+        )
+    return ", ".join(written)
 
 
 # (attrgetter: no comprehension, which makes a function at every call)
@@ -568,7 +577,7 @@ def _document_text(
 
     Every float of the document is written by one :func:`_float_texts` call, in this order:
     the hull's x and y coordinates, the centre of mass, the stable orientations, their
-    probabilities, the period, the first angle, then each option's (:func:`_option_floats`),
+    probabilities, the period, the first angle, then each option's (:func:`_options_floats`),
     and the accuracy when it is written.
     Each is the float the general path writes: the hull's vertices as its Python floats
     (which its array is made of, or made from), the stable orientations as the states hold
@@ -591,7 +600,7 @@ def _document_text(
     values = [*xs, *ys, *part.center_of_mass.tolist(), *stable, *probs]
     values += [float(states.period), bayes.first_angle]
     options = result.options
-    layouts = [_option_floats(o, values) for o in options]
+    layouts = _options_floats(options, values)
     if pb.accuracy > 0:
         values.append(pb.accuracy)
     texts = _float_texts(values)
@@ -600,11 +609,7 @@ def _document_text(
     i = 2 * n + 2  # where the stable orientations start
     j = i + k + len(probs)  # where the probabilities end
     period, first = texts[j], texts[j + 1]
-    at = j + 2
-    written = []
-    for option, layout in zip(options, layouts):  # noqa: B905 (as long)
-        option_text, at = _option_text(option, layout, texts, at)
-        written.append(option_text)
+    written = _options_text(options, layouts, texts, j + 2)
     pairs = zip(texts[:n], texts[n : 2 * n])  # noqa: B905 (as long)
     vertices = "], [".join(map(", ".join, pairs))  # "x0, y0], [x1, y1], [..."
     cx, cy = texts[2 * n], texts[2 * n + 1]
@@ -617,7 +622,7 @@ def _document_text(
         f'"stable_orientations_rad": [{", ".join(texts[i : i + k])}], '
         f'"stable_probabilities": [{", ".join(texts[i + k : j])}], '
         f'"period_rad": {period}, "first_squeeze_rad": {first}, '
-        f'"options": [{", ".join(written)}], '
+        f'"options": [{written}], '
         f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
     ]
     if result.nodes is not None:
