@@ -128,6 +128,8 @@ def test_other_value_types_are_written_as_the_encoder_writes_them() -> None:
         _with_option(res, final_orientation=True),  # a bool: the general path
         _with_option(res, expected_cost=math.inf, tolerance=math.nan),  # null, null
         dataclasses.replace(res, nodes=17),
+        dataclasses.replace(res, most_certain=True),  # a bool index: the general path
+        dataclasses.replace(res, nodes=True),
         _with_option(res, final_orientation=-0.0),  # not the text of 0.0
         _with_option(res, final_orientation=np.float64(res.problem.states.stable[1])),
         _with_option(res, final_orientation=int(res.problem.states.stable[1])),

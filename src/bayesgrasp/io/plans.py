@@ -613,7 +613,26 @@ def _document_text(
     pairs = zip(texts[:n], texts[n : 2 * n])  # noqa: B905 (as long)
     vertices = "], [".join(map(", ".join, pairs))  # "x0, y0], [x1, y1], [..."
     cx, cy = texts[2 * n], texts[2 * n + 1]
-    text = [
+    bayes_at, most_certain = result.bayes, result.most_certain
+    if type(bayes_at) is not int or type(most_certain) is not int:  # (a bool, numpy's int)
+        return None
+    more = ""  # what only some documents have
+    if result.nodes is not None:
+        more += f', "nodes": {_int(result.nodes)}'
+    if pb.accuracy > 0:
+        more += f', "accuracy_rad": {texts[-1]}'
+    if guaranteed is not None:
+        more += f', "guaranteed": {_encode(guaranteed_document(guaranteed))}'
+    elif guaranteed_missing is not None:
+        more += f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}'
+    provenance = _shared_provenance(pb, result.method, inputs, memo)
+    if memo is None:
+        shared = _encode(provenance)
+    else:
+        if memo.get("provenance_of") is not provenance:  # encoded once for the documents sharing it
+            memo["provenance_of"], memo["provenance_text"] = provenance, _encode(provenance)
+        shared = memo["provenance_text"]
+    return (
         f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
         f'"vertices": [[{vertices}]], "n_sides": {n}, '
         f'"symmetry_order": {hull.symmetry_order}{units}, '
@@ -622,24 +641,9 @@ def _document_text(
         f'"stable_orientations_rad": [{", ".join(texts[i : i + k])}], '
         f'"stable_probabilities": [{", ".join(texts[i + k : j])}], '
         f'"period_rad": {period}, "first_squeeze_rad": {first}, '
-        f'"options": [{written}], '
-        f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
-    ]
-    if result.nodes is not None:
-        text.append(f', "nodes": {_int(result.nodes)}')
-    if pb.accuracy > 0:
-        text.append(f', "accuracy_rad": {texts[-1]}')
-    if guaranteed is not None:
-        text.append(f', "guaranteed": {_encode(guaranteed_document(guaranteed))}')
-    elif guaranteed_missing is not None:
-        text.append(f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}')
-    done = "".join(text)
-    provenance = _shared_provenance(pb, result.method, inputs, memo)
-    if memo is None:
-        return f'{done}, "provenance": {_encode(provenance)}}}'
-    if memo.get("provenance_of") is not provenance:  # encoded once for the documents sharing it
-        memo["provenance_of"], memo["provenance_text"] = provenance, _encode(provenance)
-    return f'{done}, "provenance": {memo["provenance_text"]}}}'
+        f'"options": [{written}], "bayes": {bayes_at}, "most_certain": {most_certain}'
+        f'{more}, "provenance": {shared}}}'
+    )
 
 
 def _shared_provenance(
