@@ -596,9 +596,10 @@ def _document_text(
     states = pb.states
     stable = states.values[0]
     k = len(stable)
-    probs = pb.state_probabilities(bayes.first_angle, bayes.steps[0].kind)
+    step = bayes.steps[0]  # (its angle is the plan's first_angle)
+    probs = pb.state_probabilities(step.alpha, step.kind)
     values = [*xs, *ys, *part.center_of_mass.tolist(), *stable, *probs]
-    values += [float(states.period), bayes.first_angle]
+    values += [float(states.period), step.alpha]
     options = result.options
     layouts = _options_floats(options, values)
     if pb.accuracy > 0:
