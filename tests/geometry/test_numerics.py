@@ -454,7 +454,7 @@ def test_not_quite_symmetric_parts_have_the_period_pi() -> None:
         assert shift_error(s, rng.uniform(0, TWO_PI, 1000)) <= poly.tol.angle
 
 
-@pytest.mark.parametrize("n", [6, 12, 24, 60, 66, 96, 120, 1000])
+@pytest.mark.parametrize("n", [5, 6, 9, 12, 15, 24, 60, 66, 96, 120, 1000])
 def test_symmetry_order_python_and_numpy_agree(n: int) -> None:
     rng = np.random.default_rng(n)
     for noise in (1e-9, 3e-6, 1e-5, 1e-3):

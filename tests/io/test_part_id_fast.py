@@ -82,3 +82,18 @@ def test_a_large_hull_takes_numpy() -> None:
     part = Part.from_points(np.column_stack([np.cos(t), 2 * np.sin(t)]))
     assert len(part.hull.vertices) > plans.SMALL
     assert part_id(part).startswith("sha256:")
+
+
+def test_values_near_the_int64_limit() -> None:
+    """Rounded values within int64 are packed as numpy casts them; beyond it, numpy decides."""
+    square = Part.from_points([(0.0, 0.0), (3.0, 0.0), (3.0, 3.0), (0.0, 3.0)])
+    step = 2.0**-62  # (x - cx) / step = +-1.5 * 2^62: in [2^62, 2^63), numpy's cast exact
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(plans, "_grid", lambda hull: step)
+        assert plans._small_id_bytes(square, step) is not None
+        fast, general = _both(square)
+    assert fast == general
+    wide = Part.from_points([(0.0, 0.0), (4.0, 0.0), (4.0, 3.0), (0.0, 3.0)])
+    assert plans._small_id_bytes(wide, step) is None  # 2^63: beyond int64
+    assert plans._small_id_bytes(wide, 1e-320) is None  # an infinity
+    assert plans._small_id_bytes(wide, math.nan) is None

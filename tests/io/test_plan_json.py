@@ -50,8 +50,8 @@ def test_the_study_polygons_with_one_memo() -> None:
         assert plan_document_json(res, inputs=inputs, memo=memo) == dumps(res, inputs=inputs)
         general += plans_module._document_text(res, None, None, inputs, memo) is None
     assert "provenance_text" in memo  # the shared text was used
-    # The template, not its fallback, writes nearly all (a float below 1e-4 is the rest).
-    assert general <= 5
+    # The template, not its fallback, writes them all (a float below 1e-4 too).
+    assert general == 0
 
 
 PROBLEMS = [
@@ -128,6 +128,8 @@ def test_other_value_types_are_written_as_the_encoder_writes_them() -> None:
         _with_option(res, final_orientation=True),  # a bool: the general path
         _with_option(res, expected_cost=math.inf, tolerance=math.nan),  # null, null
         dataclasses.replace(res, nodes=17),
+        dataclasses.replace(res, most_certain=True),  # a bool index: the general path
+        dataclasses.replace(res, nodes=True),
         _with_option(res, final_orientation=-0.0),  # not the text of 0.0
         _with_option(res, final_orientation=np.float64(res.problem.states.stable[1])),
         _with_option(res, final_orientation=int(res.problem.states.stable[1])),
@@ -212,16 +214,22 @@ _any_float = st.one_of(
 def test_orjson_float_text_is_repr(values: list[float]) -> None:
     """The float texts the template writes by orjson are each float's repr, as json.dumps.
 
-    Or ``None`` (the general path), only for a value orjson may spell otherwise: not
-    finite, an exponent in its repr (below 1e-4 or from 1e16 on), or four zeros after a
-    point (as 10.00001, which only costs the general path).
+    Or ``None`` (the general path), only for a value that is not finite. (A value orjson
+    may spell otherwise, with an exponent in its repr, below 1e-4 or from 1e16 on, or four
+    zeros after a point as 10.00001, has every text written by repr.)
     """
     texts = plans_module._float_texts(values)
     if texts is not None:
         assert texts == [repr(x) for x in values]
     else:
-        spelled = [repr(x) for x in values]
-        assert [t for t in spelled if t in ("nan", "inf", "-inf") or "e" in t or "0.0000" in t]
+        assert not all(map(math.isfinite, values))
+
+
+def test_orjson_spellings_unlike_repr_are_written_by_repr() -> None:
+    values = [1e-05, 0.5, 1e16, 10.00001, 1.5e-300, -2e-5]
+    assert plans_module._float_texts(values) == [repr(x) for x in values]
+    assert plans_module._float_texts([0.5, math.nan]) is None
+    assert plans_module._float_texts([math.inf, 1e-05]) is None
 
 
 def test_float_texts_refuse_what_float_repr_refuses() -> None:

@@ -934,11 +934,15 @@ class ConvexPolygon:
         if known > 0:
             return known if known >= lowest else 1
         n = self.n_sides  # the arrays are made on first use: not here
-        orders = _orders_from(n, lowest)
         if known < 0:
             if lowest >= -known:
                 return 1  # every order from -known up failed
-            orders = [r for r in orders if r < -known]
+            orders = _orders_between(n, lowest, -known)
+        else:
+            orders = _orders_from(n, lowest)
+        if not orders:  # (as an odd part's half turn, after the orders from 3 failed)
+            _SET_SYMMETRY(self, -lowest)
+            return 1
         eps = self.tol.symmetry_for(self.size)
         if n <= _SMALL:
             found = _symmetry_order_python(*self._coords(), self._centroid_xy(), orders, eps)
@@ -1051,6 +1055,12 @@ def _orders_from(n: int, lowest: int) -> list[int]:
     return [r for r in _orders(n) if r >= lowest]
 
 
+@functools.cache
+def _orders_between(n: int, lowest: int, below: int) -> list[int]:
+    """:func:`_orders` from ``lowest`` up and below ``below`` (the caller must not change it)."""
+    return [r for r in _orders(n) if lowest <= r < below]
+
+
 # The symmetry order's cache, set at half object.__setattr__'s cost (once for every part).
 _SET_SYMMETRY = ConvexPolygon.__dict__["_symmetry"].__set__
 
@@ -1069,27 +1079,38 @@ def _symmetry_order_python(
     cx, cy = centroid
     n = len(xs)
     r0 = math.hypot(xs[0] - cx, ys[0] - cy)
-    radii: list[float] = []
     for r in orders:
         step = n // r
         if abs(math.hypot(xs[step] - cx, ys[step] - cy) - r0) > eps:
             continue
-        if not radii:
-            radii = [math.hypot(x - cx, y - cy) for x, y in zip(xs, ys, strict=True)]
-        if any(abs(radii[i + step] - radii[i]) > eps for i in range(n - step)):
-            continue
-        a = 2.0 * math.pi / r
-        c, s = math.cos(a), math.sin(a)
-        if all(
-            math.hypot(
-                c * (xs[i] - cx) - s * (ys[i] - cy) - (xs[(i + step) % n] - cx),
-                s * (xs[i] - cx) + c * (ys[i] - cy) - (ys[(i + step) % n] - cy),
-            )
-            <= eps
-            for i in range(n)
-        ):
+        if _turns_onto(xs, ys, cx, cy, r, eps):
             return r
     return 1
+
+
+def _turns_onto(xs: list[float], ys: list[float], cx: float, cy: float, r: int, eps: float) -> bool:
+    """Whether a turn by ``2 pi / r`` about (cx, cy) keeps the vertices within ``eps``.
+
+    Vertex i must land within ``eps`` of vertex ``i + n / r``: the test of one order of
+    :func:`_symmetry_order_python`, after its first, cheap rejection. A function of its own:
+    the generators' variables are cells, which each call of the caller would make, whether
+    its first test rejects every order or not.
+    """
+    n = len(xs)
+    step = n // r
+    radii = [math.hypot(x - cx, y - cy) for x, y in zip(xs, ys, strict=True)]
+    if any(abs(radii[i + step] - radii[i]) > eps for i in range(n - step)):
+        return False
+    a = 2.0 * math.pi / r
+    c, s = math.cos(a), math.sin(a)
+    return all(
+        math.hypot(
+            c * (xs[i] - cx) - s * (ys[i] - cy) - (xs[(i + step) % n] - cx),
+            s * (xs[i] - cx) + c * (ys[i] - cy) - (ys[(i + step) % n] - cy),
+        )
+        <= eps
+        for i in range(n)
+    )
 
 
 @dataclass(frozen=True, slots=True, eq=False)

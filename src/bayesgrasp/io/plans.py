@@ -44,9 +44,10 @@ import hashlib
 import json
 import math
 import os
-import struct
+from array import array
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -139,27 +140,41 @@ def part_id(part: Part) -> str:
     return "sha256:" + hashlib.sha256(data).hexdigest()[:16]
 
 
-# Rounded coordinates at most this large fit an int64 whichever way they are converted.
-_ID_LIMIT = 2.0**62
-
-
 def _small_id_bytes(part: Part, q: float) -> bytes | None:
     """The bytes :func:`part_id` hashes, on Python floats (a hull of at most ``SMALL`` vertices).
 
     The same subtraction and division as numpy's, then ``round`` (halves to even, as
-    ``np.rint``), and the int64 values in the machine's byte order as ``ndarray.tobytes``.
-    ``None`` (numpy decides) for values beyond :data:`_ID_LIMIT` or not finite.
+    ``np.rint``), and the int64 values in the machine's byte order, as ``ndarray.tobytes``
+    (``array("q")``: long long, 8 bytes). ``None`` (numpy decides) for a value ``round``
+    refuses (not finite) or beyond int64, which ``array`` refuses; every rounded value it
+    takes is an integral float within int64, which numpy's cast keeps exactly.
     """
     cx, cy = part.center_of_mass.tolist()
-    pts = []
-    for x, y in part.hull.vertices.tolist():
-        u, v = (x - cx) / q, (y - cy) / q
-        if not (abs(u) < _ID_LIMIT and abs(v) < _ID_LIMIT):  # NaN fails too
-            return None
-        pts.append((round(u), round(v)))
-    start = pts.index(min(pts))  # the first lexicographically least, as numpy's path
-    # int64 in the machine's order, as array("q", ...).tobytes() (long long, 8 bytes)
-    return struct.pack(f"{2 * len(pts)}q", *[c for p in pts[start:] + pts[:start] for c in p])
+    units: list[float] = []  # x0, y0, x1, y1, ... in rounding steps from the centre of mass
+    for x, y in zip(*part.hull._coords()):  # noqa: B905 (as long; strict= costs)
+        units += ((x - cx) / q, (y - cy) / q)
+    try:  # round() by the method itself: half round()'s cost, which looks the method up
+        flat = [*map(float.__round__, units)]
+    except (OverflowError, ValueError):  # an infinity, NaN
+        return None
+    start = 2 * _least(flat)
+    try:
+        return array("q", flat[start:] + flat[:start]).tobytes()
+    except OverflowError:
+        return None
+
+
+def _least(flat: list[int]) -> int:
+    """The index of the first lexicographically least (x, y) pair of ``[x0, y0, x1, ...]``.
+
+    (A function of its own: a closure in :func:`_small_id_bytes` would make cells of its
+    variables at every call, ties or not.)
+    """
+    xs = flat[0::2]
+    least = min(xs)
+    if xs.count(least) == 1:
+        return xs.index(least)
+    return min(range(len(xs)), key=lambda i: (xs[i], flat[2 * i + 1]))
 
 
 def same_part(doc: Any, part: Part) -> bool | None:
@@ -448,86 +463,103 @@ def _int(value: Any) -> str:
 def _float_texts(values: Sequence[Any]) -> list[str] | None:
     """``float.__repr__`` of each value (as ``json.dumps`` writes it), by one orjson call.
 
-    ``None`` when a value is not a float (an int, a float subclass, anything else) or orjson
-    spells one otherwise than ``repr`` (:func:`_as_repr`: a non-finite one among them): the
-    document then takes the general path, which writes or refuses it as the encoder does.
+    ``None`` when a value is not a float (an int, a float subclass, anything else) or not
+    finite (orjson's ``null``): the document then takes the general path, which writes or
+    refuses it as the encoder does. When orjson spells a finite float otherwise than
+    ``repr`` (:func:`_as_repr`), every text is the float's ``repr``, the encoder's own
+    spelling (the study's documents holding a float below 1e-4: 11 of 2000).
     """
     if not {*map(type, values)} <= _FLOAT:
         return None
-    data = orjson.dumps(values)
-    if not _as_repr(data):
-        return None
-    text = data.decode()[1:-1]
-    return text.split(",") if text else []
+    text = orjson.dumps(values).decode()
+    if not _as_repr(text):
+        if "n" in text:  # null: NaN or an infinity
+            return None
+        return [*map(float.__repr__, values)]
+    return text[1:-1].split(",") if values else []
 
 
 _FLOAT = {float}
 
 
-def _as_repr(data: bytes) -> bool:
+def _as_repr(text: str) -> bool:
     """Whether orjson's text of a list of floats is each float's ``repr`` (but the spaces).
 
     orjson writes a finite float with the shortest digits that read back to it, the digits
     ``repr`` writes (both are "shortest round-trip, nearest", Steele & White / Gay), but
     spells some differently: a magnitude below 1e-4 positionally (``0.00001`` for
     ``1e-05``), exponents without their zero (``1e-7``), and NaN and the infinities as
-    ``null``. A text without an ``e``, ``0.0000`` or ``null`` holds none of these (a float
-    below 1e-4 written positionally has four zeros after its point); test:
-    ``tests/io/test_plan_json.py::test_orjson_float_text_is_repr``.
+    ``null``. A text without an ``e``, ``n`` or ``0.0000`` holds none of these (no finite
+    float's text has an ``n``; one written positionally below 1e-4 has four zeros after its
+    point); test: ``tests/io/test_plan_json.py::test_orjson_float_text_is_repr``.
+
+    Searched in the decoded text: ``bytes.__contains__`` first tries its argument as an int,
+    and raises and clears a TypeError for each search (~1.7k instructions).
     """
-    return not (b"e" in data or b"0.0000" in data or b"null" in data)
+    return not ("e" in text or "n" in text or "0.0000" in text)
 
 
-def _option_floats(option: PlanOption, values: list[Any]) -> tuple[int, bool, bool]:
-    """Append the floats :func:`option_document` writes to ``values``; what was appended.
+def _options_floats(
+    options: Sequence[PlanOption], values: list[Any]
+) -> list[tuple[int, bool, bool]]:
+    """Append the floats :func:`option_document` writes of each option to ``values``.
 
-    In order: each step's angle, the success probability, the expected cost, the tolerance
-    and the final orientation; 0.0 in place of a cost or tolerance that :func:`json_float`
-    makes null (missing or not finite). Returns (steps, has cost, has tolerance), for
-    :func:`_option_text`.
+    For each option in turn: each step's angle, the success probability, the expected cost,
+    the tolerance and the final orientation; 0.0 in place of a cost or tolerance that
+    :func:`json_float` makes null (missing or not finite). Returns each option's (steps, has
+    cost, has tolerance), for :func:`_options_text`. (One call for all the options: a call
+    an option cost more than its work.)
     """
-    steps = option.steps
-    cost, tol = option.expected_cost, option.tolerance
-    has_cost = cost is not None and math.isfinite(cost)
-    has_tol = tol is not None and math.isfinite(tol)
-    values += [s.alpha for s in steps]
-    values += (
-        option.success_probability,
-        cost if has_cost else 0.0,
-        tol if has_tol else 0.0,
-        option.final_orientation,
-    )
-    return len(steps), has_cost, has_tol
+    layouts = []
+    for option in options:
+        steps = option.steps
+        cost, tol = option.expected_cost, option.tolerance
+        has_cost = cost is not None and math.isfinite(cost)
+        has_tol = tol is not None and math.isfinite(tol)
+        values += map(_ALPHA, steps)
+        values += (
+            option.success_probability,
+            cost if has_cost else 0.0,
+            tol if has_tol else 0.0,
+            option.final_orientation,
+        )
+        layouts.append((len(steps), has_cost, has_tol))
+    return layouts
 
 
-def _option_text(
-    option: PlanOption, layout: tuple[int, bool, bool], texts: list[str], at: int
-) -> tuple[str, int]:
-    """:func:`option_document` as JSON text, from the float texts of :func:`_option_floats`.
+def _options_text(
+    options: Sequence[PlanOption],
+    layouts: list[tuple[int, bool, bool]],
+    texts: list[str],
+    at: int,
+) -> str:
+    """The options as the JSON text of a list of :func:`option_document`.
 
-    ``texts[at:]`` starts with the option's floats; returns the text and where the next
-    option's start.
+    From the float texts of :func:`_options_floats`, ``texts[at:]`` starting with them.
     """
-    m, has_cost, has_tol = layout
-    alphas = texts[at : at + m]
-    at += m
-    probability, cost, tol, end = texts[at : at + 4]
-    steps = option.steps
-    if {s.kind for s in steps} == _SQUEEZE_KIND:  # every step the same text but its angle
-        walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
-    else:
-        pairs = zip(steps, alphas, strict=True)
-        walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
-    text = (
-        f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
-        f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
-        f'"final_orientation_rad": {end}, "success_probability": {probability}, '
-        f'"expected_cost": {cost if has_cost else "null"}, '
-        f'"tolerance_rad": {tol if has_tol else "null"}}}'
-    )
-    return text, at + 4
+    written = []
+    for option, (m, has_cost, has_tol) in zip(options, layouts):  # noqa: B905 (as long)
+        alphas = texts[at : at + m]
+        probability, cost, tol, end = texts[at + m : at + m + 4]
+        at += m + 4
+        steps = option.steps
+        if {*map(_KIND, steps)} == _SQUEEZE_KIND:  # every step the same text but its angle
+            walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
+        else:
+            pairs = zip(steps, alphas, strict=True)
+            walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
+        written.append(
+            f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
+            f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
+            f'"final_orientation_rad": {end}, "success_probability": {probability}, '
+            f'"expected_cost": {cost if has_cost else "null"}, '
+            f'"tolerance_rad": {tol if has_tol else "null"}}}'
+        )
+    return ", ".join(written)
 
 
+# (attrgetter: no comprehension, which makes a function at every call)
+_ALPHA, _KIND = attrgetter("alpha"), attrgetter("kind")
 # A squeeze step's text but its angle: before the first angle, and between two angles.
 _SQUEEZE_KIND = {SQUEEZE.name}
 _SQUEEZE_STEP = f'{{"type": {_text(SQUEEZE.name)}, "alpha_rad": '
@@ -545,7 +577,7 @@ def _document_text(
 
     Every float of the document is written by one :func:`_float_texts` call, in this order:
     the hull's x and y coordinates, the centre of mass, the stable orientations, their
-    probabilities, the period, the first angle, then each option's (:func:`_option_floats`),
+    probabilities, the period, the first angle, then each option's (:func:`_options_floats`),
     and the accuracy when it is written.
     Each is the float the general path writes: the hull's vertices as its Python floats
     (which its array is made of, or made from), the stable orientations as the states hold
@@ -564,11 +596,12 @@ def _document_text(
     states = pb.states
     stable = states.values[0]
     k = len(stable)
-    probs = pb.state_probabilities(bayes.first_angle, bayes.steps[0].kind)
+    step = bayes.steps[0]  # (its angle is the plan's first_angle)
+    probs = pb.state_probabilities(step.alpha, step.kind)
     values = [*xs, *ys, *part.center_of_mass.tolist(), *stable, *probs]
-    values += [float(states.period), bayes.first_angle]
+    values += [float(states.period), step.alpha]
     options = result.options
-    layouts = [_option_floats(o, values) for o in options]
+    layouts = _options_floats(options, values)
     if pb.accuracy > 0:
         values.append(pb.accuracy)
     texts = _float_texts(values)
@@ -577,41 +610,41 @@ def _document_text(
     i = 2 * n + 2  # where the stable orientations start
     j = i + k + len(probs)  # where the probabilities end
     period, first = texts[j], texts[j + 1]
-    at = j + 2
-    written = []
-    for option, layout in zip(options, layouts, strict=True):
-        option_text, at = _option_text(option, layout, texts, at)
-        written.append(option_text)
-    pairs = zip(texts[:n], texts[n : 2 * n], strict=True)
-    vertices = ", ".join([f"[{x}, {y}]" for x, y in pairs])
+    written = _options_text(options, layouts, texts, j + 2)
+    pairs = zip(texts[:n], texts[n : 2 * n])  # noqa: B905 (as long)
+    vertices = "], [".join(map(", ".join, pairs))  # "x0, y0], [x1, y1], [..."
     cx, cy = texts[2 * n], texts[2 * n + 1]
-    text = [
+    bayes_at, most_certain = result.bayes, result.most_certain
+    if type(bayes_at) is not int or type(most_certain) is not int:  # (a bool, numpy's int)
+        return None
+    more = ""  # what only some documents have
+    if result.nodes is not None:
+        more += f', "nodes": {_int(result.nodes)}'
+    if pb.accuracy > 0:
+        more += f', "accuracy_rad": {texts[-1]}'
+    if guaranteed is not None:
+        more += f', "guaranteed": {_encode(guaranteed_document(guaranteed))}'
+    elif guaranteed_missing is not None:
+        more += f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}'
+    provenance = _shared_provenance(pb, result.method, inputs, memo)
+    if memo is None:
+        shared = _encode(provenance)
+    else:
+        if memo.get("provenance_of") is not provenance:  # encoded once for the documents sharing it
+            memo["provenance_of"], memo["provenance_text"] = provenance, _encode(provenance)
+        shared = memo["provenance_text"]
+    return (
         f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
-        f'"vertices": [{vertices}], "n_sides": {_int(hull.n_sides)}, '
-        f'"symmetry_order": {_int(hull.symmetry_order)}{units}, '
+        f'"vertices": [[{vertices}]], "n_sides": {n}, '
+        f'"symmetry_order": {hull.symmetry_order}{units}, '
         f'"center_of_mass": [{cx}, {cy}], "id": {_text(part_id(part))}}}, '
         f'"method": {_text(result.method)}, '
         f'"stable_orientations_rad": [{", ".join(texts[i : i + k])}], '
         f'"stable_probabilities": [{", ".join(texts[i + k : j])}], '
         f'"period_rad": {period}, "first_squeeze_rad": {first}, '
-        f'"options": [{", ".join(written)}], '
-        f'"bayes": {_int(result.bayes)}, "most_certain": {_int(result.most_certain)}'
-    ]
-    if result.nodes is not None:
-        text.append(f', "nodes": {_int(result.nodes)}')
-    if pb.accuracy > 0:
-        text.append(f', "accuracy_rad": {texts[-1]}')
-    if guaranteed is not None:
-        text.append(f', "guaranteed": {_encode(guaranteed_document(guaranteed))}')
-    elif guaranteed_missing is not None:
-        text.append(f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}')
-    done = "".join(text)
-    provenance = _shared_provenance(pb, result.method, inputs, memo)
-    if memo is None:
-        return f'{done}, "provenance": {_encode(provenance)}}}'
-    if memo.get("provenance_of") is not provenance:  # encoded once for the documents sharing it
-        memo["provenance_of"], memo["provenance_text"] = provenance, _encode(provenance)
-    return f'{done}, "provenance": {memo["provenance_text"]}}}'
+        f'"options": [{written}], "bayes": {bayes_at}, "most_certain": {most_certain}'
+        f'{more}, "provenance": {shared}}}'
+    )
 
 
 def _shared_provenance(

@@ -451,7 +451,10 @@ class Problem:
             return None
         _, lo, hi = f.values
         a = first_angle
-        return [(h + a) / TWO_PI - (b + a) / TWO_PI for b, h in zip(lo, hi, strict=True)]
+        out = []  # (a loop: a comprehension would make a function and a cell for a each call)
+        for b, h in zip(lo, hi):  # noqa: B905 (as long; strict= parses keywords each call)
+            out.append((h + a) / TWO_PI - (b + a) / TWO_PI)
+        return out
 
 
 (
