@@ -281,6 +281,9 @@ def batch_case(args: argparse.Namespace) -> None:
     second call, the study, the batch one part at a time (``GROUP = 1``) and the study in
     groups; best of each over the runs, and the median of the rounds' ratios.
     """
+    # The first call as users meet it: the modules' bytecode compiled (pip compiles it on
+    # installing; under PYTHONDONTWRITEBYTECODE nothing else would).
+    subprocess.run([sys.executable, "-m", "compileall", "-q", str(HERE)], check=True)
     runs = [run(HERE, "batch", args.polygons, False, args.timeout) for _ in range(args.repeat)]
     ok = [r for r in runs if "cpu" in r]
     if not ok:
