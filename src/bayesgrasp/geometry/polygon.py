@@ -849,7 +849,8 @@ class ConvexPolygon:
         ``x0, x1, y0, y1`` their least and largest; ``least``: the cross product
         ``(b - a) x (c - b)`` of least magnitude over its vertices, positive if the ring runs
         counter-clockwise. ``None`` when this cannot promise the same polygon: the caller
-        then takes the hull.
+        then takes the hull. The polygon may keep ``xs`` and ``ys`` as its own (never
+        changed): the caller hands them over.
 
         Why it is the same polygon, to the last bit: with ``D`` the bounding box's diagonal
         and ``u`` the unit roundoff, a computed orientation of three of the points (the
@@ -867,13 +868,15 @@ class ConvexPolygon:
         either path of :func:`_hull_small`. Odd magnitudes and degenerate areas go to the
         hull, which words the refusals.
         """
-        extent = max(x1 - x0, y1 - y0)
+        # _hull_of_floats's tests and _hull_small's bound, inline (the same operations).
+        w, h = x1 - x0, y1 - y0
+        extent = w if w >= h else h  # max(w, h)
         if _odd_magnitude(x0, x1, y0, y1, extent):
             return None
-        eps = tol.length_for(extent)
+        eps = tol.length * extent  # tol.length_for(extent)
         bound = 2.0 * eps * extent
-        firm = _RING_FIRM * ((x1 - x0) ** 2 + (y1 - y0) ** 2)
-        if not (bound >= _TINY and abs(least) > 2.0 * bound and abs(least) > firm):
+        margin = abs(least)
+        if not (bound >= _TINY and margin > 2.0 * bound and margin > _RING_FIRM * (w**2 + h**2)):
             return None
         if least < 0:
             xs, ys = xs[::-1], ys[::-1]
@@ -887,13 +890,18 @@ class ConvexPolygon:
                 i += 1
         elif i == 0 and xs[-1] == x0 and ys[-1] < ys[0]:
             i = n - 1
-        hx, hy = xs[i:] + xs[:i], ys[i:] + ys[:i]
+        if i:  # (else the lists are kept: the caller hands them over)
+            xs, ys = xs[i:] + xs[:i], ys[i:] + ys[:i]
         # _measure's sums, in its order (the ring holds the least and largest y, and the
         # largest x is the x of its lexicographically largest point).
-        ox, oy = hx[0], hy[0]
-        scale = max(x1 - ox, y1 - oy, oy - y0)
+        ox, oy = xs[0], ys[0]
+        scale = x1 - ox  # max(x1 - ox, y1 - oy, oy - y0)
+        if y1 - oy > scale:
+            scale = y1 - oy
+        if oy - y0 > scale:
+            scale = oy - y0
         twice = cx = cy = qx = qy = 0.0
-        for bx, by in zip(hx[1:], hy[1:]):  # noqa: B905
+        for bx, by in zip(xs[1:], ys[1:]):  # noqa: B905
             rx = (bx - ox) / scale
             ry = (by - oy) / scale
             c = qx * ry - rx * qy
@@ -914,7 +922,7 @@ class ConvexPolygon:
         area = 0.5 * twice * scale * scale
         if not area > eps * extent:
             return None
-        return cls._of_floats(hx, hy, tol, area, cx, cy, _size(zip(hx, hy), cx, cy))  # noqa: B905
+        return cls._of_floats(xs, ys, tol, area, cx, cy, _size(zip(xs, ys), cx, cy))  # noqa: B905
 
     @property
     def n_sides(self) -> int:
