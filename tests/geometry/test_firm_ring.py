@@ -30,9 +30,9 @@ def _fields(poly: ConvexPolygon) -> list[str]:
 
 def _ring(pts: list[tuple[float, float]]) -> tuple[list[float], list[float], Box, float]:
     """The ring's coordinates, their least and largest, and ``_firm_turn`` of them."""
-    flat = points_module._small_floats([list(p) for p in pts])
-    assert flat is not None
-    xs, ys = flat[::2], flat[1::2]
+    small = points_module._small_floats([list(p) for p in pts])
+    assert small is not None
+    xs, ys = small
     box = (min(xs), max(xs), min(ys), max(ys))
     return xs, ys, box, points_module._firm_turn(xs, ys, *box)
 

@@ -87,7 +87,10 @@ def test_adversarial_inputs_agree(pts: list[list[object]], monkeypatch: pytest.M
 
 
 def test_fast_path_taken_for_small_lists() -> None:
-    assert points_module._small_floats([[0, 0], [1, 0], [0, 1]]) == [0.0, 0.0, 1.0, 0.0, 0.0, 1.0]
+    assert points_module._small_floats([[0, 0], [1, 0], [0, 1]]) == (
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    )
     assert points_module._small_floats([[0, 0], [1, 0], [0, True]]) is None
     assert points_module._small_floats(np.zeros((3, 2)).tolist() * 30) is None  # above SMALL
 
@@ -137,9 +140,9 @@ def _star(n: int, step: int, radius: float = 1.0, centre: tuple[float, float] = 
 
 def _decisions(pts: list[list[float]]) -> tuple[bool, bool | None, bool]:
     """(firmly convex, simple, convex) of the plain-Python tests, on the cleaned ring."""
-    flat = points_module._small_floats(pts)
-    assert flat is not None
-    ring = points_module._small_ring(list(zip(flat[::2], flat[1::2], strict=True)))
+    small = points_module._small_floats(pts)
+    assert small is not None
+    ring = points_module._small_ring(list(zip(*small, strict=True)))
     turns = points_module._turns(ring)
     simple = points_module._small_is_simple(ring, turns)
     convex = points_module._small_is_convex(ring, turns) if simple else None
@@ -220,8 +223,8 @@ def test_firm_convexity_against_the_pair_test(
     pts_list = (pts[::-1] if reverse else pts).tolist()
     if points_module._small_floats(pts_list) is None:
         return
-    flat = points_module._small_floats(pts_list) or []
-    if len(points_module._small_ring(list(zip(flat[::2], flat[1::2], strict=True)))) < 3:
+    small = points_module._small_floats(pts_list) or ([], [])
+    if len(points_module._small_ring(list(zip(*small, strict=True)))) < 3:
         return
     firm, simple, convex = _decisions(pts_list)
     if firm:
@@ -320,7 +323,7 @@ _item = st.one_of(
 @given(points=st.one_of(st.lists(_item, max_size=70), _leaf))
 def test_line_floats_are_the_small_floats(points: object) -> None:
     read = orjson.loads(orjson.dumps(points))
-    assert points_module._line_floats(read) == points_module._small_floats(read, 2.0**53)
+    assert points_module._line_floats(read) == points_module._small_floats(read, math.inf)
 
 
 def test_orjson_reads_only_finite_floats() -> None:
@@ -333,19 +336,56 @@ def test_orjson_reads_only_finite_floats() -> None:
 
 def test_line_floats_cases() -> None:
     line = points_module._line_floats
-    assert line([[0, 0], [1, 0.5], [0, 1]]) == [0.0, 0.0, 1.0, 0.5, 0.0, 1.0]
-    assert line([[0, 0], [1, 0], [0, 2**53]]) == [0.0, 0.0, 1.0, 0.0, 0.0, 2.0**53]
+    assert line([[0, 0], [1, 0.5], [0, 1]]) == ([0.0, 1.0, 0.0], [0.0, 0.5, 1.0])
+    assert line([[0, 0], [1, 0], [0, 2**53]]) == ([0.0, 1.0, 0.0], [0.0, 0.0, 2.0**53])
     assert line([[0, 0], [1, 0], [0, 2**53 + 1]]) is None  # would round to 2^53
-    assert line([[0, 0], [1, 0], [0, 2.0**53 + 2]]) is None
-    assert line([[0.0, 0.0], [1.0, 0.0], [-(2.0**53) - 2, 0.0]]) is None
     assert line([[0, 0], [1, 0], [-(2**53) - 1, 0]]) is None
+    big = 2.0**53 + 2  # a float: the limit is the caller's
+    assert line([[0, 0], [1, 0], [0, big]]) == ([0.0, 1.0, 0.0], [0.0, 0.0, big])
+    assert line([[0.0, 0.0], [1.0, 0.0], [0.0, 1e300]]) == ([0.0, 1.0, 0.0], [0.0, 0.0, 1e300])
     assert line([[0, 0], [1, 0], "ab"]) is None
     assert line([[0, 0], [1, 0], {"a": 1, "b": 2}]) is None
     assert line([[0, 0], [1, 0], [0, True]]) is None
     assert line([[0, 0], [1, 0], [0, 1, 2]]) is None
+    assert line([[0, 0], [1, 0], [0]]) is None
     assert line([[0, 0], [1, 0], 5]) is None
     assert line([[0, 0], [1, 0]]) is None
     assert line([[0.0, 0.0]] * 65) is None  # above SMALL
+
+
+@pytest.mark.parametrize(
+    ("far", "strict"),
+    [
+        ("9007199254740992.0", False),  # 2^53: read by orjson's values
+        ("9007199254740994.0", True),  # beyond: the strict decoder reads the line
+        ("-9007199254740994.0", True),
+        ("-9007199254740992", False),
+        ("9007199254740993", True),
+    ],
+)
+def test_coordinates_beyond_2_53_take_the_strict_decoder(
+    far: str, strict: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from bayesgrasp.io._common import ReadOptions
+    from bayesgrasp.io.points import json_line_part, parse_json
+
+    used: list[str] = []
+    decoder = points_module._DECODER
+
+    class Recording:
+        def decode(self, text: str) -> object:
+            used.append(text)
+            return decoder.decode(text)
+
+    monkeypatch.setattr(points_module, "_DECODER", Recording())
+    for line in [
+        f'{{"vertices": [[0, 0], [{far}, 0], [0, 1e15]]}}',
+        f'{{"vertices": [[0.0, 0.0], [0.0, 1e15], [{far}, 5.0]]}}',
+    ]:
+        used.clear()
+        fast = _read(json_line_part, line, "b.jsonl:3")
+        assert (used == [line]) == strict
+        assert fast == _read(parse_json, line.encode(), Path("b.jsonl:3"), ReadOptions())
 
 
 # Lines of the shape the batch reads without the strict decoder, and near it: numbers of

@@ -121,19 +121,22 @@ _BAND = 1e-9
 _EXACT_INT = 2**53
 
 
-def _small_floats(points: Any, limit: float = MAX_COORDINATE) -> list[float] | None:
-    """A short plain list of ``[x, y]`` numbers as flat Python floats; ``None`` for other input.
+def _small_floats(
+    points: Any, limit: float = MAX_COORDINATE
+) -> tuple[list[float], list[float]] | None:
+    """A short plain list of ``[x, y]`` numbers as Python floats; ``None`` for any other input.
 
     The fast path of :func:`point_list_part` (at most :data:`bayesgrasp.sizes.SMALL` points):
     only lists whose every coordinate is an ``int`` or ``float``, finite and within ``limit``
     (at most :data:`MAX_COORDINATE`), so these are exactly the values ``np.asarray`` would
-    give, as ``[x0, y0, x1, y1, ...]``. Anything else (booleans, text, big integers, bad
-    shapes, non-finite values) returns ``None`` and takes the general path, which gives its
-    errors.
+    give, as the lists of the x and of the y coordinates. Anything else (booleans, text, big
+    integers, bad shapes, non-finite values) returns ``None`` and takes the general path,
+    which gives its errors.
     """
     if not isinstance(points, list) or not 3 <= len(points) <= SMALL:
         return None
-    out: list[float] = []
+    xs: list[float] = []
+    ys: list[float] = []
     for p in points:
         if type(p) is not list or len(p) != 2:
             return None
@@ -147,41 +150,40 @@ def _small_floats(points: Any, limit: float = MAX_COORDINATE) -> list[float] | N
         # abs(nan) <= M is False: NaN and infinities take the general path too.
         if not (abs(fx) <= limit and abs(fy) <= limit):
             return None
-        out += (fx, fy)
-    return out
+        xs.append(fx)
+        ys.append(fy)
+    return xs, ys
 
 
-# The types _line_floats admits: a pair's length, and a coordinate's.
-_PAIR = {2}
+# The types _line_floats admits.
 _FLOAT = {float}
 _NUMBER = {float, int}
 
 
-def _line_floats(points: Any) -> list[float] | None:
-    """:func:`_small_floats` of a value orjson read, for coordinates within 2^53.
+def _line_floats(points: Any) -> tuple[list[float], list[float]] | None:
+    """:func:`_small_floats` of a value orjson read, without its limit on the coordinates.
 
-    The same floats, or ``None``, as ``_small_floats(points, 2.0**53)``, in bulk: orjson
-    makes only dicts, lists, strings, ints, booleans, ``None`` and finite floats, so every
-    item of ``points`` with a length of 2 is a list of two, or a string or a dict whose
+    The same floats, or ``None``, as ``_small_floats(points, math.inf)``, in bulk: orjson
+    makes only dicts, lists, strings, ints, booleans, ``None`` and finite floats, so an item
+    of ``points`` that unpacks into two is a list of two, or a string or a dict whose
     characters or keys (strings) are then refused as coordinates.
     """
     if type(points) is not list or not 3 <= len(points) <= SMALL:
         return None
     try:
-        if set(map(len, points)) != _PAIR:
-            return None
-    except TypeError:  # a number, a boolean, null
+        xs = [x for x, _ in points]
+        ys = [y for _, y in points]
+    except (TypeError, ValueError):  # a number, a boolean, null; a list of another length
         return None
-    flat = [c for p in points for c in p]
-    kinds = set(map(type, flat))
+    kinds = {*map(type, xs), *map(type, ys)}
     if kinds != _FLOAT:
-        # Python compares ints and floats exactly: an int within 2^53 converts exactly.
-        if not kinds <= _NUMBER or max(map(abs, flat)) > _EXACT_INT:
+        if not kinds <= _NUMBER:
             return None
-        flat = [float(c) for c in flat]
-    if max(flat) > _FIRST_LIMIT or min(flat) < -_FIRST_LIMIT:
-        return None
-    return flat
+        if any(type(c) is int and abs(c) > _EXACT_INT for c in xs + ys):
+            return None  # (within 2^53 an int converts exactly)
+        xs = [float(c) for c in xs]
+        ys = [float(c) for c in ys]
+    return xs, ys
 
 
 def _small_ring(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -355,7 +357,9 @@ def point_list_part(
     """
     small = _small_floats(points)
     if small is not None:  # the same decisions on Python floats
-        return _small_point_list_part(path, small, name, center_of_mass, units)
+        part = _small_point_list_part(path, *small, name, center_of_mass, units)
+        if part is not None:  # (always: no limit)
+            return part
     try:
         pts = as_points(points)
     except PartError as exc:
@@ -369,24 +373,30 @@ def point_list_part(
 
 def _small_point_list_part(
     path: Path | str,
-    flat: list[float],
+    xs: list[float],
+    ys: list[float],
     name: str,
     center_of_mass: Any = None,
     units: str | None = None,
-) -> Part:
-    """:func:`point_list_part` of the points :func:`_small_floats` gave (flat).
+    limit: float = math.inf,
+) -> Part | None:
+    """:func:`point_list_part` of the coordinates :func:`_small_floats` gave.
 
-    A firmly convex ring is its own hull, taken without the hull's chains
+    ``None`` when a coordinate is beyond ``limit`` (the caller reads the points another
+    way). A firmly convex ring is its own hull, taken without the hull's chains
     (:meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`); its outline is a
     read-only view of one flat array of the points.
     """
-    xs, ys = flat[::2], flat[1::2]
     sx, sy = sorted(xs), sorted(ys)  # (cheaper than min and max)
     x0, x1, y0, y1 = sx[0], sx[-1], sy[0], sy[-1]
+    if not (-limit <= x0 and x1 <= limit and -limit <= y0 and y1 <= limit):
+        return None
     least = _firm_turn(xs, ys, x0, x1, y0, y1)
     if least:  # most files: O(N)
         hull = ConvexPolygon._of_firm_ring(xs, ys, least, x0, x1, y0, y1, DEFAULT_TOLERANCE)
         if hull is not None:
+            flat = [0.0] * (2 * len(xs))
+            flat[::2], flat[1::2] = xs, ys
             outline = np.array(flat, dtype=np.float64)
             outline.setflags(write=False)
             try:
@@ -506,13 +516,15 @@ def json_line_part(text: str, name: str) -> Part | None:
         doc = None
     if type(doc) is dict and doc.keys() <= _NAMED_POINTS:  # most lines: one look at them
         points, label = doc.get("vertices"), doc.get("name", name)
-        flat = _line_floats(points) if type(label) is str else None
-        if flat is not None:
-            # Every number of the line is a coordinate within 2^53, so the strict decoder
-            # reads the same line; _json_document_part then reads the points so.
+        small = _line_floats(points) if type(label) is str else None
+        if small is not None:
+            # Every number of the line is a coordinate; within 2^53, the strict decoder
+            # reads the same line, and _json_document_part then reads the points so.
             if "name" not in doc:
                 label = Path(name).stem
-            return _small_point_list_part(name, flat, label)
+            part = _small_point_list_part(name, *small, label, limit=_FIRST_LIMIT)
+            if part is not None:
+                return part
     try:
         doc = _DECODER.decode(text)
     except Exception:  # any failure: the general path gives its error
