@@ -1223,7 +1223,9 @@ class Part:
         center_of_mass: ArrayLike | None,
         units: str | None,
     ) -> Part:
-        """:meth:`from_points` of points whose hull is ``hull`` (``outline``: a fresh array).
+        """:meth:`from_points` of points whose hull is ``hull``.
+
+        ``outline``: a fresh array, or a view of one that no one else holds.
 
         Raises
         ------
