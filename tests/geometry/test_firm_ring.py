@@ -1,6 +1,6 @@
 """A firmly convex ring taken as its own hull (issue 12): the hull's polygon, bit for bit.
 
-``ConvexPolygon._of_firm_ring`` skips the monotone chains when ``io.points._convex_once``
+``ConvexPolygon._of_firm_ring`` skips the monotone chains when ``io.points._firm_turn``
 found the ring firmly convex; whenever it answers, its vertices, area, centroid and size
 must be those of ``ConvexPolygon._hull_of_floats`` of the same points (compared as float
 hex), and the reader's part must be ``Part.from_points``'s.
@@ -18,6 +18,9 @@ from hypothesis import strategies as st
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part
 from bayesgrasp.io import points as points_module
 from bayesgrasp.tolerance import DEFAULT_TOLERANCE, Tolerance
+from strategies import lattice_points
+
+Box = tuple[float, float, float, float]
 
 
 def _fields(poly: ConvexPolygon) -> list[str]:
@@ -25,24 +28,33 @@ def _fields(poly: ConvexPolygon) -> list[str]:
     return [v.hex() for v in (*xs, *ys, poly.area, *poly._centroid_xy(), poly.size)]
 
 
-def _ring(pts: list[tuple[float, float]]) -> tuple[list[tuple[float, float]], float]:
+def _ring(pts: list[tuple[float, float]]) -> tuple[list[float], list[float], Box, float]:
+    """The ring's coordinates, their least and largest, and ``_firm_turn`` of them."""
     small = points_module._small_floats([list(p) for p in pts])
     assert small is not None
-    ring = points_module._small_ring(small)
-    return ring, points_module._convex_once(ring, points_module._bends(ring))
+    xs, ys = small
+    box = (min(xs), max(xs), min(ys), max(ys))
+    return xs, ys, box, points_module._firm_turn(xs, ys, *box)
+
+
+def _of_firm_ring(
+    xs: list[float], ys: list[float], box: Box, least: float, tol: Tolerance = DEFAULT_TOLERANCE
+) -> ConvexPolygon | None:
+    return ConvexPolygon._of_firm_ring(xs, ys, least, *box, tol)
 
 
 def _check(pts: list[tuple[float, float]], tol: Tolerance = DEFAULT_TOLERANCE) -> bool:
     """Whether the shortcut answered; when it did, it agrees with the hull."""
-    ring, least = _ring(pts)
-    if not least or len(ring) != len(pts):
+    xs, ys, box, least = _ring(pts)
+    if not least:
         return False
-    fast = ConvexPolygon._of_firm_ring(ring, least, tol)
+    fast = _of_firm_ring(xs, ys, box, least, tol)
     if fast is None:
         return False
     arr = np.array(pts, dtype=np.float64)
     px, py = arr.T.tolist()
     assert _fields(fast) == _fields(ConvexPolygon._hull_of_floats(arr, px, py, tol))
+    assert xs == [p[0] for p in pts] and ys == [p[1] for p in pts]  # the caller's lists kept
     return True
 
 
@@ -75,6 +87,38 @@ def test_firm_ring_is_the_hull(angles, radius, offset, squash, shift, reverse, l
         _check(pts, tol)
 
 
+# Hulls of lattice points: edges along the axes, so often two points of least x (where the
+# hull starts at the lower), in every rotation and either way round, and far from the origin.
+@settings(max_examples=400, deadline=None)
+@given(
+    pts=lattice_points(min_size=3, max_size=30, bound=6),
+    shift=st.integers(0, 29),
+    reverse=st.booleans(),
+    offset=st.sampled_from([0.0, 0.5, -1e6, 1e9]),
+    swap=st.booleans(),
+)
+def test_firm_lattice_rings_are_the_hull(pts, shift, reverse, offset, swap) -> None:
+    ring = ConvexPolygon.from_points(pts).vertices.tolist()
+    if swap:  # vertical edges become horizontal ones
+        ring = [[y, x] for x, y in ring]
+    ring = [(x + offset, y - offset) for x, y in ring]
+    if reverse:
+        ring.reverse()
+    k = shift % len(ring)
+    _check(ring[k:] + ring[:k])
+
+
+@pytest.mark.parametrize("shift", range(4))
+@pytest.mark.parametrize("reverse", [False, True])
+def test_two_points_of_least_x_start_at_the_lower(shift: int, reverse: bool) -> None:
+    square = [(0.0, 1.0), (0.0, 0.0), (1.0, 0.0), (1.0, 1.0)][:: -1 if reverse else 1]
+    ring = square[shift:] + square[:shift]
+    assert _check(ring)
+    xs, ys, box, least = _ring(ring)
+    poly = _of_firm_ring(xs, ys, box, least)
+    assert poly is not None and poly.vertices.tolist()[0] == [0.0, 0.0]
+
+
 def test_the_shortcut_is_taken_for_random_convex_polygons() -> None:
     rng = np.random.default_rng(5)
     taken = 0
@@ -98,8 +142,8 @@ def test_the_shortcut_is_taken_for_random_convex_polygons() -> None:
     ],
 )
 def test_refused_where_the_hull_may_differ(pts, why) -> None:
-    ring, least = _ring(pts)
-    answer = ConvexPolygon._of_firm_ring(ring, least, DEFAULT_TOLERANCE) if least else None
+    xs, ys, box, least = _ring(pts)
+    answer = _of_firm_ring(xs, ys, box, least) if least else None
     assert (answer is None) == (why is not None)
     if answer is not None:
         assert _check(pts)
@@ -107,11 +151,11 @@ def test_refused_where_the_hull_may_differ(pts, why) -> None:
 
 def test_least_cross_must_be_the_rings_own() -> None:
     """A least turn below the margin or of the wrong sign is refused, not trusted."""
-    ring, least = _ring([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)])
+    xs, ys, box, least = _ring([(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)])
     assert least > 0
-    assert ConvexPolygon._of_firm_ring(ring, 1e-14, DEFAULT_TOLERANCE) is None
-    assert ConvexPolygon._of_firm_ring(ring, -least, DEFAULT_TOLERANCE) is None  # clockwise?
-    assert ConvexPolygon._of_firm_ring(ring, least, DEFAULT_TOLERANCE) is not None
+    assert _of_firm_ring(xs, ys, box, 1e-14) is None
+    assert _of_firm_ring(xs, ys, box, -least) is None  # clockwise?
+    assert _of_firm_ring(xs, ys, box, least) is not None
 
 
 def test_reader_part_is_from_points_part() -> None:
@@ -125,3 +169,4 @@ def test_reader_part_is_from_points_part() -> None:
         assert got.outline.tolist() == want.outline.tolist()
         assert got.center_of_mass.tolist() == want.center_of_mass.tolist()
         assert not got.outline.flags.writeable
+        assert got.outline.base is None or not got.outline.base.flags.writeable

@@ -7,9 +7,11 @@ for at most ``sizes.SMALL`` points; forcing the general path (``_small_floats`` 
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
+import orjson
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -85,11 +87,10 @@ def test_adversarial_inputs_agree(pts: list[list[object]], monkeypatch: pytest.M
 
 
 def test_fast_path_taken_for_small_lists() -> None:
-    assert points_module._small_floats([[0, 0], [1, 0], [0, 1]]) == [
-        (0.0, 0.0),
-        (1.0, 0.0),
-        (0.0, 1.0),
-    ]
+    assert points_module._small_floats([[0, 0], [1, 0], [0, 1]]) == (
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+    )
     assert points_module._small_floats([[0, 0], [1, 0], [0, True]]) is None
     assert points_module._small_floats(np.zeros((3, 2)).tolist() * 30) is None  # above SMALL
 
@@ -141,11 +142,34 @@ def _decisions(pts: list[list[float]]) -> tuple[bool, bool | None, bool]:
     """(firmly convex, simple, convex) of the plain-Python tests, on the cleaned ring."""
     small = points_module._small_floats(pts)
     assert small is not None
-    ring = points_module._small_ring(small)
+    ring = points_module._small_ring(list(zip(*small, strict=True)))
     turns = points_module._turns(ring)
     simple = points_module._small_is_simple(ring, turns)
     convex = points_module._small_is_convex(ring, turns) if simple else None
-    return points_module._convex_once(ring, turns), simple, bool(convex)
+    return bool(_firm_turn(ring)), simple, bool(convex)
+
+
+def _firm_turn(ring: list[tuple[float, float]]) -> float:
+    xs, ys = [p[0] for p in ring], [p[1] for p in ring]
+    return points_module._firm_turn(xs, ys, min(xs), max(xs), min(ys), max(ys))
+
+
+def _firm_turn_by_angles(ring: list[tuple[float, float]]) -> float:
+    """The reference: the winding summed from each vertex's turning angle (the former test)."""
+    n = len(ring)
+    turns = []
+    for i in range(n):
+        (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
+        ux, uy, wx, wy = bx - ax, by - ay, cx - bx, cy - by
+        turns.append((ux * wy - uy * wx, ux * wx + uy * wy))
+    xs, ys = [p[0] for p in ring], [p[1] for p in ring]
+    firm = points_module._FIRM * ((max(xs) - min(xs)) ** 2 + (max(ys) - min(ys)) ** 2)
+    low, high = min(t[0] for t in turns), max(t[0] for t in turns)
+    least = low if low > firm else high if high < -firm else 0.0
+    if not least:
+        return 0.0
+    winding = sum(math.atan2(abs(c), d) for c, d in turns)
+    return least if winding < 3 * math.pi else 0.0
 
 
 @pytest.mark.parametrize(
@@ -199,7 +223,8 @@ def test_firm_convexity_against_the_pair_test(
     pts_list = (pts[::-1] if reverse else pts).tolist()
     if points_module._small_floats(pts_list) is None:
         return
-    if len(points_module._small_ring(points_module._small_floats(pts_list) or [])) < 3:
+    small = points_module._small_floats(pts_list) or ([], [])
+    if len(points_module._small_ring(list(zip(*small, strict=True)))) < 3:
         return
     firm, simple, convex = _decisions(pts_list)
     if firm:
@@ -207,6 +232,160 @@ def test_firm_convexity_against_the_pair_test(
     with pytest.MonkeyPatch.context() as mp:
         fast, general = _both(pts_list, mp)
     assert fast == general
+
+
+# Rings that wind 1 to 4 times, turning either way, with tiny turns, far from the origin, or
+# not turning one way at all (random points): the count of upward crossings against the sum
+# of turning angles.
+@settings(max_examples=500, deadline=None)
+@given(
+    angles=st.lists(st.floats(0.0, 2 * np.pi, exclude_max=True), min_size=3, max_size=40),
+    radius=st.sampled_from([1e-6, 1.0, 1e6]),
+    offset=st.sampled_from([0.0, 1.0, 1e8, -1e12]),
+    squash=st.sampled_from([1.0, 1e-6, 1e-12]),
+    step=st.integers(1, 4),
+    reverse=st.booleans(),
+    swap=st.booleans(),
+    sort=st.booleans(),
+)
+def test_winding_counted_as_summed(
+    angles: list[float],
+    radius: float,
+    offset: float,
+    squash: float,
+    step: int,
+    reverse: bool,
+    swap: bool,
+    sort: bool,
+) -> None:
+    t = np.sort(np.asarray(angles)) if sort else np.asarray(angles)
+    order = np.concatenate([np.arange(k, len(t), step) for k in range(step)])
+    x, y = offset + radius * np.cos(t[order]), squash * radius * np.sin(t[order])
+    pts = np.column_stack([y, x] if swap else [x, y])
+    ring = [(float(a), float(b)) for a, b in (pts[::-1] if reverse else pts)]
+    got = _firm_turn(ring)
+    assert got == _firm_turn_by_angles(ring)
+    if got:
+        assert math.copysign(1.0, got) == (1.0 if _shoelace(ring) > 0 else -1.0)
+
+
+def _shoelace(ring: list[tuple[float, float]]) -> float:
+    """Twice the signed area, about the first point (no cancellation far from the origin)."""
+    ox, oy = ring[0]
+    p = [(x - ox, y - oy) for x, y in ring]
+    return sum(ax * by - bx * ay for (ax, ay), (bx, by) in zip(p, p[1:] + p[:1], strict=True))
+
+
+@pytest.mark.parametrize(
+    "ring",
+    [
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)],  # edges along the axes
+        [(0.0, 1.0), (0.0, 0.0), (1.0, 0.0)],
+        [(1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.0, 0.0)][::-1],
+        [tuple(p) for p in _star(5, 2).tolist()],  # winds twice
+        [tuple(p) for p in _star(9, 4).tolist()],  # winds four times
+        [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (1.0, 0.5), (0.0, 2.0)],  # turns both ways
+    ],
+)
+def test_winding_counted_on_axis_edges_and_stars(ring: list[tuple[float, float]]) -> None:
+    for k in range(len(ring)):
+        turned = ring[k:] + ring[:k]
+        assert _firm_turn(turned) == _firm_turn_by_angles(turned)
+        swapped = [(b, a) for a, b in turned]
+        assert _firm_turn(swapped) == _firm_turn_by_angles(swapped)
+
+
+# JSON values as orjson reads them: every leaf type, pairs that are strings or objects of
+# two, big and exact-limit integers and floats, nesting.
+_leaf = st.one_of(
+    st.floats(allow_nan=False, allow_infinity=False),
+    st.floats(-1e3, 1e3),
+    st.integers(-(2**53) - 2, 2**53 + 2),
+    st.sampled_from([2**53, -(2**53), 2**53 + 1, 2**63, -(2**63), 2**64 - 1]),
+    st.sampled_from([2.0**53, -(2.0**53), 2.0**53 + 2, 1e300, -0.0, 5e-324]),
+    st.booleans(),
+    st.none(),
+    st.text(max_size=2),
+)
+_number = st.one_of(st.floats(-1e17, 1e17), st.integers(-(2**54), 2**54))
+_item = st.one_of(
+    st.lists(_number, min_size=2, max_size=2),
+    st.lists(_number, min_size=2, max_size=2),
+    st.lists(_leaf, min_size=2, max_size=2),
+    st.lists(_leaf, max_size=3),
+    st.dictionaries(st.text(max_size=2), _leaf, min_size=2, max_size=2),
+    st.text(min_size=2, max_size=2),
+    _leaf,
+)
+
+
+@settings(max_examples=500, deadline=None)
+@given(points=st.one_of(st.lists(_item, max_size=70), _leaf))
+def test_line_floats_are_the_small_floats(points: object) -> None:
+    read = orjson.loads(orjson.dumps(points))
+    assert points_module._line_floats(read) == points_module._small_floats(read, math.inf)
+
+
+def test_orjson_reads_only_finite_floats() -> None:
+    """What _line_floats relies on: orjson refuses what would be a NaN or an infinity."""
+    for text in ["[NaN]", "[Infinity]", "[-Infinity]", "[1e400]", "[-1e999]"]:
+        with pytest.raises(orjson.JSONDecodeError, match=r"."):
+            orjson.loads(text)
+    assert orjson.loads("[1e-400, 18446744073709551616]") == [0.0, 2.0**64]
+
+
+def test_line_floats_cases() -> None:
+    line = points_module._line_floats
+    assert line([[0, 0], [1, 0.5], [0, 1]]) == ([0.0, 1.0, 0.0], [0.0, 0.5, 1.0])
+    assert line([[0, 0], [1, 0], [0, 2**53]]) == ([0.0, 1.0, 0.0], [0.0, 0.0, 2.0**53])
+    assert line([[0, 0], [1, 0], [0, 2**53 + 1]]) is None  # would round to 2^53
+    assert line([[0, 0], [1, 0], [-(2**53) - 1, 0]]) is None
+    big = 2.0**53 + 2  # a float: the limit is the caller's
+    assert line([[0, 0], [1, 0], [0, big]]) == ([0.0, 1.0, 0.0], [0.0, 0.0, big])
+    assert line([[0.0, 0.0], [1.0, 0.0], [0.0, 1e300]]) == ([0.0, 1.0, 0.0], [0.0, 0.0, 1e300])
+    assert line([[0, 0], [1, 0], "ab"]) is None
+    assert line([[0, 0], [1, 0], {"a": 1, "b": 2}]) is None
+    assert line([[0, 0], [1, 0], [0, True]]) is None
+    assert line([[0, 0], [1, 0], [0, 1, 2]]) is None
+    assert line([[0, 0], [1, 0], [0]]) is None
+    assert line([[0, 0], [1, 0], 5]) is None
+    assert line([[0, 0], [1, 0]]) is None
+    assert line([[0.0, 0.0]] * 65) is None  # above SMALL
+
+
+@pytest.mark.parametrize(
+    ("far", "strict"),
+    [
+        ("9007199254740992.0", False),  # 2^53: read by orjson's values
+        ("9007199254740994.0", True),  # beyond: the strict decoder reads the line
+        ("-9007199254740994.0", True),
+        ("-9007199254740992", False),
+        ("9007199254740993", True),
+    ],
+)
+def test_coordinates_beyond_2_53_take_the_strict_decoder(
+    far: str, strict: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from bayesgrasp.io._common import ReadOptions
+    from bayesgrasp.io.points import json_line_part, parse_json
+
+    used: list[str] = []
+    decoder = points_module._DECODER
+
+    class Recording:
+        def decode(self, text: str) -> object:
+            used.append(text)
+            return decoder.decode(text)
+
+    monkeypatch.setattr(points_module, "_DECODER", Recording())
+    for line in [
+        f'{{"vertices": [[0, 0], [{far}, 0], [0, 1e15]]}}',
+        f'{{"vertices": [[0.0, 0.0], [0.0, 1e15], [{far}, 5.0]]}}',
+    ]:
+        used.clear()
+        fast = _read(json_line_part, line, "b.jsonl:3")
+        assert (used == [line]) == strict
+        assert fast == _read(parse_json, line.encode(), Path("b.jsonl:3"), ReadOptions())
 
 
 # Lines of the shape the batch reads without the strict decoder, and near it: numbers of

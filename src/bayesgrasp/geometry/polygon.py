@@ -832,15 +832,25 @@ class ConvexPolygon:
 
     @classmethod
     def _of_firm_ring(
-        cls, ring: list[tuple[float, float]], least: float, tol: Tolerance
+        cls,
+        xs: list[float],
+        ys: list[float],
+        least: float,
+        x0: float,
+        x1: float,
+        y0: float,
+        y1: float,
+        tol: Tolerance,
     ) -> ConvexPolygon | None:
         """:meth:`_hull_of_floats` of a ring's points, when the ring is already their hull.
 
-        ``ring``: at most :data:`_SMALL` finite points in order round a polygon that turns
-        the same way at every vertex and winds once (``io.points._convex_once``); ``least``:
-        the cross product ``(b - a) x (c - b)`` of least magnitude over its vertices,
-        positive if the ring runs counter-clockwise. ``None`` when this cannot promise the
-        same polygon: the caller then takes the hull.
+        ``xs``, ``ys``: at most :data:`_SMALL` finite points in order round a polygon that
+        turns the same way at every vertex and winds once (``io.points._firm_turn``), and
+        ``x0, x1, y0, y1`` their least and largest; ``least``: the cross product
+        ``(b - a) x (c - b)`` of least magnitude over its vertices, positive if the ring runs
+        counter-clockwise. ``None`` when this cannot promise the same polygon: the caller
+        then takes the hull. The polygon may keep ``xs`` and ``ys`` as its own (never
+        changed): the caller hands them over.
 
         Why it is the same polygon, to the last bit: with ``D`` the bounding box's diagonal
         and ``u`` the unit roundoff, a computed orientation of three of the points (the
@@ -854,28 +864,65 @@ class ConvexPolygon:
         one, counter-clockwise from the lexicographically least. And when ``|least|`` is
         also above twice the chains' bound ``2 eps extent`` of :func:`_hull_small`, no vertex
         is within ``eps`` of its neighbours' chord, so the near-collinear test drops none,
-        and :func:`_measure` of that order gives the same area, centroid and size as either
-        path of :func:`_hull_small`. Points met twice, odd magnitudes and degenerate areas
-        go to the hull, which words the refusals.
+        and :func:`_measure`'s sums in that order give the same area, centroid and size as
+        either path of :func:`_hull_small`. Odd magnitudes and degenerate areas go to the
+        hull, which words the refusals.
         """
-        ys = [p[1] for p in ring]
-        start, top = min(ring), max(ring)  # the lexicographically least and largest
-        x0, x1, y0, y1 = start[0], top[0], min(ys), max(ys)
-        extent = max(x1 - x0, y1 - y0)
+        # _hull_of_floats's tests and _hull_small's bound, inline (the same operations).
+        w, h = x1 - x0, y1 - y0
+        extent = w if w >= h else h  # max(w, h)
         if _odd_magnitude(x0, x1, y0, y1, extent):
             return None
-        eps = tol.length_for(extent)
+        eps = tol.length * extent  # tol.length_for(extent)
         bound = 2.0 * eps * extent
-        firm = _RING_FIRM * ((x1 - x0) ** 2 + (y1 - y0) ** 2)
-        if not (bound >= _TINY and abs(least) > 2.0 * bound and abs(least) > firm):
+        margin = abs(least)
+        if not (bound >= _TINY and margin > 2.0 * bound and margin > _RING_FIRM * (w**2 + h**2)):
             return None
-        turn = ring if least > 0 else ring[::-1]
-        i = turn.index(start)
-        hull = turn[i:] + turn[:i]
-        measured = _measure(hull, hull.index(top), y0, y1)
-        if measured is None or not measured[2] > eps * extent:
+        if least < 0:
+            xs, ys = xs[::-1], ys[::-1]
+        # The lexicographically least point starts the hull: the first of least x, or the
+        # other point of least x if lower (a convex polygon has at most two, one after the
+        # other: after the first, or last in the list when the first is first).
+        i = xs.index(x0)
+        n = len(xs)
+        if i + 1 < n and xs[i + 1] == x0:
+            if ys[i + 1] < ys[i]:
+                i += 1
+        elif i == 0 and xs[-1] == x0 and ys[-1] < ys[0]:
+            i = n - 1
+        if i:  # (else the lists are kept: the caller hands them over)
+            xs, ys = xs[i:] + xs[:i], ys[i:] + ys[:i]
+        # _measure's sums, in its order (the ring holds the least and largest y, and the
+        # largest x is the x of its lexicographically largest point).
+        ox, oy = xs[0], ys[0]
+        scale = x1 - ox  # max(x1 - ox, y1 - oy, oy - y0)
+        if y1 - oy > scale:
+            scale = y1 - oy
+        if oy - y0 > scale:
+            scale = oy - y0
+        twice = cx = cy = qx = qy = 0.0
+        for bx, by in zip(xs[1:], ys[1:]):  # noqa: B905
+            rx = (bx - ox) / scale
+            ry = (by - oy) / scale
+            c = qx * ry - rx * qy
+            twice += c
+            cx += (qx + rx) * c
+            cy += (qy + ry) * c
+            qx = rx
+            qy = ry
+        c = qx * 0.0 - 0.0 * qy  # the edge back to the first vertex, at (0, 0)
+        twice += c
+        cx += (qx + 0.0) * c
+        cy += (qy + 0.0) * c
+        if twice == 0.0:
             return None
-        return cls._of_floats(*measured[:2], tol, *measured[2:])
+        unit = scale / (3.0 * twice)
+        cx = cx * unit + ox
+        cy = cy * unit + oy
+        area = 0.5 * twice * scale * scale
+        if not area > eps * extent:
+            return None
+        return cls._of_floats(xs, ys, tol, area, cx, cy, _size(zip(xs, ys), cx, cy))  # noqa: B905
 
     @property
     def n_sides(self) -> int:
@@ -1197,7 +1244,9 @@ class Part:
         center_of_mass: ArrayLike | None,
         units: str | None,
     ) -> Part:
-        """:meth:`from_points` of points whose hull is ``hull`` (``outline``: a fresh array).
+        """:meth:`from_points` of points whose hull is ``hull``.
+
+        ``outline``: a fresh array, or a view of one that no one else holds.
 
         Raises
         ------

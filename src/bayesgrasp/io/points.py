@@ -27,7 +27,6 @@ import dataclasses
 import json
 import math
 import numbers
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -122,18 +121,22 @@ _BAND = 1e-9
 _EXACT_INT = 2**53
 
 
-def _small_floats(points: Any, limit: float = MAX_COORDINATE) -> list[tuple[float, float]] | None:
+def _small_floats(
+    points: Any, limit: float = MAX_COORDINATE
+) -> tuple[list[float], list[float]] | None:
     """A short plain list of ``[x, y]`` numbers as Python floats; ``None`` for any other input.
 
     The fast path of :func:`point_list_part` (at most :data:`bayesgrasp.sizes.SMALL` points):
     only lists whose every coordinate is an ``int`` or ``float``, finite and within ``limit``
     (at most :data:`MAX_COORDINATE`), so these are exactly the values ``np.asarray`` would
-    give. Anything else (booleans, text, big integers, bad shapes, non-finite values) returns
-    ``None`` and takes the general path, which gives its errors.
+    give, as the lists of the x and of the y coordinates. Anything else (booleans, text, big
+    integers, bad shapes, non-finite values) returns ``None`` and takes the general path,
+    which gives its errors.
     """
     if not isinstance(points, list) or not 3 <= len(points) <= SMALL:
         return None
-    out: list[tuple[float, float]] = []
+    xs: list[float] = []
+    ys: list[float] = []
     for p in points:
         if type(p) is not list or len(p) != 2:
             return None
@@ -147,8 +150,40 @@ def _small_floats(points: Any, limit: float = MAX_COORDINATE) -> list[tuple[floa
         # abs(nan) <= M is False: NaN and infinities take the general path too.
         if not (abs(fx) <= limit and abs(fy) <= limit):
             return None
-        out.append((fx, fy))
-    return out
+        xs.append(fx)
+        ys.append(fy)
+    return xs, ys
+
+
+# The types _line_floats admits.
+_FLOAT = {float}
+_NUMBER = {float, int}
+
+
+def _line_floats(points: Any) -> tuple[list[float], list[float]] | None:
+    """:func:`_small_floats` of a value orjson read, without its limit on the coordinates.
+
+    The same floats, or ``None``, as ``_small_floats(points, math.inf)``, in bulk: orjson
+    makes only dicts, lists, strings, ints, booleans, ``None`` and finite floats, so an item
+    of ``points`` that unpacks into two is a list of two, or a string or a dict whose
+    characters or keys (strings) are then refused as coordinates.
+    """
+    if type(points) is not list or not 3 <= len(points) <= SMALL:
+        return None
+    try:
+        xs = [x for x, _ in points]
+        ys = [y for _, y in points]
+    except (TypeError, ValueError):  # a number, a boolean, null; a list of another length
+        return None
+    kinds = {*map(type, xs), *map(type, ys)}
+    if kinds != _FLOAT:
+        if not kinds <= _NUMBER:
+            return None
+        if any(type(c) is int and abs(c) > _EXACT_INT for c in xs + ys):
+            return None  # (within 2^53 an int converts exactly)
+        xs = [float(c) for c in xs]
+        ys = [float(c) for c in ys]
+    return xs, ys
 
 
 def _small_ring(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
@@ -168,17 +203,6 @@ def _turns(ring: list[tuple[float, float]]) -> list[tuple[float, float, float]]:
         (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
         ux, uy, wx, wy = bx - ax, by - ay, cx - bx, cy - by
         out.append((ux * wy - uy * wx, ux * wx + uy * wy, math.hypot(ux, uy) * math.hypot(wx, wy)))
-    return out
-
-
-def _bends(ring: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    """(cross, dot) at each vertex of the ring: :func:`_turns` without the edge lengths."""
-    n = len(ring)
-    out = []
-    for i in range(n):
-        (ax, ay), (bx, by), (cx, cy) = ring[i - 1], ring[i], ring[(i + 1) % n]
-        ux, uy, wx, wy = bx - ax, by - ay, cx - bx, cy - by
-        out.append((ux * wy - uy * wx, ux * wx + uy * wy))
     return out
 
 
@@ -240,19 +264,22 @@ def _small_is_convex(
 
 
 # A turn whose cross product exceeds this fraction of the squared bounding-box diagonal is
-# far beyond every threshold and rounding error of the tests below (see _convex_once).
+# far beyond every threshold and rounding error of the tests below (see _firm_turn).
 _FIRM = 2e-12
 
 
-def _convex_once(ring: list[tuple[float, float]], turns: Sequence[tuple[float, ...]]) -> float:
+def _firm_turn(
+    xs: list[float], ys: list[float], x0: float, x1: float, y0: float, y1: float
+) -> float:
     """Whether the ring is firmly convex: every turn one way, by a margin, winding once.
 
-    Then :func:`_small_is_simple` and :func:`_small_is_convex` both return True, found in
-    O(N) rather than their O(N^2) pairs of edges. Returns the cross product of least
-    magnitude (positive: the ring runs counter-clockwise), for
-    :meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`; ``0.0`` means only
-    "not shown here". ``turns``: the (cross, dot, ...) of :func:`_bends` or :func:`_turns`
-    at each vertex.
+    ``xs`` and ``ys``: the ring's coordinates (a point repeated next to itself makes a turn
+    of 0: not firm); ``x0, x1, y0, y1``: their least and largest. Then
+    :func:`_small_is_simple` and :func:`_small_is_convex` both return True, found in O(N)
+    rather than their O(N^2) pairs of edges. Returns the cross product ``u x w`` (``u`` the
+    incoming, ``w`` the outgoing edge) of least magnitude (positive: the ring runs
+    counter-clockwise), for :meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`;
+    ``0.0`` means only "not shown here".
 
     Why: a ring that turns one way at every vertex and once in all (exterior angles in
     (0, pi) summing to 2 pi) is a convex polygon. Every vertex R off an edge PQ then lies at
@@ -265,17 +292,36 @@ def _convex_once(ring: list[tuple[float, float]], turns: Sequence[tuple[float, .
     crossing test computes strictly on one side, and it is also above twice the fold-back and
     convexity thresholds (``_STRAIGHT * |u| |w|``, with ``|u| |w| <= D^2``), outside their
     bands.
+
+    Winding once, counted exactly: each computed cross product is within ``2 u |u| |w|`` of
+    the exact one of the computed edges, so when all are beyond ``_FIRM * D^2`` the edges'
+    direction turns the same way at every vertex, by an angle strictly between 0 and pi.
+    Turning so, it reaches the direction pi/2 (or -pi/2, turning clockwise) once in each
+    revolution, and there only: at the vertices where the edges' x component goes from
+    positive to not positive. One such vertex: one revolution (the sum of the exterior
+    angles, 2 pi, where a star has 4 pi or more).
     """
-    xs = [p[0] for p in ring]
-    ys = [p[1] for p in ring]
-    firm = _FIRM * ((max(xs) - min(xs)) ** 2 + (max(ys) - min(ys)) ** 2)
-    crosses = [t[0] for t in turns]
-    low, high = min(crosses), max(crosses)
-    least = low if low > firm else high if high < -firm else 0.0
-    if not least:
+    firm = _FIRM * ((x1 - x0) ** 2 + (y1 - y0) ** 2)
+    bx, by = xs[-1], ys[-1]
+    ux, uy = bx - xs[-2], by - ys[-2]  # the edge into the first point
+    crosses: list[float] = []
+    push = crosses.append
+    ups = 0
+    for cx, cy in zip(xs, ys):  # noqa: B905
+        wx = cx - bx
+        wy = cy - by
+        push(ux * wy - uy * wx)
+        if ux > 0.0 >= wx:
+            ups += 1
+        ux = wx
+        uy = wy
+        bx = cx
+        by = cy
+    if ups != 1:
         return 0.0
-    winding = sum([math.atan2(abs(t[0]), t[1]) for t in turns])
-    return least if winding < 3 * math.pi else 0.0  # 2 pi once, 4 pi or more for a star
+    crosses.sort()
+    low, high = crosses[0], crosses[-1]
+    return low if low > firm else high if high < -firm else 0.0
 
 
 def point_list_part(
@@ -311,7 +357,9 @@ def point_list_part(
     """
     small = _small_floats(points)
     if small is not None:  # the same decisions on Python floats
-        return _small_point_list_part(path, small, name, center_of_mass, units)
+        part = _small_point_list_part(path, *small, name, center_of_mass, units)
+        if part is not None:  # (always: no limit)
+            return part
     try:
         pts = as_points(points)
     except PartError as exc:
@@ -325,27 +373,42 @@ def point_list_part(
 
 def _small_point_list_part(
     path: Path | str,
-    small: list[tuple[float, float]],
+    xs: list[float],
+    ys: list[float],
     name: str,
     center_of_mass: Any = None,
     units: str | None = None,
-) -> Part:
-    """:func:`point_list_part` of the points :func:`_small_floats` gave.
+    limit: float = math.inf,
+) -> Part | None:
+    """:func:`point_list_part` of the coordinates :func:`_small_floats` gave.
 
-    A firmly convex ring with no point repeated is its own hull, taken without the hull's
-    chains (:meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`).
+    ``None`` when a coordinate is beyond ``limit`` (the caller reads the points another
+    way). A firmly convex ring is its own hull, taken without the hull's chains
+    (:meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`); its outline is a
+    read-only view of one flat array of the points.
     """
+    sx, sy = sorted(xs), sorted(ys)  # (cheaper than min and max)
+    x0, x1, y0, y1 = sx[0], sx[-1], sy[0], sy[-1]
+    if not (-limit <= x0 and x1 <= limit and -limit <= y0 and y1 <= limit):
+        return None
+    least = _firm_turn(xs, ys, x0, x1, y0, y1)
+    if least:  # most files: O(N)
+        hull = ConvexPolygon._of_firm_ring(xs, ys, least, x0, x1, y0, y1, DEFAULT_TOLERANCE)
+        if hull is not None:
+            flat = [0.0] * (2 * len(xs))
+            flat[::2], flat[1::2] = xs, ys
+            outline = np.array(flat, dtype=np.float64)
+            outline.setflags(write=False)
+            try:
+                return Part._of_hull(hull, outline.reshape(-1, 2), name, center_of_mass, units)
+            except PartError as exc:
+                raise fail(Path(path), str(exc)) from None
+    small = list(zip(xs, ys, strict=True))
     pts = np.array(small, dtype=np.float64)
     sring = _small_ring(small)
-    least = _convex_once(sring, _bends(sring)) if len(sring) >= 3 else 0.0
-    if least:  # most files: O(N)
-        if len(sring) == len(small):
-            hull = ConvexPolygon._of_firm_ring(sring, least, DEFAULT_TOLERANCE)
-            if hull is not None:
-                try:
-                    return Part._of_hull(hull, pts, name, center_of_mass, units)
-                except PartError as exc:
-                    raise fail(Path(path), str(exc)) from None
+    if not least and 3 <= len(sring) < len(small):  # points repeated: firm without them?
+        least = _firm_turn([p[0] for p in sring], [p[1] for p in sring], x0, x1, y0, y1)
+    if least:
         simple, concave = True, False
     else:
         turns = _turns(sring) if len(sring) >= 3 else []
@@ -453,13 +516,15 @@ def json_line_part(text: str, name: str) -> Part | None:
         doc = None
     if type(doc) is dict and doc.keys() <= _NAMED_POINTS:  # most lines: one look at them
         points, label = doc.get("vertices"), doc.get("name", name)
-        small = _small_floats(points, _FIRST_LIMIT) if type(label) is str else None
+        small = _line_floats(points) if type(label) is str else None
         if small is not None:
-            # Every number of the line is a coordinate within 2^53, so the strict decoder
-            # reads the same line; _json_document_part then reads the points so.
+            # Every number of the line is a coordinate; within 2^53, the strict decoder
+            # reads the same line, and _json_document_part then reads the points so.
             if "name" not in doc:
                 label = Path(name).stem
-            return _small_point_list_part(name, small, label)
+            part = _small_point_list_part(name, *small, label, limit=_FIRST_LIMIT)
+            if part is not None:
+                return part
     try:
         doc = _DECODER.decode(text)
     except Exception:  # any failure: the general path gives its error
