@@ -353,6 +353,20 @@ def test_line_floats_cases() -> None:
     assert line([[0.0, 0.0]] * 65) is None  # above SMALL
 
 
+def _record_strict_decodes(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The lines the strict decoder reads from now on (it still decodes them)."""
+    used: list[str] = []
+    strict = points_module._DECODER
+
+    class Recording:
+        def decode(self, text: str) -> object:
+            used.append(text)
+            return strict.decode(text)
+
+    monkeypatch.setattr(points_module, "_DECODER", Recording())
+    return used
+
+
 @pytest.mark.parametrize(
     ("far", "strict"),
     [
@@ -369,15 +383,7 @@ def test_coordinates_beyond_2_53_take_the_strict_decoder(
     from bayesgrasp.io._common import ReadOptions
     from bayesgrasp.io.points import json_line_part, parse_json
 
-    used: list[str] = []
-    decoder = points_module._DECODER
-
-    class Recording:
-        def decode(self, text: str) -> object:
-            used.append(text)
-            return decoder.decode(text)
-
-    monkeypatch.setattr(points_module, "_DECODER", Recording())
+    used = _record_strict_decodes(monkeypatch)
     for line in [
         f'{{"vertices": [[0, 0], [{far}, 0], [0, 1e15]]}}',
         f'{{"vertices": [[0.0, 0.0], [0.0, 1e15], [{far}, 5.0]]}}',
@@ -440,15 +446,7 @@ def test_simple_lines_skip_the_strict_decoder(monkeypatch: pytest.MonkeyPatch) -
     """The comparison above sees the C-number path: simple lines never reach _DECODER."""
     from bayesgrasp.io.points import json_line_part
 
-    used: list[str] = []
-    strict = points_module._DECODER
-
-    class Recording:
-        def decode(self, text: str) -> object:
-            used.append(text)
-            return strict.decode(text)
-
-    monkeypatch.setattr(points_module, "_DECODER", Recording())
+    used = _record_strict_decodes(monkeypatch)
     part = json_line_part('{"name": "w", "vertices": [[0, 0], [3, 0.5], [0, 1]]}', "b.jsonl:1")
     assert part is not None and part.name == "w"
     assert json_line_part('{"vertices": [[0, 0], [3, 0], [0, 1]]}', "b.jsonl:2").name == "b"

@@ -429,11 +429,27 @@ def _measure(
     """
     ox, oy = hull[0]
     scale = max(hull[last][0] - ox, y1 - oy, oy - y0)
-    xs, ys = [ox], [oy]
+    xs, ys = [p[0] for p in hull], [p[1] for p in hull]
+    twice, cx, cy = _area_sums(hull[1:], ox, oy, scale)
+    if not (twice != 0.0 and y0 in ys and y1 in ys and 0.0 < scale < math.inf):
+        return None
+    unit = scale / (3.0 * twice)
+    cx = cx * unit + ox
+    cy = cy * unit + oy
+    return xs, ys, 0.5 * twice * scale * scale, cx, cy, _size(hull, cx, cy)
+
+
+def _area_sums(
+    rest: Iterable[tuple[float, float]], ox: float, oy: float, scale: float
+) -> tuple[float, float, float]:
+    """Twice the area and the centroid's sums of the ring ``(ox, oy), *rest``.
+
+    :func:`_drop_and_measure`'s sums, in its order, about the first vertex in units of
+    ``scale`` (the first vertex at (0, 0)): the centroid is ``(cx, cy) * scale / (3 * twice)
+    + (ox, oy)``.
+    """
     twice = cx = cy = qx = qy = 0.0
-    for bx, by in hull[1:]:
-        xs.append(bx)
-        ys.append(by)
+    for bx, by in rest:
         rx = (bx - ox) / scale
         ry = (by - oy) / scale
         c = qx * ry - rx * qy
@@ -443,15 +459,7 @@ def _measure(
         qx = rx
         qy = ry
     c = qx * 0.0 - 0.0 * qy  # the edge back to the first vertex, at (0, 0)
-    twice += c
-    cx += (qx + 0.0) * c
-    cy += (qy + 0.0) * c
-    if not (twice != 0.0 and y0 in ys and y1 in ys and 0.0 < scale < math.inf):
-        return None
-    unit = scale / (3.0 * twice)
-    cx = cx * unit + ox
-    cy = cy * unit + oy
-    return xs, ys, 0.5 * twice * scale * scale, cx, cy, _size(hull, cx, cy)
+    return twice + c, cx + (qx + 0.0) * c, cy + (qy + 0.0) * c
 
 
 def _odd_magnitude(x0: float, x1: float, y0: float, y1: float, extent: float) -> bool:
@@ -900,20 +908,7 @@ class ConvexPolygon:
             scale = y1 - oy
         if oy - y0 > scale:
             scale = oy - y0
-        twice = cx = cy = qx = qy = 0.0
-        for bx, by in zip(xs[1:], ys[1:]):  # noqa: B905
-            rx = (bx - ox) / scale
-            ry = (by - oy) / scale
-            c = qx * ry - rx * qy
-            twice += c
-            cx += (qx + rx) * c
-            cy += (qy + ry) * c
-            qx = rx
-            qy = ry
-        c = qx * 0.0 - 0.0 * qy  # the edge back to the first vertex, at (0, 0)
-        twice += c
-        cx += (qx + 0.0) * c
-        cy += (qy + 0.0) * c
+        twice, cx, cy = _area_sums(zip(xs[1:], ys[1:]), ox, oy, scale)  # noqa: B905
         if twice == 0.0:
             return None
         unit = scale / (3.0 * twice)
