@@ -12,15 +12,26 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import pytest
 
-from snapshots.generate import ROOT, SNAPSHOT, VOLATILE_KEYS, drop_volatile, run_cli
+from snapshots.generate import (
+    MORE,
+    ROOT,
+    SNAPSHOT,
+    VOLATILE_KEYS,
+    drop_volatile,
+    numbers,
+    run_cli,
+    run_more,
+)
 
 REL = ABS = 1e-9
 
 ENTRIES: list[dict[str, Any]] = json.loads(SNAPSHOT.read_text(encoding="utf-8"))
+MORE_ENTRIES: list[dict[str, Any]] = json.loads(MORE.read_text(encoding="utf-8"))
 
 
 def _kind(x: Any) -> str:
@@ -75,6 +86,28 @@ def test_cli_json_unchanged(entry: dict[str, Any], monkeypatch: pytest.MonkeyPat
     assert code == entry["exit_code"]
     diff = first_difference(entry["json"], doc)
     assert diff is None, diff
+
+
+@pytest.mark.parametrize("entry", MORE_ENTRIES, ids=[" ".join(e["argv"]) for e in MORE_ENTRIES])
+def test_cli_more_unchanged(
+    entry: dict[str, Any], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """Sensing, noise, payoff, several parts, batch, tables and robot files as they were."""
+    monkeypatch.chdir(ROOT)
+    got = run_more(entry, tmp_path)
+    assert got["exit_code"] == entry["exit_code"]
+    for key in ("json", "jsonl", "numbers", "files"):
+        if key in entry:
+            diff = first_difference(entry[key], got.get(key), f"$.{key}")
+            assert diff is None, diff
+
+
+def test_numbers_of_a_table() -> None:
+    assert numbers("p 0.5, cost -4e+00 at 12 deg\nwall time 0.01 s (3e6 trials/s)\n") == [
+        0.5,
+        -4.0,
+        12.0,
+    ]
 
 
 def test_snapshot_has_no_volatile_keys() -> None:
