@@ -57,7 +57,7 @@ def test_plan_with_a_payoff_file(tmp_path: Path, capsys: pytest.CaptureFixture[s
         (["--contact-noise", "1.5"], "contact-noise"),
         (["--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
         (["--turn-noise", "normal:1", "--guaranteed"], "do not take noise"),
-        (["--payoff", "missing.csv"], "cannot be read"),
+        (["--payoff", "missing.csv"], "no such file"),
     ],
 )
 def test_bad_options_exit_2(
