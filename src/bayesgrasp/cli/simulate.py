@@ -227,6 +227,7 @@ def simulate(
         pb, option, label = noise_aware_plan(which, spec, p, model, pay)
     else:
         pb, option, label = chosen_plan(which, spec, p, force)
+        _note_plan_file(which, model, pay)
     u = None if pay is None else _payoff_vector(pay, pb)
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
 
@@ -332,6 +333,44 @@ def noise_aware_plan(
     chosen = res.bayes if which == "bayes" else res.most_certain
     what = "noise-aware " if not noise.exact else "payoff "
     return pb, res.options[chosen].option, what + PLAN_NAMES[which]
+
+
+def _note_plan_file(which: str, noise: Any, payoff: Any) -> None:
+    """Say on stderr when a plan file was made under a noise or payoff the run does not use.
+
+    The run uses the options as given (the same command prints the same numbers); the note
+    names the options that would simulate the plan under the conditions it was made for.
+    """
+    import json
+
+    from ..model.noise import NoiseModel, TurnNoise
+
+    path = Path(which)
+    if path.suffix.lower() != ".json":
+        return
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        made = doc.get("noise") if isinstance(doc, dict) else None
+        theirs = NoiseModel(
+            TurnNoise(made["turn"]["kind"], made["turn"]["scale_rad"]), made["contact"]
+        ) if isinstance(made, dict) else NoiseModel()  # fmt: skip
+        paid = isinstance(doc, dict) and doc.get("payoff") is not None
+    except (OSError, ValueError, KeyError, TypeError):  # the plan reader has checked the file
+        return
+    missing = []
+    if theirs != noise and not theirs.exact:
+        t, q = theirs.turn, theirs.contact
+        missing += [f"--turn-noise {t.spec()}"] if not t.exact else []
+        missing += [f"--contact-noise {q:g}"] if q > 0 else []
+    if paid and payoff is None:
+        missing.append("--payoff FILE")
+    if missing:
+        typer.echo(
+            f"note: plan file {path.name!r} was made under other conditions "
+            f"({theirs.describe()}{', a payoff' if paid else ''}); to simulate it under them "
+            f"give {' '.join(missing)}",
+            err=True,
+        )
 
 
 def _read_payoff(path: Path | None) -> Any:

@@ -25,7 +25,6 @@ import numpy as np
 from ..angles import TWO_PI, mod_2pi
 from ..errors import SimulationError
 from ..model.actions import SQUEEZE
-from ..model.noise import NoiseModel
 from ..model.payoff import Payoff
 from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
 from ..model.problem import Problem
@@ -173,6 +172,7 @@ def simulate_kinematic(
 
     The triangle's Bayes plan when one jaw touches first in 40% of the squeezes:
 
+    >>> from bayesgrasp.model.noise import NoiseModel
     >>> from bayesgrasp.shapes import load
     >>> pb = Problem.build(load("triangle"))
     >>> plan = plan_exact(pb).bayes_plan

@@ -277,7 +277,7 @@ class SimulationResult:
 
     @property
     def observed_payoff(self) -> float:
-        """Mean payoff of the trials' final states (a jammed trial earns 0; NaN without a payoff)."""
+        """Mean payoff of the final states (a jammed trial earns 0; NaN without a payoff)."""
         if self.payoff is None or not self.trials:
             return math.nan
         return float(self.observed @ self.payoff) / self.trials
