@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from numpy.typing import NDArray
 
@@ -396,3 +398,46 @@ def test_a_plan_file_made_under_noise_is_noted(
     code, _, err = run(capsys, "simulate", "key", "--plan", str(plan), "--trials", "100",
                        "--turn-noise", "normal:2", "--payoff", str(payoff_file))  # fmt: skip
     assert code == 0 and err == ""
+
+
+# -- invariants ----------------------------------------------------------------------------------
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    kind=st.sampled_from(["normal", "uniform"]),
+    deg=st.floats(0.0, 30.0),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_a_gripper_error_is_its_turn_noise(kind: str, deg: float, seed: int) -> None:
+    """The older form of a turn error draws and predicts exactly what the model's form does."""
+    pb = Problem.build(load("key"))
+    plan = plan_exact(pb).bayes_plan
+    scale = math.radians(deg)
+    a = simulate_kinematic(pb, plan, 500, GripperNoise(kind, scale), rng=seed)  # type: ignore[arg-type]
+    b = simulate_kinematic(pb, plan, 500, NoiseModel(TurnNoise(kind, scale)), rng=seed)  # type: ignore[arg-type]
+    assert np.array_equal(a.final, b.final) and np.array_equal(a.predicted, b.predicted)
+    assert_allclose(a.predicted.sum(), 1.0, atol=1e-9)
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    values=st.lists(st.sampled_from([0.0, 0.25, 0.5, 1.0]), min_size=8, max_size=8).filter(
+        lambda v: any(x > 0 for x in v)
+    ),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_the_payoff_interval_holds_the_mean(values: list[float], seed: int) -> None:
+    """The payoff's intervals hold its observed mean, in [0, 1]; a 0/1 payoff's is success's."""
+    pb = Problem.build(load("key"))
+    plan = plan_exact(pb).bayes_plan
+    u = np.array(values)
+    res = simulate_kinematic(pb, plan, 300, NoiseModel(contact=0.2), rng=seed, payoff=u)
+    for z in (1.959963984540054, 4.0):
+        lo, hi = res.payoff_interval(z)
+        assert 0.0 <= lo <= res.observed_payoff <= hi <= 1.0
+    assert_allclose(res.predicted_payoff, float(res.predicted @ u), atol=0)
+    assert_allclose(res.predicted_success, float(res.predicted[u > 0].sum()), atol=0)
+    if set(values) <= {0.0, 1.0}:
+        assert_allclose(res.payoff_interval(), res.ci95, atol=1e-12)
+        assert_allclose(res.payoff_interval(4.0), res.success_interval, atol=1e-12)

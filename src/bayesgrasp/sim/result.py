@@ -292,8 +292,9 @@ class SimulationResult:
         """
         if self.payoff is None:
             return (math.nan, math.nan)
-        m = self.observed_payoff
-        return wilson_interval(min(max(m, 0.0), 1.0) * self.trials, self.trials, _confidence(z))
+        m = min(max(self.observed_payoff, 0.0), 1.0)
+        lo, hi = wilson_interval(m * self.trials, self.trials, _confidence(z))
+        return min(lo, m), max(hi, m)  # rounding at a mean of 0 or 1
 
     def cost_per_unit_payoff(self) -> tuple[float, float, float, float]:
         """Predicted and observed cost per unit payoff, and the observed one's 95% interval.
