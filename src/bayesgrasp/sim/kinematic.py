@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,6 +44,9 @@ from .result import (
     summarize,
 )
 
+if TYPE_CHECKING:  # pragma: no cover
+    from ..geometry.transfer import TransferFunction
+
 __all__ = [
     # Defined elsewhere in bayesgrasp.sim; listed so that today's imports from this module
     # keep working (cli/simulate.py, sweep/tasks.py, report.py, benchmarks). New code
@@ -50,6 +55,8 @@ __all__ = [
     "SimulationResult",
     "boundary_distance",
     # Defined here.
+    "contact_push",
+    "run_trials",
     "sample_prior",
     "simulate_kinematic",
 ]
@@ -187,6 +194,7 @@ def simulate_kinematic(
     model = noise_model(noise)
     turn = noise if isinstance(noise, GripperNoise) else GripperNoise.of(model.turn)
     gen = as_generator(rng)
+    push = contact_push(problem, model.contact)
     jam_tol = JAM_TOLERANCE_FACTOR * problem.states.angle_tol
     finals: list[FloatArray] = []
     nears: list[BoolArray] = []
@@ -195,8 +203,8 @@ def simulate_kinematic(
     done = 0
     while done < trials:
         m = min(chunk, trials - done)
-        theta, near, jam = _run(problem, option.steps, turn, model.contact, m, gen,
-                                boundary_margin)  # fmt: skip
+        theta, near, jam = run_trials(problem, option.steps, turn, model.contact, m, gen,
+                                      boundary_margin, push)  # fmt: skip
         finals.append(theta)
         nears.append(near)
         jams.append(jam)
@@ -225,21 +233,31 @@ def _vector(problem: Problem, payoff: Payoff | FloatArray) -> FloatArray:
     return np.asarray(as_vector(payoff, problem.states), dtype=np.float64)
 
 
-def _run(
+def contact_push(problem: Problem, contact: float) -> TransferFunction | None:
+    """The push-grasp function a squeeze becomes when one jaw touches first (none if q = 0)."""
+    if contact <= 0:
+        return None
+    from ..geometry.push import push_grasp_function
+
+    return push_grasp_function(problem.part, problem.states)
+
+
+def run_trials(
     problem: Problem,
-    steps: tuple[PlanStep, ...] | list[PlanStep],
+    steps: Sequence[PlanStep],
     turn: GripperNoise,
     contact: float,
     m: int,
     gen: np.random.Generator,
     boundary_margin: float = 0.0,
+    push: TransferFunction | None = None,
 ) -> tuple[FloatArray, BoolArray, BoolArray]:
     """``m`` trials of a plan: final orientations, near-boundary starts, jams.
 
-    The draws of a chunk, in order: the initial orientations, the turn errors (one per
-    action and trial, none when there is no turn error), the contact events (one per action
-    and trial, none without contact asynchrony); so a run without contact noise draws what
-    it always drew.
+    The draws, in order: the initial orientations, the turn errors (one per action and
+    trial, none when there is no turn error), the contact events (one per action and trial,
+    none without contact asynchrony); so a run without contact noise draws what it always
+    drew. ``push``: :func:`contact_push` (made here when not given).
     """
     transfers = [problem.transfer(s.kind) for s in steps]
     alphas = np.array([s.alpha for s in steps])
@@ -248,11 +266,8 @@ def _run(
     jam = np.zeros(m, dtype=bool)
     err = turn.draw((len(alphas), m), gen) if turn.scale > 0 else None
     event = gen.random((len(alphas), m)) if contact > 0 else None
-    push = None
-    if event is not None:
-        from ..geometry.push import push_grasp_function
-
-        push = push_grasp_function(problem.part, problem.states)
+    if event is not None and push is None:
+        push = contact_push(problem, contact)
     for j, f in enumerate(transfers):
         theta = theta - alphas[j] if err is None else theta - (alphas[j] + err[j])
         if boundary_margin > 0:

@@ -20,7 +20,7 @@ from ..model.noise import NoiseModel
 from ..model.problem import Problem
 from ..model.states import nearest_state
 from ..planning.result import PlanStep
-from .kinematic import _run
+from .kinematic import contact_push, run_trials
 from .noise import GripperNoise, as_generator
 from .result import check_steps, check_trials
 
@@ -69,11 +69,12 @@ def simulate_noise(
     check_steps(problem, steps)
     gen = as_generator(rng)
     turn = GripperNoise.of(noise.turn)
+    push = contact_push(problem, noise.contact)
     counts = np.zeros(problem.n_states, dtype=np.intp)
     done = 0
     while done < trials:
         m = min(chunk, trials - done)
-        theta, _, _ = _run(problem, list(steps), turn, noise.contact, m, gen)
+        theta, _, _ = run_trials(problem, steps, turn, noise.contact, m, gen, push=push)
         counts += np.bincount(nearest_state(problem.states, theta), minlength=problem.n_states)
         done += m
     if int(counts.sum()) != trials:  # pragma: no cover - a bug
