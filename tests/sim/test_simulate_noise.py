@@ -370,7 +370,7 @@ def test_mujoco_results_are_predicted_under_the_noise(
         (["--turn-noise", "normal:2", "--noise-kind", "uniform"], "names its own"),
         (["--turn-noise", "normal:2", "--noise", "1"], "not both"),
         (["--turn-noise", "normal:50"], "scale"),
-        (["--payoff", "missing.json"], "cannot be read"),
+        (["--payoff", "missing.json"], "no such file"),
         (["--contact-noise", "0.2", "--sense", "width"], "--sense"),
         (["--payoff", "missing.json", "--sense", "width"], "--sense"),
         (["--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
