@@ -168,3 +168,9 @@ def test_parse_and_validate() -> None:
     assert TurnNoise("normal", 0.1).curvature_bound == pytest.approx(
         2 * math.exp(-0.5) / math.sqrt(2 * math.pi) / 0.01
     )
+
+
+@pytest.mark.parametrize("spec", ["normal:1e-300", "normal:1e-310", "uniform:1e-12"])
+def test_a_vanishing_turn_error_is_refused(spec: str) -> None:
+    with pytest.raises(PlanningError, match="exact to rounding: give 0 for exact turns"):
+        parse_turn_noise(spec)
