@@ -72,23 +72,18 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ..errors import ExportError  # defined in errors.py; importable from here as before
 from ..model.problem import Problem, nearest_state
-from ..planning.policy import Policy
 from ..planning.result import PlanOption
-from .machine import (
-    RobotMachine,
-    machine_csv,
-    machine_document,
-    plan_machine,
-    policy_machine,
-    wrap_angle,
-)
 from .plans import json_float, part_document
+
+if TYPE_CHECKING:  # the policy machinery (and scipy) only when a policy is written
+    from ..planning.policy import Policy
+    from .machine import RobotMachine
 
 __all__ = [
     "EXPORT_FORMATS",
@@ -100,6 +95,7 @@ __all__ = [
     "robot_document",
     "robot_steps",
     "stroke_violation",
+    "wrap_angle",
     "write_robot",
 ]
 
@@ -162,7 +158,19 @@ class RobotStep:
         return math.degrees(self.gripper_rad)
 
 
-_wrap = wrap_angle  # one wrap for plans and state machines
+def wrap_angle(angle: float) -> float:
+    """An angle in ``(-pi, pi]`` (plans' and state machines' gripper angles).
+
+    Examples
+    --------
+    >>> wrap_angle(3 * math.pi) == math.pi, wrap_angle(-math.pi) == math.pi
+    (True, True)
+    """
+    out = math.remainder(angle, 2.0 * math.pi)
+    return math.pi if out <= -math.pi else out
+
+
+_wrap = wrap_angle
 
 
 def robot_steps(problem: Problem, option: PlanOption) -> list[RobotStep]:
@@ -345,14 +353,16 @@ def check_stroke(
     >>> check_stroke(pb, plan_exact(pb).bayes_plan, Stroke(10.0, 40.0))
     """
     machine = _machine(problems, strategy)
-    kind = "state" if isinstance(strategy, Policy) else "step"
+    kind = "step" if isinstance(strategy, PlanOption) else "state"
     why = stroke_violation(machine, stroke, kind)
     if why is not None:
         raise ExportError(f"the gripper's stroke cannot run this strategy: {why}")
 
 
 def _machine(problems: Problem | Sequence[Problem], strategy: PlanOption | Policy) -> RobotMachine:
-    if isinstance(strategy, Policy):
+    from .machine import plan_machine, policy_machine
+
+    if not isinstance(strategy, PlanOption):
         return policy_machine(problems, strategy)
     pb = problems if isinstance(problems, Problem) else problems[0]
     return plan_machine(pb, strategy)
@@ -375,7 +385,9 @@ def write_robot(
     kind = target.suffix.lstrip(".").lower()
     if kind not in EXPORT_FORMATS:
         raise ExportError(f"the robot file must end in .csv or .json; got {target.name!r}")
-    if isinstance(option, Policy):
+    if not isinstance(option, PlanOption):
+        from .machine import machine_csv, machine_document, policy_machine
+
         machine = policy_machine(problem, option)
         if kind == "csv":
             text = machine_csv(machine)

@@ -82,6 +82,7 @@ from ..model.problem import Problem
 from ..model.sensing import WidthSensor
 from ..planning.policy import Branch, Declare, Policy, PolicyNode, Reject
 from ..planning.result import PlanOption
+from .export import wrap_angle
 from .plans import json_float
 
 __all__ = [
@@ -122,18 +123,6 @@ MACHINE_COLUMNS = (
 
 FloatArray = NDArray[np.float64]
 Outcome = Literal["next", "declare", "reject"]
-
-
-def wrap_angle(angle: float) -> float:
-    """An angle in ``(-pi, pi]``.
-
-    Examples
-    --------
-    >>> wrap_angle(3 * math.pi) == math.pi, wrap_angle(-math.pi) == math.pi
-    (True, True)
-    """
-    out = math.remainder(angle, 2.0 * math.pi)
-    return math.pi if out <= -math.pi else out
 
 
 @dataclass(frozen=True, slots=True)
