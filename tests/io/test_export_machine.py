@@ -13,7 +13,7 @@ succeed as often as the policy claims.
 from __future__ import annotations
 
 import csv
-import io
+import itertools
 import json
 import math
 from collections.abc import Sequence
@@ -185,7 +185,7 @@ def test_file_runs_as_the_policy(
     for rows in table.values():  # each state's rows tile the readings in order
         assert float(rows[0]["reading_lo"]) == -math.inf
         assert float(rows[-1]["reading_hi"]) == math.inf
-        for a, b in zip(rows, rows[1:], strict=False):
+        for a, b in itertools.pairwise(rows):
             assert a["reading_hi"] == b["reading_lo"]
         assert_allclose(sum(float(r["probability"]) for r in rows), 1.0, atol=1e-9)
     n = 4000
