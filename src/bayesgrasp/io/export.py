@@ -28,13 +28,20 @@ rad) and jaw opening; units in the ``#`` lines that head the CSV and in the JSON
 ``units``. :func:`write_robot` writes it when given a policy::
 
     $ bayesgrasp plan house --sense width --export house-robot.csv
-    $ head -6 house-robot.csv
+    $ cut -c 1-88 house-robot.csv
     # bayesgrasp.robot-policy/1; parts: house
-    # units: lengths (opening_before, ...) in mm; angles in deg (*_deg) and rad (*_rad), ...
-    # start: state 1; after the state's action a reading r takes its row with reading_lo <= ...
-    state,action,turn_deg,gripper_deg,gripper_rad,opening_before,width_after_min,...
-    1,squeeze,0,0,0,61.97576623,40,58.66,-inf,45.55,0.5,next,2,,,,,
-    1,squeeze,0,0,0,61.97576623,40,58.66,45.55,inf,0.5,next,3,,,,,
+    # units: lengths (opening_before, width_after_min, width_after_max, reading_lo, reading_
+    # start: state 1; after the state's action a reading r takes its row with reading_lo <=
+    state,action,turn_deg,gripper_deg,gripper_rad,opening_before,width_after_min,width_after
+    1,squeeze,0,0,0,61.97576623,40,58.66,-inf,48.26729625,0.5,declare,,house,0,0,0,0
+    1,squeeze,0,0,0,61.97576623,40,58.66,48.26729625,57.59729625,0.2908144585,next,2,,,,,
+    1,squeeze,0,0,0,61.97576623,40,58.66,57.59729625,inf,0.2091855415,declare,,house,270,4.7
+    2,squeeze,34.59407923,34.59407923,0.6037805843,60.95643911,40,58.66,-inf,57.59729625,0.5
+    2,squeeze,34.59407923,34.59407923,0.6037805843,60.95643911,40,58.66,57.59729625,inf,0.5,
+
+After the first squeeze (gripper at 0 deg) a reading below 48.27 mm declares the house at
+0 deg; one in ``[48.27, 57.60)`` goes to state 2, which turns the gripper to 34.59 deg in the
+world frame, squeezes and declares.
 
 A linear plan is the same machine with one row a state (:func:`~.machine.plan_machine`;
 its angles and openings are this module's), but ``write_robot`` keeps the step table above

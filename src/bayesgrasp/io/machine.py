@@ -32,12 +32,12 @@ The files (:func:`machine_csv`, :func:`machine_document`; schema ``bayesgrasp.ro
 CSV: lines starting with ``#`` first (the schema, the units, the start state), then one row a
 transition, in state order::
 
-    # bayesgrasp.robot-policy/1
-    # units: lengths (opening_before, width_after_*, reading_lo, reading_hi) in mm; ...
-    # start: state 1; a reading r takes the row of the current state with reading_lo <= r < ...
+    # bayesgrasp.robot-policy/1; parts: house
+    # units: lengths (opening_before, width_after_min, width_after_max, reading_lo, ...
+    # start: state 1; after the state's action a reading r takes its row with ...
     state,action,turn_deg,gripper_deg,gripper_rad,opening_before,width_after_min,...
-    1,squeeze,0,0,0,61.97576623,40,...,-inf,45,0.5,next,2,,,,,
-    1,squeeze,0,0,0,61.97576623,40,...,45,inf,0.5,declare,,house,0,0,0,0
+    1,squeeze,0,0,0,61.97576623,40,58.66,-inf,48.26729625,0.5,declare,,house,0,0,0,0
+    1,squeeze,0,0,0,61.97576623,40,58.66,48.26729625,57.59729625,0.2908144585,next,2,,,,,
 
 The columns after the state's own (``state`` ... ``width_after_max``) are ``reading_lo``,
 ``reading_hi``, ``probability`` (of the interval, given that the state is reached),
