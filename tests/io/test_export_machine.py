@@ -399,3 +399,26 @@ def test_cli_stroke(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert "less than `max_opening`" in capsys.readouterr().err
     assert main(["plan", "house", "key", "--max-opening", "70"]) == 2
     assert "take one PART" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["triangle", "rectangle", "ic-chip", "house", "example", "allen-wrench", "tuning-fork", "key"],
+)
+def test_the_first_squeeze_decides_the_stroke(name: str) -> None:
+    """Squeezes under a prior of full support: the first action needs the whole stroke.
+
+    It sees every orientation (the widest opening) and reaches every stable orientation
+    (the narrowest closing), so no later step of any squeeze strategy needs more: a stroke
+    that refuses a strategy refuses the part (why the command line calls it bad input).
+    """
+    (pb,) = _problems((name,), ("squeeze",), None)
+    for m in (
+        plan_machine(pb, plan_exact(pb).bayes_plan),
+        policy_machine(pb, plan_policy(pb, "width:0,0.5", 2)),
+    ):
+        first = m.states[0]
+        assert_allclose(first.width_after_min, float(np.min(pb.widths)), rtol=1e-12)
+        for s in m.states:
+            assert s.opening_before <= first.opening_before
+            assert s.width_after_min >= first.width_after_min
