@@ -123,8 +123,26 @@ CSV_COLUMNS = (
 )
 
 
+class GripperAngles:
+    """The degrees of a step's radians (a base of :class:`RobotStep` and machine states)."""
+
+    __slots__ = ()
+    turn_rad: float
+    gripper_rad: float
+
+    @property
+    def turn_deg(self) -> float:
+        """:attr:`turn_rad` in degrees."""
+        return math.degrees(self.turn_rad)
+
+    @property
+    def gripper_deg(self) -> float:
+        """:attr:`gripper_rad` in degrees, in ``(-180, 180]``."""
+        return math.degrees(self.gripper_rad)
+
+
 @dataclass(frozen=True, slots=True)
-class RobotStep:
+class RobotStep(GripperAngles):
     """One action of a plan as a controller executes it.
 
     Attributes
@@ -153,16 +171,6 @@ class RobotStep:
     width_after: float
     width_after_min: float
     width_after_max: float
-
-    @property
-    def turn_deg(self) -> float:
-        """:attr:`turn_rad` in degrees."""
-        return math.degrees(self.turn_rad)
-
-    @property
-    def gripper_deg(self) -> float:
-        """:attr:`gripper_rad` in degrees, in ``(-180, 180]``."""
-        return math.degrees(self.gripper_rad)
 
 
 def wrap_angle(angle: float) -> float:

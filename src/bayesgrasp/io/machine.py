@@ -82,7 +82,7 @@ from ..model.problem import Problem
 from ..model.sensing import WidthSensor
 from ..planning.policy import Branch, Declare, Policy, PolicyNode, Reject
 from ..planning.result import PlanOption
-from .export import wrap_angle
+from .export import GripperAngles, wrap_angle
 from .plans import json_float
 
 __all__ = [
@@ -162,7 +162,7 @@ class Transition:
 
 
 @dataclass(frozen=True, slots=True)
-class MachineState:
+class MachineState(GripperAngles):
     """One action of a strategy as a controller runs it.
 
     Attributes
@@ -192,16 +192,6 @@ class MachineState:
     width_after_min: float
     width_after_max: float
     transitions: tuple[Transition, ...]
-
-    @property
-    def turn_deg(self) -> float:
-        """:attr:`turn_rad` in degrees."""
-        return math.degrees(self.turn_rad)
-
-    @property
-    def gripper_deg(self) -> float:
-        """:attr:`gripper_rad` in degrees, in ``(-180, 180]``."""
-        return math.degrees(self.gripper_rad)
 
     def transition(self, reading: float) -> Transition:
         """The transition a reading takes (``lo <= reading < hi``)."""
