@@ -155,7 +155,7 @@ MinOpeningOpt = Annotated[
         min=0.0,
         metavar="WIDTH",
         help="The narrowest the gripper closes (part units): refuse a plan or policy with a "
-        "step that may leave the part narrower than this across the jaws.",
+        "step that may close the jaws on a width narrower than this.",
     ),
 ]
 # SenseOpt, AlsoOpt, PartPriorOpt and MaxActionsOpt: the options of a sensing policy (plan,
