@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from bayesgrasp import Problem, plan_exact, resolve_part
+from bayesgrasp import Part, Problem, plan_exact, resolve_part
 from bayesgrasp.cli import main
 from bayesgrasp.io.export import (
     ExportError,
@@ -43,10 +43,12 @@ from bayesgrasp.io.machine import (
     plan_machine,
     policy_machine,
 )
-from bayesgrasp.model.prior import von_mises
+from bayesgrasp.model.cost import CostModel
+from bayesgrasp.model.prior import SamplePrior, von_mises
 from bayesgrasp.model.problem import nearest_state
 from bayesgrasp.model.sensing import parse_sensor
 from bayesgrasp.planning.policy import Declare, Policy, PolicyNode, Reject, plan_policy
+from bayesgrasp.planning.result import PlanOption, PlanStep
 from bayesgrasp.sim.kinematic import sample_prior
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
@@ -213,6 +215,26 @@ def test_file_runs_as_the_policy(
                 assert b["declare"]["part"] == r["part"]
 
 
+def test_rejections_run_from_the_file(tmp_path: Path) -> None:
+    """Dear verification: the policy rejects some parts, and the file's reject rows agree."""
+    pb = Problem.build(resolve_part("triangle"), cost=CostModel(verify=30.0))
+    pol = plan_policy(pb, "width:1,0.5", 2)
+    assert pol.reject_probability > 0.05
+    text = write_robot(tmp_path / "tri.csv", pb, pol).read_text(encoding="utf-8")
+    table = read_machine_csv(text)
+    assert any(r["outcome"] == "reject" for rows in table.values() for r in rows)
+    n = 4000
+    ok, declared = run_file([pb], pol, table, n, seed=5)
+    p, r = pol.success_probability, pol.reject_probability
+    assert abs(ok / n - p) <= 4.5 * math.sqrt(p * (1 - p) / n)
+    assert abs((n - declared) / n - r) <= 4.5 * math.sqrt(r * (1 - r) / n)
+    # a part without units says so
+    quad = Part.from_points([(0.0, 0.0), (4.0, 0.0), (3.6, 2.2), (0.5, 2.6)], name="quad")
+    bare = Problem.build(quad)
+    line = machine_csv(policy_machine(bare, plan_policy(bare, "width", 1))).splitlines()[1]
+    assert "in the part's units;" in line
+
+
 @pytest.mark.parametrize(
     ("names", "sense", "actions"),
     [
@@ -327,6 +349,23 @@ def test_stroke_check_names_the_step() -> None:
     with pytest.raises(ExportError, match=r"state 1 \(squeeze"):
         check_stroke(pb, pol, Stroke(max_opening=widest - 0.01))
     assert stroke_violation(policy_machine(pb, pol), Stroke(narrowest, widest)) is None
+
+
+def test_a_later_step_outside_the_stroke() -> None:
+    """A prior of gaps: the first squeeze reaches only the wide state, the second the narrow."""
+    rect = Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)], units="mm")
+    pb = Problem.build(rect, prior=SamplePrior([0.1, -0.1, math.pi]))
+    plan = PlanOption(
+        (PlanStep("squeeze", 0.0), PlanStep("squeeze", math.pi / 2)), 0.0, 1, 2, None, (0, 1)
+    )
+    m = plan_machine(pb, plan)
+    widths = [(s.width_after_min, s.width_after_max) for s in m.states]
+    assert_allclose(widths, [(31.0, 31.0), (20.0, 20.0)], atol=1e-9)
+    assert_allclose(m.states[1].opening_before, 20.0)  # the part lies 20 across the jaws
+    with pytest.raises(ExportError, match=r"the planners do not avoid it\): step 2 \(squeeze"):
+        check_stroke(pb, plan, Stroke(min_opening=25.0))
+    with pytest.raises(ExportError, match=r"^the part does not fit the gripper's stroke: step 1"):
+        check_stroke(pb, plan, Stroke(min_opening=32.0))
 
 
 @pytest.mark.parametrize(

@@ -331,18 +331,24 @@ largest opening 30 mm
     step 1 (squeeze, gripper at 0 deg) may close the jaws to 20 mm, less than the least \
 opening 21 mm
     """
+    found = _outside(machine, stroke, kind)
+    return None if found is None else found[1]
+
+
+def _outside(machine: RobotMachine, stroke: Stroke, kind: str) -> tuple[int, str] | None:
+    """The first state outside the stroke and why (:func:`stroke_violation`)."""
     units = f" {machine.units}" if machine.units else ""
     for s in machine.states:
         where = f"{kind} {s.state} ({s.action}, gripper at {s.gripper_deg:.4g} deg)"
         hi = stroke.max_opening
         if s.opening_before > hi * (1 + _STROKE_RTOL):
-            return (
+            return s.state, (
                 f"{where} needs the jaws open to {s.opening_before:.4g}{units}, more than the "
                 f"largest opening {hi:g}{units}"
             )
         lo = stroke.min_opening
         if s.width_after_min < lo * (1 - _STROKE_RTOL):
-            return (
+            return s.state, (
                 f"{where} may close the jaws to {s.width_after_min:.4g}{units}, less than the "
                 f"least opening {lo:g}{units}"
             )
@@ -357,7 +363,11 @@ def check_stroke(
     Raises
     ------
     ExportError
-        Naming the first step (the plan's step, the policy's state) outside the stroke.
+        Naming the first step (the plan's step, the policy's state) outside the stroke. At
+        the first step the part itself does not fit: that action sees every orientation
+        and, for squeezes under a prior of full support, reaches every stable one, so it
+        needs the widest opening and the narrowest closing of any strategy. A later step
+        could be avoidable: the planners do not take the stroke into account.
 
     Examples
     --------
@@ -369,9 +379,15 @@ def check_stroke(
     """
     machine = _machine(problems, strategy)
     kind = "step" if isinstance(strategy, PlanOption) else "state"
-    why = stroke_violation(machine, stroke, kind)
-    if why is not None:
-        raise ExportError(f"the gripper's stroke cannot run this strategy: {why}")
+    found = _outside(machine, stroke, kind)
+    if found is None:
+        return
+    state, why = found
+    if state == 1:  # the first action sees every orientation: no strategy would fit
+        raise ExportError(f"the part does not fit the gripper's stroke: {why}")
+    raise ExportError(
+        f"the gripper's stroke cannot run this strategy (the planners do not avoid it): {why}"
+    )
 
 
 def _machine(problems: Problem | Sequence[Problem], strategy: PlanOption | Policy) -> RobotMachine:
