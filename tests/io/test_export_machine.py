@@ -190,7 +190,7 @@ def test_file_runs_as_the_policy(
         for a, b in itertools.pairwise(rows):
             assert a["reading_hi"] == b["reading_lo"]
         assert_allclose(sum(float(r["probability"]) for r in rows), 1.0, atol=1e-9)
-    n = 4000
+    n = 2500
     ok, _ = run_file(pbs, pol, table, n, seed=7)
     p = pol.success_probability
     assert abs(ok / n - p) <= 4.5 * math.sqrt(p * (1 - p) / n) + 1e-9
