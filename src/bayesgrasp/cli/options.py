@@ -139,6 +139,26 @@ PartPriorOpt = Annotated[
 MaxActionsOpt = Annotated[
     int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
 ]
+MaxOpeningOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--max-opening",
+        min=0.0,
+        metavar="WIDTH",
+        help="The widest the gripper opens (part units): refuse a plan or policy with a step "
+        "that needs the jaws open wider than the part can lie across them.",
+    ),
+]
+MinOpeningOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--min-opening",
+        min=0.0,
+        metavar="WIDTH",
+        help="The narrowest the gripper closes (part units): refuse a plan or policy with a "
+        "step that may close the jaws on a width narrower than this.",
+    ),
+]
 # SenseOpt, AlsoOpt, PartPriorOpt and MaxActionsOpt: the options of a sensing policy (plan,
 # simulate and plot --sense), gathered into a SenseSpec.
 FoldOpt = Annotated[
