@@ -37,6 +37,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -205,8 +206,16 @@ def robot_csv(problem: Problem, option: PlanOption) -> str:
     return buf.getvalue()
 
 
-def write_robot(path: str | Path, problem: Problem, option: PlanOption) -> Path:
+def write_robot(
+    path: str | Path,
+    problem: Problem,
+    option: PlanOption,
+    metadata: Mapping[str, Any] | None = None,
+) -> Path:
     """Write a plan for a robot: CSV or JSON by the file's ending (``.csv``, ``.json``).
+
+    ``metadata`` (JSON-ready values, such as the noise model the plan was made for): in the
+    JSON document as more members, in the CSV as ``# KEY: JSON`` lines above the header.
 
     Raises
     ------
@@ -217,10 +226,13 @@ def write_robot(path: str | Path, problem: Problem, option: PlanOption) -> Path:
     kind = target.suffix.lstrip(".").lower()
     if kind not in EXPORT_FORMATS:
         raise ExportError(f"the robot file must end in .csv or .json; got {target.name!r}")
+    meta = dict(metadata or {})
     if kind == "csv":
-        text = robot_csv(problem, option)
+        head = "".join(f"# {k}: {json.dumps(v, allow_nan=False)}\n" for k, v in meta.items())
+        text = head + robot_csv(problem, option)
     else:
-        text = json.dumps(robot_document(problem, option), indent=2, allow_nan=False) + "\n"
+        doc = robot_document(problem, option) | meta
+        text = json.dumps(doc, indent=2, allow_nan=False) + "\n"
     try:
         target.write_text(text, encoding="utf-8")
     except OSError as exc:
