@@ -24,9 +24,9 @@ from .part import draw_part
 
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
+    from matplotlib.figure import Figure, SubFigure
 
     from ..planning.noisy import NoisyPlanResult
-    from matplotlib.figure import Figure, SubFigure
 
 __all__ = [
     "chosen_option",

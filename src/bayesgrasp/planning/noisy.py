@@ -524,9 +524,10 @@ def plan_guaranteed_noisy(
     if leave > problem.part.hull.tol.probability:
         which = "" if turn.exact else f" under turn error {turn.spec()} deg"
         reason = (
-            f"the shortest plan guaranteed{which} ({option.n_actions} actions) leaves its goal with probability {leave:.4g} under "
-            f"{noise.describe()} (a squeeze may act as a push-grasp from either side); no "
-            "plan that holds under one-sided contact is searched for"
+            f"the shortest plan guaranteed{which} ({option.n_actions} actions) leaves its "
+            f"goal with probability {leave:.4g} under contact noise {noise.contact:g} (a "
+            "squeeze may act as a push-grasp from either side); no plan that holds under "
+            "one-sided contact is searched for"
         )
         return GuaranteedPlan(
             problem,
