@@ -282,3 +282,29 @@ def test_an_input_is_never_a_template_output(
     first, second = (json.loads(x) for x in out.splitlines())
     assert code == 2 and "is an input" in first["error"] and "schema" in second
     assert part.read_text() == before
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["--sense", "width", "--guaranteed"], "takes no --guaranteed"),
+        (["--sense", "width", "--plot", "p.png"], "takes no --plot"),
+        (["--sense", "width", "--only", "best"], "takes no --only best"),
+        (["--sense", "width", "--method", "bfs"], "takes no --method"),
+        (["--sense", "width", "--max-squeezes", "2"], "the policy's depth is --max-actions"),
+        (["--max-actions", "3"], "--max-actions needs --sense"),
+        (["--fold-below", "0.01"], "--fold-below needs --sense"),
+        (["--turn-noise", "normal:1", "--max-actions", "2"], "--max-actions needs --sense"),
+    ],
+)
+def test_options_of_the_other_mode_are_refused(
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    args: list[str],
+    match: str,
+) -> None:
+    """An option given (even at its default value) that the mode does not use is refused."""
+    monkeypatch.chdir(tmp_path)
+    assert match in refused(capsys, "plan", "key", *args)
+    assert list(tmp_path.iterdir()) == []

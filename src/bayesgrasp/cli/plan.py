@@ -30,6 +30,16 @@ from .specs import PartSpec, ProblemSpec, SenseSpec, guaranteed_plan, run_inputs
 app = command_app()
 
 
+def _given(ctx: typer.Context, *names: str) -> list[str]:
+    """The options among ``names`` (parameter names) given on the command line, as typed."""
+    flags = {p.name: p.opts[0] for p in ctx.command.params if p.opts}
+    return [
+        flags.get(n, n)
+        for n in names
+        if (source := ctx.get_parameter_source(n)) is not None and source.name != "DEFAULT"
+    ]
+
+
 class Only(enum.StrEnum):
     """Which plans ``plan`` reports."""
 
@@ -104,6 +114,7 @@ BatchOpt = Annotated[
 @functools.partial(part_options, optional=True)
 @problem_options()
 def plan(
+    ctx: typer.Context,
     part: PartSpec,
     spec: ProblemSpec,
     more_parts: MorePartsArg = None,
@@ -143,6 +154,9 @@ def plan(
 
     if sense is None and (also or part_prior is not None):
         raise typer.BadParameter("--also and --part-prior need --sense")
+    if sense is None and (given := _given(ctx, "max_actions", "fold_below")):
+        need = "needs" if len(given) == 1 else "need"
+        raise typer.BadParameter(f"{' and '.join(given)} {need} --sense")
     noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
     if noise_asked and sense is not None:
         raise typer.BadParameter(
@@ -151,6 +165,19 @@ def plan(
     if sense is not None:
         if part.part is None or batch is not None:
             raise typer.BadParameter("--sense needs PART and takes no --batch")
+        refused = [
+            name
+            for name, on in (
+                ("--guaranteed", guaranteed),
+                ("--plot", plot_file is not None),
+                ("--only best", only is Only.best),
+                ("--method", spec.method.value != "exact"),
+                ("--max-squeezes (the policy's depth is --max-actions)", spec.max_actions),
+            )
+            if on
+        ]
+        if refused:
+            raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         from .sensing import plan_policy_command
 
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
