@@ -162,15 +162,25 @@ def test_guaranteed_under_uniform_error_tolerates_it(capsys: pytest.CaptureFixtu
 def test_guaranteed_without_a_plan_exits_1_with_the_reason(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    args = ("key", "--turn-noise", "uniform:2", "--contact-noise", "0.1", "--guaranteed")
+    args = ("house", "--turn-noise", "uniform:2", "--contact-noise", "0.1", "--guaranteed")
     doc = document(capsys, *args, code=1)
     assert doc["guaranteed"] is None
     assert "contact noise 0.1" in doc["guaranteed_missing"]
+    assert "spans more than one orbit" in doc["guaranteed_missing"]
     code, out, _ = run(capsys, "plan", *args)
     assert code == 1 and "Guaranteed plan: none (" in out
     # Far more error than any plan tolerates: no plan, the turn error named.
     doc = document(capsys, "rectangle", "--turn-noise", "uniform:40", "--guaranteed", code=1)
     assert "no plan guarantees under turn error uniform:40 deg" in doc["guaranteed_missing"]
+
+
+def test_guaranteed_under_contact_noise(capsys: pytest.CaptureFixture[str]) -> None:
+    doc = document(
+        capsys, "key", "--contact-noise", "0.1", "--turn-noise", "uniform:2", "--guaranteed"
+    )
+    g = doc["guaranteed"]
+    assert g["tolerance_rad"] >= math.radians(2) and g["squeezes"] == 4
+    assert g["success_probability"] <= 0.5 + 1e-12
 
 
 def test_guaranteed_under_normal_error_is_refused(capsys: pytest.CaptureFixture[str]) -> None:

@@ -4,7 +4,7 @@ The options are declared in :mod:`.options` (``plan`` and ``simulate`` load this
 when they are given); this module parses them (:meth:`NoisyRun.of`), calls
 :func:`~bayesgrasp.planning.noisy.plan_noisy` and prints. ``plan`` gives every one of its
 surfaces the noise-aware plan: the table or ``--json``, ``--only best``, ``--guaranteed``
-(:func:`~bayesgrasp.planning.noisy.plan_guaranteed_noisy`), ``--plot`` (the distributions
+(:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`), ``--plot`` (the distributions
 under the noise), ``--export`` (the robot file, with the noise model in its header) and
 several parts or ``--batch`` (:func:`~bayesgrasp.cli.batch.run_batch`, one document a line).
 """
@@ -82,10 +82,10 @@ class NoisyRun:
 
         ``--guaranteed`` under a normal turn error is refused: no plan of two or more
         actions can guarantee under an unbounded error
-        (:data:`~bayesgrasp.planning.noisy.UNBOUNDED_GUARANTEE`).
+        (:data:`~bayesgrasp.planning.robust.UNBOUNDED_GUARANTEE`).
         """
         from ..model.payoff import read_payoff
-        from ..planning.noisy import UNBOUNDED_GUARANTEE
+        from ..planning.robust import UNBOUNDED_GUARANTEE
 
         if spec.method.value != "exact":
             raise typer.BadParameter(
@@ -100,7 +100,8 @@ class NoisyRun:
 
     def plan(self, pb: Problem) -> Planned:
         """The noise-aware plans of a problem, and its guaranteed plan under the noise."""
-        from ..planning.noisy import plan_guaranteed_noisy, plan_noisy
+        from ..planning.noisy import plan_noisy
+        from ..planning.robust import plan_guaranteed_noisy
 
         res = plan_noisy(pb, self.noise, self.payoff, self.max_actions)
         if self.best_only:

@@ -53,8 +53,8 @@ GuaranteedOpt = Annotated[
         "--guaranteed",
         help="Also give the shortest plan that orients every initial orientation "
         "(up to the transfer functions' period). Under uniform turn noise of half-width A: "
-        "a plan whose turns tolerate A; under contact noise, if it holds for every contact; "
-        "normal turn noise is refused (unbounded).",
+        "a plan whose turns tolerate A; under contact noise, one that holds whichever jaw "
+        "touches first; normal turn noise is refused (unbounded error).",
     ),
 ]
 PlotOpt = Annotated[

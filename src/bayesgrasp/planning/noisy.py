@@ -76,7 +76,7 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -99,18 +99,13 @@ from .result import (
 )
 
 __all__ = [
-    "UNBOUNDED_GUARANTEE",
     "NoisyEvaluation",
     "NoisyOption",
     "NoisyPlanResult",
     "evaluate_plan",
-    "plan_guaranteed_noisy",
     "plan_noisy",
     "step_distributions_noisy",
 ]
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .guaranteed import GuaranteedPlan
 
 FloatArray = NDArray[np.float64]
 
@@ -421,132 +416,6 @@ def step_distributions_noisy(
     plan_actions(problem, [s.kind for s in steps])
     ev = _Evaluator(problem, noise, None)
     return ev.forward([s.kind for s in steps], [s.alpha for s in steps])
-
-
-UNBOUNDED_GUARANTEE = (
-    "no plan of two or more actions can guarantee under normal turn noise: its error is "
-    "unbounded, so every turn may err by any angle (give uniform:A_DEG for a bounded error)"
-)
-"""Why :func:`plan_guaranteed_noisy` refuses a normal turn error."""
-
-
-def plan_guaranteed_noisy(
-    problem: Problem, noise: NoiseModel, max_actions: int | None = None
-) -> GuaranteedPlan:
-    """The shortest plan that orients every orientation (up to the period) under a noise.
-
-    A guarantee under noise is a guarantee for every error the noise can make:
-
-    - *Uniform turn error* of half-width ``A``: a guaranteed plan whose turns tolerate an
-      error of ``A`` (its tolerance, the margin each image keeps inside the next arc, is at
-      least ``A``) sends every start to the goal whatever the errors (but the measure-zero
-      errors of exactly ``A`` that land on an unstable equilibrium). So this is the
-      guaranteed planner (:func:`~bayesgrasp.planning.guaranteed.plan_guaranteed`, Goldberg
-      1993) with a gripper accuracy of ``max(A, problem.accuracy)``; the first action's
-      error does not matter, since the plan orients every initial orientation.
-    - *Normal turn error*: unbounded, so a turn after the first can land anywhere and the
-      last action can end in any of its stable orientations; no plan of two or more
-      actions guarantees (:data:`UNBOUNDED_GUARANTEE`, raised).
-    - *Contact noise* ``q > 0``: every squeeze may act as a push-grasp from either side
-      (:class:`~bayesgrasp.model.noise.NoiseModel`), each with probability ``q / 2``. A
-      guarantee must hold for every such event, which does not depend on the value of
-      ``q`` (only on which events can happen). The plan for the turn error is checked under
-      the full noise model: the exact final distribution from a uniform start must lie on
-      the goal's orbit ``final + j * period``. If it does the plan is given; if not there is
-      no plan, and the reason gives the probability of leaving the goal (no other plan
-      is searched: plans that hold under one-sided contact are not planned for).
-
-    With a plan, its success probability and expected cost are those under the noise (for
-    the problem's prior and goal), exact (:func:`evaluate_plan`).
-
-    Parameters
-    ----------
-    problem : Problem
-    noise : NoiseModel
-    max_actions : int, optional
-        As :func:`~bayesgrasp.planning.guaranteed.plan_guaranteed`.
-
-    Returns
-    -------
-    GuaranteedPlan
-        Status ``"ok"`` with the plan, or ``"no-plan"`` and the reason.
-
-    Raises
-    ------
-    PlanningError
-        A normal turn error (:data:`UNBOUNDED_GUARANTEE`).
-
-    Examples
-    --------
-    >>> from bayesgrasp.geometry.polygon import Part
-    >>> from bayesgrasp.model.noise import TurnNoise
-    >>> pb = Problem.build(Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)]))
-    >>> g = plan_guaranteed_noisy(pb, NoiseModel(TurnNoise("uniform", math.radians(5))))
-    >>> g.status, g.n_actions, g.option.tolerance >= math.radians(5)
-    ('ok', 2, True)
-    >>> g = plan_guaranteed_noisy(pb, NoiseModel(TurnNoise("uniform", math.radians(30))))
-    >>> g.status, g.reason.split(" deg:")[0]
-    ('no-plan', 'no plan guarantees under turn error uniform:30')
-    """
-    from ..model.prior import UniformPrior
-    from .guaranteed import GuaranteedPlan, plan_guaranteed
-
-    turn = noise.turn
-    if not turn.exact and turn.kind == "normal":
-        raise PlanningError(UNBOUNDED_GUARANTEE)
-    bound = 0.0 if turn.exact else turn.scale
-    pb = problem if bound <= problem.accuracy else dataclasses.replace(problem, accuracy=bound)
-    found = plan_guaranteed(pb, max_actions)
-    found = dataclasses.replace(found, problem=problem)
-    if found.status != "ok":
-        if turn.exact:
-            return found
-        return dataclasses.replace(
-            found, reason=f"no plan guarantees under turn error {turn.spec()} deg: {found.reason}"
-        )
-    option = found.option
-    kinds, angles = option.kinds, [s.alpha for s in option.steps]
-    stable = problem.states.stable
-    final = int(nearest_state(problem.states, np.array([option.final_orientation]))[0])
-    # Every start: the same plan from a uniform prior (full support) under the noise.
-    everywhere = Problem.build(
-        problem.part,
-        prior=UniformPrior(),
-        cost=problem.cost,
-        goal=problem.goal,
-        actions=problem.actions,
-        accuracy=problem.accuracy,
-    )
-    q = _Evaluator(everywhere, noise, None).forward(kinds, angles)[-1]
-    off = np.abs(np.mod(stable - stable[final] + found.period / 2, found.period) - found.period / 2)
-    orbit = off <= 1e3 * problem.states.angle_tol
-    leave = float(q[~orbit].sum())
-    if leave > problem.part.hull.tol.probability:
-        which = "" if turn.exact else f" under turn error {turn.spec()} deg"
-        reason = (
-            f"the shortest plan guaranteed{which} ({option.n_actions} actions) leaves its "
-            f"goal with probability {leave:.4g} under contact noise {noise.contact:g} (a "
-            "squeeze may act as a push-grasp from either side); no plan that holds under "
-            "one-sided contact is searched for"
-        )
-        return GuaranteedPlan(
-            problem,
-            (),
-            0,
-            0,
-            "guaranteed",
-            status="no-plan",
-            reason=reason,
-            period=found.period,
-            widths=found.widths,
-        )
-    if noise.exact:
-        return found
-    e = _Evaluator(problem, noise, None).evaluate(kinds, angles, final)
-    opt = dataclasses.replace(
-        option, success_probability=e.success_probability, expected_cost=e.expected_cost
-    )
-    return dataclasses.replace(found, options=(opt,))
 
 
 @dataclass(slots=True)
