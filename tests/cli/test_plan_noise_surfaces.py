@@ -318,3 +318,11 @@ def test_options_of_the_other_mode_are_refused(
     monkeypatch.chdir(tmp_path)
     assert match in refused(capsys, "plan", "key", *args)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_payoff_file_is_an_input(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    u = tmp_path / "u.csv"
+    u.write_text("orientation_deg,value\n80.63,1\n")
+    err = refused(capsys, "plan", "key", "--payoff", str(u), "--export", str(u), "--force")
+    assert "is an input" in err
+    assert u.read_text() == "orientation_deg,value\n80.63,1\n"

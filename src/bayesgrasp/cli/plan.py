@@ -192,7 +192,7 @@ def plan(
         if noise_asked
         else None
     )
-    files = input_files(part.part, spec.prior, batch)
+    files = input_files(part.part, spec.prior, batch, payoff)
     outputs = PartOutputs.of(plot_file, export, force, files, several)
     if several:
         from .batch import BatchFileError, run_batch
