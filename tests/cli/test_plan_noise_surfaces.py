@@ -265,6 +265,15 @@ def test_two_parts_of_one_name_do_not_share_a_file(
         (["key", "--turn-noise", "normal:1", "--also", "house"], "need --sense"),
         (["key", "--contact-noise", "0.1", "--part-prior", "1,1"], "need --sense"),
         (["key", "--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
+        # an option of the other mode, given (even at its default value)
+        (["key", "--sense", "width", "--guaranteed"], "takes no --guaranteed"),
+        (["key", "--sense", "width", "--plot", "p.png"], "takes no --plot"),
+        (["key", "--sense", "width", "--only", "best"], "takes no --only best"),
+        (["key", "--sense", "width", "--method", "bfs"], "takes no --method"),
+        (["key", "--sense", "width", "--max-squeezes", "2"], "the policy's depth is --max-actions"),
+        (["key", "--max-actions", "3"], "--max-actions needs --sense"),
+        (["key", "--fold-below", "0.01"], "--fold-below needs --sense"),
+        (["key", "--turn-noise", "normal:1", "--max-actions", "2"], "--max-actions needs --sense"),
     ],
 )
 def test_refused_with_the_reason(
@@ -292,32 +301,6 @@ def test_an_input_is_never_a_template_output(
     first, second = (json.loads(x) for x in out.splitlines())
     assert code == 2 and "is an input" in first["error"] and "schema" in second
     assert part.read_text() == before
-
-
-@pytest.mark.parametrize(
-    ("args", "match"),
-    [
-        (["--sense", "width", "--guaranteed"], "takes no --guaranteed"),
-        (["--sense", "width", "--plot", "p.png"], "takes no --plot"),
-        (["--sense", "width", "--only", "best"], "takes no --only best"),
-        (["--sense", "width", "--method", "bfs"], "takes no --method"),
-        (["--sense", "width", "--max-squeezes", "2"], "the policy's depth is --max-actions"),
-        (["--max-actions", "3"], "--max-actions needs --sense"),
-        (["--fold-below", "0.01"], "--fold-below needs --sense"),
-        (["--turn-noise", "normal:1", "--max-actions", "2"], "--max-actions needs --sense"),
-    ],
-)
-def test_options_of_the_other_mode_are_refused(
-    capsys: pytest.CaptureFixture[str],
-    tmp_path: Path,
-    monkeypatch: pytest.MonkeyPatch,
-    args: list[str],
-    match: str,
-) -> None:
-    """An option given (even at its default value) that the mode does not use is refused."""
-    monkeypatch.chdir(tmp_path)
-    assert match in refused(capsys, "plan", "key", *args)
-    assert list(tmp_path.iterdir()) == []
 
 
 def test_the_payoff_file_is_an_input(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
