@@ -204,6 +204,27 @@ def test_zero_noise_document_equals_the_noiseless_one(
         assert (mine["bayes"], mine["most_certain"]) == (ref["bayes"], ref["most_certain"])
 
 
+@pytest.mark.parametrize(
+    "options",
+    [
+        ["--accuracy", "2", "--goal", "symmetry"],
+        ["--actions", "squeeze,push-grasp", "--push-grasp-cost", "0.7"],
+        ["--prior", "vonmises:30,2"],
+        ["--max-squeezes", "2"],
+        ["--retry-cost", "1", "--verify-cost", "2"],
+    ],
+    ids=" ".join,
+)
+@pytest.mark.parametrize("part", ["house", "key"])
+def test_zero_noise_with_problem_options(
+    capsys: pytest.CaptureFixture[str], options: list[str], part: str
+) -> None:
+    ref = document(capsys, part, *options)
+    mine = document(capsys, part, "--turn-noise", "uniform:0", *options)
+    same_where_shared(mine, ref)
+    assert mine["provenance"] | {"method": "exact"} == ref["provenance"]
+
+
 @pytest.mark.parametrize("noise", [[], NOISES[0]], ids=["no noise", "noise"])
 @pytest.mark.parametrize("ending", ["csv", "json"])
 def test_per_part_files_from_a_template(
