@@ -205,15 +205,18 @@ def _off_orbit_mass(pb: Problem, q: NDArray[np.float64], period: float) -> float
 def test_the_set_search_agrees_with_the_guaranteed_planner(pb: Problem, degrees: float) -> None:
     """Goldberg's search over sets of states and the arcs find plans of one length."""
     noise = NoiseModel(TurnNoise("uniform", degrees * DEG))
-    arcs = plan_guaranteed(dataclasses.replace(pb, accuracy=degrees * DEG))
-    found = support_search(pb, noise)
-    if arcs.status != "ok":
-        assert isinstance(found, str)
-        return
-    assert not isinstance(found, str)
-    assert len(found.kinds) == arcs.n_actions
-    if len(found.kinds) > 1:
-        assert found.margin > 0
+    accurate = dataclasses.replace(pb, accuracy=degrees * DEG)
+    arcs = plan_guaranteed(accurate)
+    # The error as turn noise, or as the problem's gripper accuracy: the same search.
+    for found in (support_search(pb, noise), support_search(accurate, NoiseModel())):
+        if arcs.status != "ok":
+            assert isinstance(found, str)
+            continue
+        assert not isinstance(found, str)
+        assert len(found.kinds) == arcs.n_actions
+        assert found.error == degrees * DEG
+        if len(found.kinds) > 1:
+            assert found.margin > 0
 
 
 def test_guaranteed_refuses_unbounded_error_and_keeps_zero_noise() -> None:

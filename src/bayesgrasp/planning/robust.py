@@ -28,7 +28,8 @@ of ``S``, contact offset ``o``, basin boundary ``B_b``), so the middle of each i
 between consecutive critical turns stands for all of it, and the search over those middles
 is exhaustive: the first level with a set inside one orbit gives the shortest plan (then
 the cheapest, then the one of widest intervals). A turn may err by ``A`` plus half its
-interval's width and the sets stay the same: that is the plan's tolerance.
+interval's width and the sets stay the same: that is the plan's tolerance. A gripper
+accuracy (``Problem.accuracy``) larger than ``A`` is searched as the error's half-width.
 
 The tests hold the two methods together: without contact noise the set search finds plans
 of the guaranteed planner's length, and every plan's executions, simulated with the noise
@@ -46,7 +47,7 @@ from numpy.typing import NDArray
 
 from ..angles import TWO_PI
 from ..errors import PlanningError
-from ..model.noise import NoiseModel, NoisyTransitions
+from ..model.noise import NoiseModel, NoisyTransitions, TurnNoise
 from ..model.prior import UniformPrior
 from ..model.problem import Problem, nearest_state
 from .arcs import period_cap
@@ -80,7 +81,10 @@ class SetPlan:
         The first action's world angle (0: any angle orients every orientation), then the
         turns, each the middle of its interval of turns.
     margin : float
-        The least half-width of those intervals (the tolerance beyond the noise's bound).
+        The least half-width of those intervals (the tolerance beyond ``error``).
+    error : float
+        The turn error searched for: the larger of the uniform error's half-width and the
+        problem's gripper accuracy.
     final : ndarray of bool, shape (K,)
         The states the part can end in (all on one orbit).
     """
@@ -88,6 +92,7 @@ class SetPlan:
     kinds: tuple[str, ...]
     angles: tuple[float, ...]
     margin: float
+    error: float
     final: BoolArray
 
 
@@ -140,7 +145,10 @@ def support_search(
     turn = noise.turn
     if not turn.exact and turn.kind == "normal":
         raise PlanningError(UNBOUNDED_GUARANTEE)
-    width = 0.0 if turn.exact else turn.scale
+    # The gripper accuracy is a bounded turn error too: the larger of the two is searched.
+    width = max(0.0 if turn.exact else turn.scale, problem.accuracy)
+    if width > 0 and (turn.exact or width > turn.scale):
+        noise = NoiseModel(TurnNoise("uniform", width), noise.contact)
     period = period_cap(problem)
     orbit = _orbits(problem, period)
     everywhere = _uniform(problem)
@@ -166,7 +174,7 @@ def support_search(
         if goals:
             cost = problem.cost.attempt_cost
             s, kinds, angles, margin = min(goals, key=lambda n: (cost(n[1]), -n[3]))
-            return SetPlan(kinds, angles, 0.0 if k == 1 else margin, s)
+            return SetPlan(kinds, angles, 0.0 if k == 1 else margin, width, s)
         if k == limit:
             break
         nxt = []
@@ -313,7 +321,7 @@ def plan_guaranteed_noisy(
                 period=period, widths=(),
             )  # fmt: skip
         steps = tuple(PlanStep(t, a) for t, a in zip(got.kinds, got.angles, strict=True))
-        tolerance = None if len(steps) == 1 else bound + got.margin
+        tolerance = None if len(steps) == 1 else got.error + got.margin
         first = problem.transfer(steps[0].kind)
         lo = float(first.basin_lo[0])
         option = PlanOption(steps, 0.0, 0.0, math.inf, tolerance, (lo, lo + TWO_PI))
