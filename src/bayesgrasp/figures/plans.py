@@ -347,7 +347,7 @@ def noisy_plan_figure(result: NoisyPlanResult, which: str = "bayes") -> Figure:
     >>> pb = Problem.build(Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)]))
     >>> res = plan_noisy(pb, NoiseModel(TurnNoise("normal", math.radians(5))))
     >>> fig = noisy_plan_figure(res)
-    >>> "under turn error normal:5 deg" in fig.subfigs[1].get_suptitle()
+    >>> "exact under turn error normal:5 deg" in fig.subfigs[1].get_suptitle()
     True
     """
     from ..planning.noisy import step_distributions_noisy
@@ -355,7 +355,7 @@ def noisy_plan_figure(result: NoisyPlanResult, which: str = "bayes") -> Figure:
     report = result.plan_result()
     option = chosen_option(report, which)
     qs = step_distributions_noisy(result.problem, result.noise, option.steps)
-    note = f"under {result.noise.describe()}: exact distributions"
+    note = f"the distributions below: exact under {result.noise.describe()}"
     if result.payoff is not None:
         note += "; E[cost] per unit payoff"
     return plan_figure(report, which, qs, note)
