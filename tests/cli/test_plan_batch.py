@@ -146,7 +146,7 @@ def test_usage_errors(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> Non
     code, _, err = run(capsys, "plan", "--batch", str(tmp_path / "missing.jsonl"))
     assert code == 2 and "cannot read" in err and "\n" == err[-1] and err.count("\n") == 1
     code, _, err = run(capsys, "plan", "key", "house", "--plot", str(tmp_path / "a.png"))
-    assert code == 2 and "--plot takes one PART" in err
+    assert code == 2 and "several parts need one file each" in err and "{name}" in err
 
 
 def test_only_best_is_the_bayes_and_most_certain(capsys: pytest.CaptureFixture[str]) -> None:

@@ -56,7 +56,7 @@ def test_plan_with_a_payoff_file(tmp_path: Path, capsys: pytest.CaptureFixture[s
         (["--turn-noise", "normal:50"], "scale"),
         (["--contact-noise", "1.5"], "contact-noise"),
         (["--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
-        (["--turn-noise", "normal:1", "--guaranteed"], "do not take noise"),
+        (["--turn-noise", "normal:1", "--guaranteed"], "unbounded"),
         (["--payoff", "missing.csv"], "no such file"),
     ],
 )

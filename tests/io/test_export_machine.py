@@ -436,8 +436,13 @@ def test_cli_stroke(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert "Bayes plan" in capsys.readouterr().out
     assert main(["plan", "house", "--min-opening", "80", "--max-opening", "70"]) == 2
     assert "less than `max_opening`" in capsys.readouterr().err
-    assert main(["plan", "house", "key", "--max-opening", "70"]) == 2
-    assert "take one PART" in capsys.readouterr().err
+    # Several parts: a part outside the stroke gets its error line, the others their plans.
+    assert main(["plan", "house", "key", "--max-opening", "50"]) == 2
+    lines = [json.loads(x) for x in capsys.readouterr().out.splitlines()]
+    assert "error" in lines[0] and "61.98 mm" in lines[0]["error"]
+    assert lines[1]["part"]["name"] == "key" and "error" not in lines[1]
+    assert main(["plan", "key", "--turn-noise", "normal:2", "--max-opening", "30"]) == 2
+    assert "needs the jaws open to 38.74 mm" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

@@ -24,9 +24,12 @@ from .specs import (
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..io.export import Stroke
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
     from ..planning.result import PlanReport
+    from .noisy import NoisyRun
+    from .outputs import PartOutputs
 
 __all__ = ["BatchFileError", "run_batch"]
 
@@ -47,6 +50,10 @@ def run_batch(
     spec: ProblemSpec,
     guaranteed: bool,
     best_only: bool,
+    *,
+    noisy: NoisyRun | None = None,
+    outputs: PartOutputs | None = None,
+    stroke: Stroke | None = None,
 ) -> int:
     """Plan each part in turn, one JSON document a line; the largest exit code of the parts.
 
@@ -65,6 +72,14 @@ def run_batch(
     that is not a bad part (a bug) makes the group planned again one part at a time, so the
     lines before it are written before it is raised.
 
+    ``noisy``: plan each part under the noise options (:class:`~.noisy.NoisyRun`), each
+    line what ``plan PART --json`` prints with them. ``outputs``: each part's ``--plot``
+    and ``--export`` files (:class:`~.outputs.PartOutputs`, a path template); a part whose
+    file is refused or cannot be written gets an error line instead of its document. With
+    either, the parts are planned one at a time (:func:`_one_at_a_time`), as with
+    ``stroke`` (the gripper's stroke: a part whose Bayes plan needs an opening outside it
+    gets an error line, :func:`~bayesgrasp.io.export.check_stroke`).
+
     Raises
     ------
     BatchFileError
@@ -78,6 +93,16 @@ def run_batch(
     # json.dumps(doc, allow_nan=False); documents are trees, so no test for cycles
     encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
+    if noisy is not None or outputs is not None or stroke is not None:
+        stage = _one_at_a_time(spec, inputs, guaranteed, best_only, noisy, outputs, encode, stroke)
+        code = 0
+        for index, (label, load) in enumerate(_batch_parts(part, more, batch), start=1):
+            try:
+                found: Any = (index, label, load())
+            except BayesGraspError as exc:
+                found = exc
+            code = _finish([(label, found)], (stage,), encode, out, code)
+        return code
     build, plan = _builder(spec), spec.planner(best_only)
     memo: dict[str, Any] = {}  # what the documents share (the provenance)
 
@@ -98,7 +123,7 @@ def run_batch(
     group: list[tuple[str, Any]] = []  # (label, its part, or the error that stopped it)
     for label, load in _batch_parts(part, more, batch):
         try:
-            found: Any = load()
+            found = load()
         except BayesGraspError as exc:
             found = exc
         except Exception:  # a bug: the lines before it first
@@ -156,6 +181,76 @@ def _finish(
     out.write("".join(text))  # a group at a time (a line at a time from stdin)
     out.flush()
     return code
+
+
+def _one_at_a_time(
+    spec: ProblemSpec,
+    inputs: dict[str, Any],
+    guaranteed: bool,
+    best_only: bool,
+    noisy: NoisyRun | None,
+    outputs: PartOutputs | None,
+    encode: Callable[[Any], str],
+    stroke: Stroke | None = None,
+) -> Callable[[tuple[int, str, Part]], _Line]:
+    """The one stage of a part planned with noise or with files: its line.
+
+    The same document as the single-part run: :meth:`NoisyRun.document` or
+    :func:`~bayesgrasp.io.plans.plan_document_json`; a file refused or not written makes
+    the line an error (exit code 2), as the single run exits 2.
+    """
+    import typer
+
+    from ..io.export import check_stroke
+    from ..io.plans import plan_document_json
+    from .common import input_files
+
+    build, plan = _builder(spec), spec.planner(best_only)
+
+    def stage(item: tuple[int, str, Part]) -> _Line:
+        index, label, found = item
+        try:
+            if outputs is not None:
+                outputs.check(found.name, index, input_files(label))
+            pb = build(found)
+            if noisy is not None:
+                done = noisy.plan(pb)
+                if stroke is not None:
+                    check_stroke(pb, done[0].bayes_plan.option, stroke)
+                text = encode(noisy.document(done, inputs))
+                missing = isinstance(done[1], str)
+                if outputs is not None:
+                    noisy.write_outputs(outputs, index, pb, done[0])
+            else:
+                result = plan(pb)
+                if stroke is not None:
+                    check_stroke(pb, result.bayes_plan, stroke)
+                found_g = guaranteed_plan(pb) if guaranteed else None
+                sure, gone = (None, found_g) if isinstance(found_g, str) else (found_g, None)
+                text = plan_document_json(
+                    result, guaranteed=sure, guaranteed_missing=gone, inputs=inputs
+                )
+                missing = gone is not None
+                if outputs is not None:
+                    write_plain_outputs(outputs, index, pb, result)
+        except typer.BadParameter as exc:  # a file refused: this part's error
+            hint = f"{exc.param_hint}: " if isinstance(exc.param_hint, str) else ""
+            text = encode({"part": label, "error": hint + exc.message, "exit_code": 2})
+            return text, 2
+        return text, 1 if missing else 0
+
+    return stage
+
+
+def write_plain_outputs(outputs: PartOutputs, index: int, pb: Problem, result: PlanReport) -> None:
+    """Write a part's ``--plot`` and ``--export`` files (the plan figure, the Bayes plan)."""
+    from ..figures.plans import plan_figure
+    from ..io.export import write_robot
+
+    def robot(path: Path) -> None:
+        write_robot(path, pb, result.bayes_plan)
+
+    outputs.write(pb.part.name, index, lambda: plan_figure(result), robot)
 
 
 def _builder(spec: ProblemSpec) -> Any:

@@ -1,12 +1,17 @@
 """``plan --turn-noise / --contact-noise / --payoff``: the Bayes plan under noise (and a payoff).
 
 The options are declared in :mod:`.options` (``plan`` and ``simulate`` load this module only
-when they are given); this module parses them, calls
-:func:`~bayesgrasp.planning.noisy.plan_noisy` and prints.
+when they are given); this module parses them (:meth:`NoisyRun.of`), calls
+:func:`~bayesgrasp.planning.noisy.plan_noisy` and prints. ``plan`` gives every one of its
+surfaces the noise-aware plan: the table or ``--json``, ``--only best``, ``--guaranteed``
+(:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`), ``--plot`` (the distributions
+under the noise), ``--export`` (the robot file, with the noise model in its header) and
+several parts or ``--batch`` (:func:`~bayesgrasp.cli.batch.run_batch`, one document a line).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -16,9 +21,17 @@ from .common import emit_json
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..io.export import Stroke
     from ..model.noise import NoiseModel, TurnNoise
+    from ..model.payoff import Payoff
+    from ..model.problem import Problem
+    from ..planning.guaranteed import GuaranteedPlan
     from ..planning.noisy import NoisyPlanResult
+    from .outputs import PartOutputs
     from .specs import ProblemSpec
+
+#: A noise-aware plan and its guaranteed plan (or the reason there is none, or not asked).
+Planned = tuple["NoisyPlanResult", "GuaranteedPlan | str | None"]
 
 
 def asked(turn: str | None, contact: float | None, payoff: Path | None) -> bool:
@@ -46,11 +59,101 @@ def noise_model(turn: str | None, contact: float | None) -> NoiseModel:
     return NoiseModel(turn_noise(turn), contact or 0.0)
 
 
-def noisy_document(res: NoisyPlanResult) -> dict[str, Any]:
+@dataclass(frozen=True, slots=True)
+class NoisyRun:
+    """The noise options of a ``plan`` run, parsed once for all its parts."""
+
+    noise: NoiseModel
+    payoff: Payoff | None
+    max_actions: int | None
+    best_only: bool
+    guaranteed: bool
+
+    @classmethod
+    def of(
+        cls,
+        spec: ProblemSpec,
+        turn: str | None,
+        contact: float | None,
+        payoff: Path | None,
+        best_only: bool = False,
+        guaranteed: bool = False,
+    ) -> NoisyRun:
+        """Parse and check the options before any work (bad input: exit 2, one line).
+
+        ``--guaranteed`` under a normal turn error is refused: no plan of two or more
+        actions can guarantee under an unbounded error
+        (:data:`~bayesgrasp.planning.robust.UNBOUNDED_GUARANTEE`).
+        """
+        from ..model.payoff import read_payoff
+        from ..planning.robust import UNBOUNDED_GUARANTEE
+
+        if spec.method.value != "exact":
+            raise typer.BadParameter(
+                "the noise-aware planner seeds from the exact planner; drop --method",
+                param_hint="--method",
+            )
+        noise = noise_model(turn, contact)
+        if guaranteed and not noise.turn.exact and noise.turn.kind == "normal":
+            raise typer.BadParameter(UNBOUNDED_GUARANTEE, param_hint="--guaranteed")
+        u = read_payoff(payoff) if payoff is not None else None
+        return cls(noise, u, spec.max_actions, best_only, guaranteed)
+
+    def plan(self, pb: Problem) -> Planned:
+        """The noise-aware plans of a problem, and its guaranteed plan under the noise."""
+        from ..planning.noisy import plan_noisy
+        from ..planning.robust import plan_guaranteed_noisy
+
+        res = plan_noisy(pb, self.noise, self.payoff, self.max_actions)
+        if self.best_only:
+            res = res.best_only()
+        if not self.guaranteed:
+            return res, None
+        found = plan_guaranteed_noisy(pb, self.noise)
+        return res, found if found.status == "ok" else str(found.reason or "no guaranteed plan")
+
+    def document(self, done: Planned, inputs: dict[str, Any] | None = None) -> dict[str, Any]:
+        """The plan document (``plan --json``) of a planned part."""
+        res, found = done
+        sure, missing = (None, found) if isinstance(found, str) else (found, None)
+        return noisy_document(res, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+
+    def robot_metadata(self, res: NoisyPlanResult) -> dict[str, Any]:
+        """What a robot file of the plan says about the noise it was planned for."""
+        meta: dict[str, Any] = {"noise": self.noise.to_json()}
+        if res.payoff is not None:
+            meta["payoff"] = res.payoff.tolist()
+        return meta
+
+    def write_outputs(
+        self, outputs: PartOutputs, index: int, pb: Problem, res: NoisyPlanResult
+    ) -> None:
+        """Write the part's ``--plot`` (under the noise) and ``--export`` files."""
+        from ..figures.plans import noisy_plan_figure
+        from ..io.export import write_robot
+
+        def robot(path: Path) -> None:
+            write_robot(path, pb, res.bayes_plan.option, self.robot_metadata(res))
+
+        outputs.write(pb.part.name, index, lambda: noisy_plan_figure(res), robot)
+
+
+def noisy_document(
+    res: NoisyPlanResult,
+    *,
+    guaranteed: GuaranteedPlan | None = None,
+    guaranteed_missing: str | None = None,
+    inputs: dict[str, Any] | None = None,
+) -> dict[str, Any]:
     """The plan document of a noisy result: the usual fields plus the noise and payoff."""
     from ..io.plans import json_float, plan_document
 
-    doc = plan_document(res.plan_result())
+    doc = plan_document(
+        res.plan_result(),
+        guaranteed=guaranteed,
+        guaranteed_missing=guaranteed_missing,
+        inputs=inputs,
+    )
     bayes = res.bayes_plan
     doc["expected_payoff"] = bayes.expected_payoff
     doc["expected_cost_per_unit_payoff"] = json_float(bayes.evaluation.expected_cost)
@@ -84,25 +187,40 @@ def noisy_text(res: NoisyPlanResult) -> str:
 def plan_noisy_command(
     part: Part,
     spec: ProblemSpec,
-    turn: str | None,
-    contact: float | None,
-    payoff: Path | None,
+    run: NoisyRun,
     as_json: bool,
-) -> None:
-    """``plan`` with the noise and payoff options: plan, print."""
-    from ..model.payoff import read_payoff
-    from ..planning.noisy import plan_noisy
+    outputs: PartOutputs | None = None,
+    inputs: dict[str, Any] | None = None,
+    stroke: Stroke | None = None,
+) -> int:
+    """``plan PART`` with the noise and payoff options: plan, print, write; the exit code.
 
-    if spec.method.value != "exact":
-        raise typer.BadParameter(
-            "the noise-aware planner seeds from the exact planner; drop --method",
-            param_hint="--method",
-        )
-    noise = noise_model(turn, contact)
+    ``stroke``: the noise-aware Bayes plan must fit the gripper's stroke
+    (:func:`~bayesgrasp.io.export.check_stroke`).
+
+    1 when a guaranteed plan was asked for and there is none (after printing why).
+    """
+    from .. import report
+
+    if outputs is not None:
+        outputs.check(part.name, 1)
     pb = spec.build(part)
-    u = read_payoff(payoff) if payoff is not None else None
-    res = plan_noisy(pb, noise, u, spec.max_actions)
+    done = run.plan(pb)
+    res, found = done
+    if stroke is not None:
+        from ..io.export import check_stroke
+
+        check_stroke(pb, res.bayes_plan.option, stroke)
     if as_json:
-        emit_json(noisy_document(res))
+        emit_json(run.document(done, inputs))
     else:
         typer.echo(noisy_text(res))
+        if isinstance(found, str):
+            typer.echo(f"Guaranteed plan: none ({found})")
+        elif found is not None:
+            typer.echo(report.guaranteed_text(found))
+            if not run.noise.exact:
+                typer.echo(f"(guaranteed under {run.noise.describe()})")
+    if outputs is not None:
+        run.write_outputs(outputs, 1, pb, res)
+    return 1 if isinstance(found, str) else 0

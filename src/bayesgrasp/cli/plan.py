@@ -10,14 +10,7 @@ from typing import Annotated
 
 import typer
 
-from .common import (
-    check_export,
-    check_figure_path,
-    check_outputs,
-    emit_json,
-    input_files,
-    save_figure,
-)
+from .common import check_export, emit_json, input_files
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
@@ -40,6 +33,16 @@ from .specs import PartSpec, ProblemSpec, SenseSpec, guaranteed_plan, run_inputs
 app = command_app()
 
 
+def _given(ctx: typer.Context, *names: str) -> list[str]:
+    """The options among ``names`` (parameter names) given on the command line, as typed."""
+    flags = {p.name: p.opts[0] for p in ctx.command.params if p.opts}
+    return [
+        flags.get(n, n)
+        for n in names
+        if (source := ctx.get_parameter_source(n)) is not None and source.name != "DEFAULT"
+    ]
+
+
 class Only(enum.StrEnum):
     """Which plans ``plan`` reports."""
 
@@ -52,7 +55,9 @@ GuaranteedOpt = Annotated[
     typer.Option(
         "--guaranteed",
         help="Also give the shortest plan that orients every initial orientation "
-        "(up to the transfer functions' period).",
+        "(up to the transfer functions' period). Under uniform turn noise of half-width A: "
+        "a plan whose turns tolerate A; under contact noise, one that holds whichever jaw "
+        "touches first; normal turn noise is refused (unbounded error).",
     ),
 ]
 PlotOpt = Annotated[
@@ -61,7 +66,8 @@ PlotOpt = Annotated[
         "--plot",
         metavar="FILE",
         help="Also draw the part, its diameter function and the Bayes plan's distributions "
-        "into FILE (.png, .svg, .pdf).",
+        "(under the noise, with noise options) into FILE (.png, .svg, .pdf). Several parts: "
+        "FILE must hold {name}, the part's name (and may hold {index}, its place in the run).",
     ),
 ]
 
@@ -71,10 +77,11 @@ ExportOpt = Annotated[
         "--export",
         metavar="FILE",
         help="Also write the Bayes plan for a robot into FILE (.csv or .json): per step the "
-        "action, the absolute gripper angle (deg and rad) and the jaw widths to expect. With "
-        "--sense: the policy as a state machine, a row per state and reading range [lo, hi) "
-        "leading to the next state, a declaration or a rejection (units in the CSV's # lines "
-        "and the JSON's units).",
+        "action, the absolute gripper angle (deg and rad) and the jaw widths to expect (with "
+        "noise options, the noise-aware plan and its noise model). With --sense: the policy as "
+        "a state machine, a row per state and reading range [lo, hi) leading to the next "
+        "state, a declaration or a rejection (units in the CSV's # lines and the JSON's "
+        "units). Several parts: FILE must hold {name}, as --plot.",
     ),
 ]
 
@@ -112,6 +119,7 @@ BatchOpt = Annotated[
 @functools.partial(part_options, optional=True)
 @problem_options()
 def plan(
+    ctx: typer.Context,
     part: PartSpec,
     spec: ProblemSpec,
     more_parts: MorePartsArg = None,
@@ -138,33 +146,50 @@ def plan(
     With --sense: the policy of least expected cost that branches on the jaw widths read
     after each action (and tells the candidate parts apart), beside the sensorless Bayes plan.
 
+    With --turn-noise, --contact-noise or --payoff: the noise-aware Bayes plan, through
+    every other option (--only, --guaranteed, --plot, --export, several parts, --batch).
+
     Several PARTs or --batch: each part planned in turn, one JSON document a line (as
     --json prints it); a part that fails gets {"part": ..., "error": ..., "exit_code": ...}
-    on its line and the others go on; the exit code is the largest of the parts'.
+    on its line and the others go on; the exit code is the largest of the parts'. --plot
+    and --export then write one file a part, named by a path with {name}.
     """
     from .. import report
     from ..io.plans import plan_document
     from . import noisy
+    from .outputs import PartOutputs
 
     stroke = None
     if max_opening is not None or min_opening is not None:
         from ..io.export import Stroke
 
         stroke = Stroke(min_opening or 0.0, math.inf if max_opening is None else max_opening)
-    if noisy.asked(turn_noise, contact_noise, payoff):
-        if sense is not None or guaranteed or plot_file is not None or export is not None:
-            raise typer.BadParameter(
-                "--sense, --guaranteed, --plot and --export do not take noise yet"
-            )
-        if stroke is not None:
-            raise typer.BadParameter("--max-opening and --min-opening do not take noise yet")
-        if part.part is None or batch is not None or more_parts:
-            raise typer.BadParameter("noise options take one PART (no --batch)")
-        noisy.plan_noisy_command(part.load(), spec, turn_noise, contact_noise, payoff, as_json)
-        return
+    if sense is None and (also or part_prior is not None):
+        raise typer.BadParameter("--also and --part-prior need --sense")
+    if sense is None and (given := _given(ctx, "max_actions", "fold_below")):
+        need = "needs" if len(given) == 1 else "need"
+        raise typer.BadParameter(f"{' and '.join(given)} {need} --sense")
+    noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
+    if noise_asked and sense is not None:
+        raise typer.BadParameter(
+            "--sense does not take --turn-noise, --contact-noise or --payoff yet"
+        )
     if sense is not None:
         if part.part is None or batch is not None:
             raise typer.BadParameter("--sense needs PART and takes no --batch")
+        refused = [
+            name
+            for name, on in (
+                ("--guaranteed", guaranteed),
+                ("--plot", plot_file is not None),
+                ("--only best", only is Only.best),
+                ("--method", spec.method.value != "exact"),
+                ("--max-squeezes (the policy's depth is --max-actions)", spec.max_actions),
+            )
+            if on
+        ]
+        if refused:
+            raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         from .sensing import plan_policy_command
 
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
@@ -173,30 +198,46 @@ def plan(
         sensing = SenseSpec(sense, more, part_prior, max_actions)
         plan_policy_command(part, spec, sensing, as_json, fold_below, export, stroke)
         return
-    if also or part_prior is not None:
-        raise typer.BadParameter("--also and --part-prior need --sense")
-    if batch is not None or more_parts:
-        if plot_file is not None:
-            raise typer.BadParameter("--plot takes one PART", param_hint="--plot")
-        if stroke is not None:
-            raise typer.BadParameter("--max-opening and --min-opening take one PART")
+    several = batch is not None or bool(more_parts)
+    if part.part is None and not several:
+        raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
+    run = (
+        noisy.NoisyRun.of(spec, turn_noise, contact_noise, payoff, only is Only.best, guaranteed)
+        if noise_asked
+        else None
+    )
+    files = input_files(part.part, spec.prior, batch, payoff)
+    outputs = PartOutputs.of(plot_file, export, force, files, several)
+    if several:
         from .batch import BatchFileError, run_batch
 
         try:
-            code = run_batch(part, more_parts or [], batch, spec, guaranteed, only is Only.best)
+            code = run_batch(
+                part,
+                more_parts or [],
+                batch,
+                spec,
+                guaranteed,
+                only is Only.best,
+                noisy=run,
+                outputs=outputs,
+                stroke=stroke,
+            )
         except BatchFileError as exc:
             raise typer.BadParameter(str(exc), param_hint="--batch") from None
         if code:
             raise typer.Exit(code)
         return
-    if part.part is None:
-        raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
-    if plot_file is not None:
-        check_figure_path(plot_file)
-        check_outputs([plot_file], input_files(part.part, spec.prior), force, "--plot")
-    if export is not None:
-        check_export(export, input_files(part.part, spec.prior), force)
-    pb = spec.build(part.load())
+    loaded = part.load()
+    inputs = run_inputs(part, spec)
+    if run is not None:
+        code = noisy.plan_noisy_command(loaded, spec, run, as_json, outputs, inputs, stroke)
+        if code:
+            raise typer.Exit(code)
+        return
+    if outputs is not None:
+        outputs.check(loaded.name, 1)
+    pb = spec.build(loaded)
     result = spec.plan(pb, best_only=only is Only.best)
     if stroke is not None:
         from ..io.export import check_stroke
@@ -205,7 +246,6 @@ def plan(
     found = guaranteed_plan(pb) if guaranteed else None
     sure, missing = (None, found) if isinstance(found, str) else (found, None)
     if as_json:
-        inputs = run_inputs(part, spec)
         emit_json(plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs))
     else:
         typer.echo(report.plan_table(result, spec.max_actions))
@@ -213,15 +253,9 @@ def plan(
             typer.echo(report.guaranteed_text(sure))
         if missing is not None:
             typer.echo(f"Guaranteed plan: none ({missing})")
-    if plot_file is not None:
-        from ..figures.plots import plan_figure
+    if outputs is not None:
+        from .batch import write_plain_outputs
 
-        save_figure(plan_figure(result), plot_file)
-        typer.echo(f"bayesgrasp: wrote {plot_file}", err=True)
-    if export is not None:
-        from ..io.export import write_robot
-
-        write_robot(export, pb, result.bayes_plan)
-        typer.echo(f"bayesgrasp: wrote {export}", err=True)
+        write_plain_outputs(outputs, 1, pb, result)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)

@@ -26,12 +26,15 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure, SubFigure
 
+    from ..planning.noisy import NoisyPlanResult
+
 __all__ = [
     "chosen_option",
     "draw_evolution",
     "draw_probability_labels",
     "evolution_figure",
     "label_levels",
+    "noisy_plan_figure",
     "plan_figure",
     "step_distributions",
     "step_title",
@@ -42,6 +45,8 @@ FloatArray = NDArray[np.float64]
 #: Font size (points) and padding of the probability labels above the stems.
 LABEL_POINTS = 6.94
 LABEL_LIFT = 4.0
+#: Probabilities below this get a stem but no label (a noisy plan spreads over every state).
+LABEL_BELOW = 0.005
 
 
 def step_distributions(
@@ -140,9 +145,20 @@ def draw_probability_labels(
 
 
 def draw_evolution(
-    fig: Figure | SubFigure, problem: Problem, option: PlanOption, label: str
+    fig: Figure | SubFigure,
+    problem: Problem,
+    option: PlanOption,
+    label: str,
+    distributions: Sequence[FloatArray] | None = None,
+    note: str | None = None,
 ) -> list[Axes]:
-    """Panels (d): the prior, then the distribution after each step."""
+    """Panels (d): the prior, then the distribution after each step.
+
+    ``distributions``: the (K,) distribution over the states after each step, in place of
+    the noise-free ones (:func:`step_distributions`), for example under a noise model;
+    ``note`` is then added to the title (what they are). States of probability below
+    :data:`LABEL_BELOW` get a stem but no label.
+    """
     n = option.n_actions + 1
     axes = fig.subplots(n, 1, sharex=True, squeeze=False)[:, 0]
     margin = 6.0  # degrees each side: a stem or the goal at 0 shows whole
@@ -158,13 +174,19 @@ def draw_evolution(
     )
     ax.set_ylim(0, max(float(prior_mass.max()) * 1.3, 1e-9))
     top = 1.22
-    for k, (where, probs) in enumerate(step_distributions(problem, option.steps)):
+    if distributions is None:
+        dists = step_distributions(problem, option.steps)
+    else:
+        stable = problem.states.stable
+        dists = [(stable[q > 0], np.asarray(q)[q > 0]) for q in distributions]
+    for k, (where, probs) in enumerate(dists):
         ax = axes[k + 1]
         ax.vlines(np.degrees(where), 0, probs, colors=BAR_COLOR, lw=3, gid="distribution")
         ax.plot(np.degrees(where), probs, "o", color=BAR_COLOR, ms=4)
         ax.set_ylim(0, top)
         degree_axis(ax, "x", 360.0, margin=margin)
-        draw_probability_labels(ax, np.degrees(where), probs, xlim, top)
+        shown = probs >= LABEL_BELOW
+        draw_probability_labels(ax, np.degrees(where[shown]), probs[shown], xlim, top)
         ax.set_title(step_title(problem, option.steps[k], k), fontsize="medium")
     last = axes[-1]
     goal = math.degrees(option.final_orientation)
@@ -193,7 +215,7 @@ def draw_evolution(
     fig.suptitle(
         f"{problem.part.name}: the {label} plan, {option.n_actions} action(s): "
         f"P(success) = {option.success_probability:.3f}, "
-        f"E[cost] = {option.expected_cost:.3g}"
+        f"E[cost] = {option.expected_cost:.3g}" + ("" if note is None else f"\n{note}")
     )
     return list(axes)
 
@@ -246,7 +268,12 @@ def chosen_option(report: PlanReport | Any, which: str) -> PlanOption:
     return cast("PlanOption", option)
 
 
-def plan_figure(report: PlanReport, which: str = "bayes") -> Figure:
+def plan_figure(
+    report: PlanReport,
+    which: str = "bayes",
+    distributions: Sequence[FloatArray] | None = None,
+    note: str | None = None,
+) -> Figure:
     """The part, its diameter function and the evolution of a plan, in one figure.
 
     The figure of ``bayesgrasp plan --plot FILE``: (a) and (b) on top, (d) below.
@@ -257,6 +284,9 @@ def plan_figure(report: PlanReport, which: str = "bayes") -> Figure:
         What a planner returned (its problem and its plans).
     which : str, optional
         ``"bayes"`` (default) or ``"most-certain"``.
+    distributions, note : optional
+        The distributions after each step to draw instead of the noise-free ones, and what
+        they are (see :func:`draw_evolution`; :func:`noisy_plan_figure`).
 
     Returns
     -------
@@ -285,5 +315,47 @@ def plan_figure(report: PlanReport, which: str = "bayes") -> Figure:
     ax_part, ax_d = top.subplots(1, 2, width_ratios=[1.0, 1.5])
     draw_part(ax_part, pb, 0.0)
     draw_diameter(ax_d, pb, option.first_angle, option.steps[0].kind)
-    draw_evolution(bottom, pb, option, PLAN_LABELS[which])
+    draw_evolution(bottom, pb, option, PLAN_LABELS[which], distributions, note)
     return fig
+
+
+def noisy_plan_figure(result: NoisyPlanResult, which: str = "bayes") -> Figure:
+    """The plan figure of a noise-aware plan: its distributions under the noise.
+
+    As :func:`plan_figure`, but each panel of (d) draws the exact distribution over the
+    stable orientations after that step under the result's noise model
+    (:func:`~bayesgrasp.planning.noisy.step_distributions_noisy`), the title the plan's
+    success probability and cost under the noise, and the noise model.
+
+    Parameters
+    ----------
+    result : NoisyPlanResult
+        What :func:`~bayesgrasp.planning.noisy.plan_noisy` returned.
+    which : str, optional
+        ``"bayes"`` (default) or ``"most-certain"``.
+
+    Returns
+    -------
+    Figure
+
+    Examples
+    --------
+    >>> import math
+    >>> from bayesgrasp.geometry import Part
+    >>> from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    >>> from bayesgrasp.planning.noisy import plan_noisy
+    >>> pb = Problem.build(Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)]))
+    >>> res = plan_noisy(pb, NoiseModel(TurnNoise("normal", math.radians(5))))
+    >>> fig = noisy_plan_figure(res)
+    >>> "exact under turn error normal:5 deg" in fig.subfigs[1].get_suptitle()
+    True
+    """
+    from ..planning.noisy import step_distributions_noisy
+
+    report = result.plan_result()
+    option = chosen_option(report, which)
+    qs = step_distributions_noisy(result.problem, result.noise, option.steps)
+    note = f"the distributions below: exact under {result.noise.describe()}"
+    if result.payoff is not None:
+        note += "; E[cost] per unit payoff"
+    return plan_figure(report, which, qs, note)

@@ -76,7 +76,7 @@ import csv
 import io
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -400,12 +400,17 @@ def _machine(problems: Problem | Sequence[Problem], strategy: PlanOption | Polic
 
 
 def write_robot(
-    path: str | Path, problem: Problem | Sequence[Problem], option: PlanOption | Policy
+    path: str | Path,
+    problem: Problem | Sequence[Problem],
+    option: PlanOption | Policy,
+    metadata: Mapping[str, Any] | None = None,
 ) -> Path:
     """Write a plan or a policy for a robot: CSV or JSON by the file's ending.
 
     A plan: one row a step (:func:`robot_csv`, :func:`robot_document`). A policy (with its
     problems, one per candidate part): the state machine of :mod:`bayesgrasp.io.machine`.
+    ``metadata`` (JSON-ready values, such as the noise model the strategy was made for): in
+    the JSON document as more members, in the CSV as ``# KEY: JSON`` lines above the header.
 
     Raises
     ------
@@ -416,6 +421,7 @@ def write_robot(
     kind = target.suffix.lstrip(".").lower()
     if kind not in EXPORT_FORMATS:
         raise ExportError(f"the robot file must end in .csv or .json; got {target.name!r}")
+    meta = dict(metadata or {})
     if not isinstance(option, PlanOption):
         from .machine import machine_csv, machine_document, policy_machine
 
@@ -423,13 +429,16 @@ def write_robot(
         if kind == "csv":
             text = machine_csv(machine)
         else:
-            text = json.dumps(machine_document(machine), indent=2, allow_nan=False) + "\n"
+            text = json.dumps(machine_document(machine) | meta, indent=2, allow_nan=False) + "\n"
     else:
         pb = problem if isinstance(problem, Problem) else problem[0]
         if kind == "csv":
             text = robot_csv(pb, option)
         else:
-            text = json.dumps(robot_document(pb, option), indent=2, allow_nan=False) + "\n"
+            text = json.dumps(robot_document(pb, option) | meta, indent=2, allow_nan=False) + "\n"
+    if kind == "csv":
+        head = "".join(f"# {k}: {json.dumps(v, allow_nan=False)}\n" for k, v in meta.items())
+        text = head + text
     try:
         target.write_text(text, encoding="utf-8")
     except OSError as exc:

@@ -57,13 +57,17 @@ The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
   cheapest attempt of ``k + 1`` actions, at the highest attainable payoff (the largest entry
   of ``u``; for today's goal without contact noise, the noise-free bound: averaging over
   errors cannot beat the best deterministic plan, so ``p <= max prior mass of an arc of the
-  period``), already costs more than the best plan found;
+  period``), already costs more than the best plan found, and not before the length of
+  the noise-free most certain plan (so the most certain plan under the noise is chosen
+  among at least the lengths the exact planner reports);
 - not guaranteed: the global maximum over all turns at once (the payoff is a multimodal
   function of the turns). The tests compare the planner with a brute-force grid over the
   turns of every plan of up to 3 actions, within the grid's resolution bound
   ``peak_density * h * (k - 1) / 2`` (``|d f / d alpha_m| <= sup density``).
 
-With no noise at all the planner returns the exact planner's plans, re-evaluated.
+With no noise at all (and the problem's goal, no payoff) the planner returns the exact
+planner's result as it is: the same options (tolerances included), Bayes and most certain
+plans, each evaluated by the matrices for the noise-specific fields.
 """
 
 from __future__ import annotations
@@ -94,7 +98,14 @@ from .result import (
     short_turns,
 )
 
-__all__ = ["NoisyEvaluation", "NoisyOption", "NoisyPlanResult", "evaluate_plan", "plan_noisy"]
+__all__ = [
+    "NoisyEvaluation",
+    "NoisyOption",
+    "NoisyPlanResult",
+    "evaluate_plan",
+    "plan_noisy",
+    "step_distributions_noisy",
+]
 
 FloatArray = NDArray[np.float64]
 
@@ -212,6 +223,30 @@ class NoisyPlanResult:
             self.bayes,
             self.most_certain,
             "noisy",
+        )
+
+    def best_only(self) -> NoisyPlanResult:
+        """The same result with only the Bayes and the most certain plans (in length order).
+
+        As :meth:`~bayesgrasp.planning.result.PlanResult.best_only`: one plan when they are
+        the same.
+
+        Examples
+        --------
+        >>> from bayesgrasp.geometry.polygon import Part
+        >>> from bayesgrasp.model.noise import TurnNoise
+        >>> rect = Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)])
+        >>> res = plan_noisy(Problem.build(rect), NoiseModel(TurnNoise("uniform", 0.05)))
+        >>> best = res.best_only()
+        >>> [o.option.n_actions for o in best.options], best.bayes, best.most_certain
+        ([2], 0, 0)
+        """
+        keep = sorted({self.bayes, self.most_certain})
+        return dataclasses.replace(
+            self,
+            options=tuple(self.options[i] for i in keep),
+            bayes=keep.index(self.bayes),
+            most_certain=keep.index(self.most_certain),
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -355,6 +390,32 @@ def evaluate_plan(
     u = None if payoff is None else as_vector(payoff, problem.states)
     ev = _Evaluator(problem, noise, u)
     return ev.evaluate([s.kind for s in steps], [s.alpha for s in steps])
+
+
+def step_distributions_noisy(
+    problem: Problem, noise: NoiseModel, steps: Sequence[PlanStep]
+) -> list[FloatArray]:
+    """The distribution over the states after each step of a plan, under the noise.
+
+    Entry ``k`` is the (K,) distribution after step ``k + 1`` (in that step's gripper
+    frame), by the exact transition matrices: what a figure of the plan under the noise
+    draws.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.noise import TurnNoise
+    >>> pb = Problem.build(Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)]))
+    >>> steps = plan_exact(pb).bayes_plan.steps
+    >>> qs = step_distributions_noisy(pb, NoiseModel(TurnNoise("normal", 0.2)), steps)
+    >>> len(qs) == len(steps), [round(float(q.sum()), 12) for q in qs]
+    (True, [1.0, 1.0])
+    """
+    if not steps:
+        raise PlanningError("a plan needs at least one step")
+    plan_actions(problem, [s.kind for s in steps])
+    ev = _Evaluator(problem, noise, None)
+    return ev.forward([s.kind for s in steps], [s.alpha for s in steps])
 
 
 @dataclass(slots=True)
@@ -639,11 +700,15 @@ def plan_noisy(
     u = None if payoff is None else as_vector(payoff, problem.states)
     pl = _Planner(problem, noise, u)
     ev = pl.ev
+    if noise.exact and u is None and not all_lengths:
+        return _noise_free(problem, noise, max_actions, pl)
     exact = ev if noise.exact else _Evaluator(problem, NoiseModel(), u)
     cost = problem.cost
     kinds_all = problem.action_kinds
     limit = min(max_plan_length(problem), max_actions or max_plan_length(problem))
     seeds = _seeds(problem, noise, max_actions)
+    # The noise-free planner's lengths (up to its most certain plan) are always searched.
+    reach = max(len(c.kinds) for c in seeds if c.source == "exact")
     bound = _payoff_bound(problem, ev, u)
     first_kind = min(kinds_all, key=lambda t: cost.action_cost(t, first=True))
     next_kind = min(kinds_all, key=lambda t: cost.action_cost(t))
@@ -708,7 +773,7 @@ def plan_noisy(
         options.append(_noisy_option(problem, exact, best))
         best_cost = min(best_cost, best.ev.expected_cost)  # type: ignore[union-attr]
         cheapest_next = cost.expected_cost((first_kind,) + (next_kind,) * k, bound)
-        if not all_lengths and cheapest_next >= best_cost * (1.0 - 1e-12):
+        if not all_lengths and k >= reach and cheapest_next >= best_cost * (1.0 - 1e-12):
             break
     plans = tuple(o.option for o in options)
     bayes, most = choose_indices(plans, pl.p_tol)
@@ -722,6 +787,35 @@ def plan_noisy(
         h = turn.scale / GRID_PER_SIGMA
         eps = turn.curvature_bound * h * h / 8.0
     return NoisyPlanResult(problem, noise, u, tuple(options), bayes, most, ev.evaluated, eps, bound)
+
+
+def _noise_free(
+    problem: Problem, noise: NoiseModel, max_actions: int | None, pl: _Planner
+) -> NoisyPlanResult:
+    """Without noise, for the problem's goal: the exact planner's result, evaluated.
+
+    The exact planner is exact for this case (its plans are the best of each length, up to
+    the most certain), so its options are reported as they are, tolerances included, and
+    each is evaluated by the matrices for the noise-specific fields.
+    """
+    res = plan_exact(problem, max_actions)
+    options = []
+    for o in res.options:
+        prefer = int(nearest_state(problem.states, np.array([o.final_orientation]))[0])
+        e = pl.ev.evaluate(o.kinds, [s.alpha for s in o.steps], prefer)
+        options.append(NoisyOption(o, e, e.expected_payoff, "exact"))
+    bound = _payoff_bound(problem, pl.ev, None)
+    return NoisyPlanResult(
+        problem,
+        noise,
+        None,
+        tuple(options),
+        res.bayes,
+        res.most_certain,
+        pl.ev.evaluated,
+        0.0,
+        bound,
+    )
 
 
 def _noisy_option(problem: Problem, exact: _Evaluator, c: _Cand) -> NoisyOption:
