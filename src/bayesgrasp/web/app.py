@@ -409,16 +409,48 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     spec = problem_spec(req)
     part = service.part(req.part)
     pb = build_problem(part, req, spec)
-    result = spec.plan(pb)
-    found = guaranteed_plan(pb) if req.guaranteed else None
-    sure, missing = (None, found) if isinstance(found, str) else (found, None)
-    inputs = run_inputs(None, spec)  # the provenance the command line writes
-    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+    if req.noisy:
+        doc = noisy_plan_document(pb, req)
+    else:
+        result = spec.plan(pb)
+        found = guaranteed_plan(pb) if req.guaranteed else None
+        sure, missing = (None, found) if isinstance(found, str) else (found, None)
+        inputs = run_inputs(None, spec)  # the provenance the command line writes
+        doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
     if service.gallery is not None:
         options = req.model_dump(exclude={"part"}, exclude_defaults=True)
         bayes = doc["options"][doc["bayes"]] if doc["options"] else {}
         service.gallery.add(part.name, doc["part"]["vertices"], options, bayes)
     return doc
+
+
+def noisy_plan_document(pb: Problem, req: PlanRequest) -> dict[str, Any]:
+    """``bayesgrasp plan PART --turn-noise ... --contact-noise ... --payoff FILE --json``.
+
+    The same calls as the command line (:func:`~bayesgrasp.planning.noisy.plan_noisy`,
+    :func:`bayesgrasp.cli.noisy.noisy_document`), with the payoff given inline.
+    """
+    from ..cli.noisy import noisy_document
+    from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
+    from ..planning.noisy import plan_noisy
+
+    if req.method != "exact":
+        raise LimitError(
+            422, "`method`: the noise-aware planner seeds from the exact planner; drop `method`"
+        )
+    if req.guaranteed:
+        raise LimitError(422, "`guaranteed` does not take noise yet")
+    turn = TurnNoise() if req.turn_noise is None else parse_turn_noise(req.turn_noise)
+    noise = NoiseModel(turn, req.contact_noise or 0.0)
+    payoff = None
+    if req.payoff is not None:
+        import numpy as np
+
+        from ..model.payoff import Payoff
+
+        degs, values = req.payoff.entries()
+        payoff = Payoff(np.radians(degs), np.array(values), req.payoff.default, req.payoff.name)
+    return noisy_document(plan_noisy(pb, noise, payoff, req.max_actions))
 
 
 def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
