@@ -449,7 +449,7 @@ def noisy_plan_document(pb: Problem, req: PlanRequest) -> dict[str, Any]:
         from ..model.payoff import Payoff
 
         degs, values = req.payoff.entries()
-        payoff = Payoff(np.radians(degs), np.array(values), req.payoff.default, req.payoff.name)
+        payoff = Payoff(np.radians(degs), np.array(values), req.payoff.default, "request")
     return noisy_document(plan_noisy(pb, noise, payoff, req.max_actions))
 
 

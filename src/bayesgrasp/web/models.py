@@ -130,7 +130,6 @@ class PayoffIn(_Strict):
         '{"DEG": V, ...} or a list [{"orientation_deg": DEG, "value": V}, ...].',
     )
     default: Unit = Field(0.0, description="Payoff of every state not listed.")
-    name: Name = Field("payoff", description="A label for the payoff (the file name on the CLI).")
 
     @field_validator("payoff", mode="before")
     @classmethod
