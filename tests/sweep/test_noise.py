@@ -266,3 +266,17 @@ def test_sweep_help_names_only_its_own_options(cli_run: CliRun) -> None:
     assert "--plan FILE" not in flat  # sweep has no --plan
     code, text, _ = cli_run(["simulate", "--help"])
     assert "--plan FILE" in " ".join(text.split())  # simulate has it
+
+
+def test_report_of_noisy_rows(parts: list[str]) -> None:
+    import statistics
+
+    from bayesgrasp.sweep.report import report_html
+
+    options = noisy(turn_noise="normal:2", contact_noise=0.1)
+    rows = run_chunk([*map(_source, parts)], options).rows
+    page = report_html(rows)
+    assert f"<td>noise: turn_noise normal:2, contact_noise 0.1</td><td>{len(parts)}</td>" in page
+    mean = statistics.fmean(r["bayes_payoff"] for r in rows)
+    assert f"<td>Bayes plan expected payoff: mean</td><td>{mean:.4g}</td>" in page
+    assert "expected payoff" not in report_html(run_chunk([_source(parts[0])], SweepOptions()).rows)
