@@ -13,7 +13,9 @@ Cases:
   command's ``main``; its first call imports the command's modules, so later calls are
   timed too), beside the in-process study; also the batch one part at a time and the study
   planned in groups stage by stage, as the batch plans its lines (the like-for-like
-  comparison of that technique);
+  comparison of that technique). With ``--before REV`` (a commit, or a ``src`` folder), the
+  same runs of that version alternate with this branch's, and the two are shown side by
+  side;
 - ``bfs``: the breadth-first baseline (``planning/bfs.py``) on the same 2000 polygons, beside
   the exact planner on the same problems (this branch only);
 - ``circle N``: N random points on the unit circle (N = 10^3, 10^4, 10^5);
@@ -26,7 +28,9 @@ For the large parts: the hull (``Part.from_points``), the problem, and the exact
 reported as such. The machine may be shared: the figures are floors, compare them side by
 side.
 
-Run: ``.venv/bin/python benchmarks/bench_limits.py [--ref /work/wt/ref373] [--repeat 3]``
+Run: ``.venv/bin/python benchmarks/bench_limits.py [--ref /work/wt/ref373] [--repeat 3]``;
+the batch beside an earlier commit:
+``.venv/bin/python benchmarks/bench_limits.py --only batch --before HEAD~1 --repeat 5``
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ import math
 import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -228,6 +233,11 @@ def main() -> None:
     ap.add_argument(
         "--only", default="", help="comma-separated groups to run: study, bfs, batch, large"
     )
+    ap.add_argument(
+        "--before",
+        default=None,
+        help="batch: also time this version (a git commit, or a src folder), run by run",
+    )
     args = ap.parse_args()
     only = set(args.only.split(",")) if args.only else {"study", "bfs", "batch", "large"}
     ref = args.ref if (args.ref / "bayesgrasp").is_dir() else None
@@ -240,7 +250,7 @@ def main() -> None:
     if "bfs" in only:
         bfs_case(args)
     if "batch" in only:
-        batch_case(args)
+        batch_case(args, _source(args.before) if args.before else None)
     if "large" in only:
         large_cases(ref, args)
 
@@ -274,21 +284,52 @@ def bfs_case(args: argparse.Namespace) -> None:
         )
 
 
-def batch_case(args: argparse.Namespace) -> None:
-    """``plan --batch`` beside the in-process study (this branch).
+def _source(before: str) -> Path:
+    """The ``src`` of an earlier version: a folder as given, or a commit's, extracted."""
+    given = Path(before)
+    if (given / "bayesgrasp").is_dir():
+        return given
+    if (given / "src" / "bayesgrasp").is_dir():
+        return given / "src"
+    root = HERE.parent
+    out = Path(tempfile.mkdtemp(prefix="bench-before-"))
+    archive = subprocess.run(
+        ["git", "-C", str(root), "archive", before, "src"], capture_output=True, check=True
+    )
+    subprocess.run(["tar", "-x", "-C", str(out)], input=archive.stdout, check=True)
+    return out / "src"
+
+
+def batch_case(args: argparse.Namespace, before: Path | None = None) -> None:
+    """``plan --batch`` beside the in-process study (this branch, and ``before``'s).
 
     Each run: the first call (it imports the command's modules), then three rounds of a
     second call, the study, the batch one part at a time (``GROUP = 1``) and the study in
-    groups; best of each over the runs, and the median of the rounds' ratios.
+    groups; best of each over the runs, and the median of the rounds' ratios. The runs of
+    the two versions alternate, so that a change of the machine's load hits both alike.
     """
+    versions = [("this branch", HERE)] + ([(f"before ({args.before})", before)] if before else [])
     # The first call as users meet it: the modules' bytecode compiled (pip compiles it on
     # installing; under PYTHONDONTWRITEBYTECODE nothing else would).
-    subprocess.run([sys.executable, "-m", "compileall", "-q", str(HERE)], check=True)
-    runs = [run(HERE, "batch", args.polygons, False, args.timeout) for _ in range(args.repeat)]
+    for _, src in versions:
+        subprocess.run([sys.executable, "-m", "compileall", "-q", str(src)], check=True)
+    runs: dict[str, list[dict[str, Any]]] = {label: [] for label, _ in versions}
+    for _ in range(args.repeat):
+        for label, src in versions:
+            runs[label].append(run(src, "batch", args.polygons, False, args.timeout))
+    warm = {label: _show_batch(label, found) for label, found in runs.items()}
+    if before is not None and all(w is not None for w in warm.values()):
+        new, old = warm.values()
+        assert new is not None and old is not None
+        print(f"  this branch's warm batch {new / old:.2f}x the one before")
+
+
+def _show_batch(label: str, runs: list[dict[str, Any]]) -> float | None:
+    """Print one version's batch figures; its best warm time."""
     ok = [r for r in runs if "cpu" in r]
     if not ok:
-        print(f"plan --batch: {runs[0]}")
-        return
+        print(f"plan --batch, {label}: {runs[0]}")
+        return None
 
     def best(key: str) -> float:
         return min(min(r[key]) if isinstance(r[key], list) else r[key] for r in ok)
@@ -298,11 +339,13 @@ def batch_case(args: argparse.Namespace) -> None:
         return ratios[len(ratios) // 2]
 
     study, warm, cold = best("study"), best("warm"), best("cpu")
+    n = ok[0]["lines"]
     print(
-        f"plan --batch, {ok[0]['lines']} parts in one process: {warm:.3f} s warm, "
-        f"{cold:.3f} s the first call (the command's imports); the in-process study "
-        f"{study:.3f} s: warm {warm / study:.2f}x (median of the rounds "
-        f"{median_ratio('warm', 'study'):.2f}x), first call {cold / study:.2f}x"
+        f"plan --batch, {label}, {n} parts in one process: {warm:.3f} s warm "
+        f"({warm / n * 1e6:.0f} us a part), {cold:.3f} s the first call (the command's "
+        f"imports); the in-process study {study:.3f} s ({study / n * 1e6:.0f} us a part): "
+        f"warm {warm / study:.2f}x (median of the rounds {median_ratio('warm', 'study'):.2f}x), "
+        f"first call {cold / study:.2f}x"
     )
     one, grouped = best("one"), best("study_grouped")
     print(
@@ -310,6 +353,7 @@ def batch_case(args: argparse.Namespace) -> None:
         f"the study in groups of 32: {grouped:.3f} s (the batch {warm / grouped:.2f}x it, "
         f"median {median_ratio('warm', 'study_grouped'):.2f}x)"
     )
+    return warm
 
 
 def large_cases(ref: Path | None, args: argparse.Namespace) -> None:

@@ -12,15 +12,26 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 from typing import Any
 
 import pytest
 
-from snapshots.generate import ROOT, SNAPSHOT, VOLATILE_KEYS, drop_volatile, run_cli
+from snapshots.generate import (
+    MORE,
+    ROOT,
+    SNAPSHOT,
+    VOLATILE_KEYS,
+    drop_volatile,
+    numbers,
+    run_cli,
+    run_more,
+)
 
 REL = ABS = 1e-9
 
 ENTRIES: list[dict[str, Any]] = json.loads(SNAPSHOT.read_text(encoding="utf-8"))
+MORE_ENTRIES: list[dict[str, Any]] = json.loads(MORE.read_text(encoding="utf-8"))
 
 
 def _kind(x: Any) -> str:
@@ -75,6 +86,49 @@ def test_cli_json_unchanged(entry: dict[str, Any], monkeypatch: pytest.MonkeyPat
     assert code == entry["exit_code"]
     diff = first_difference(entry["json"], doc)
     assert diff is None, diff
+
+
+@pytest.mark.parametrize("entry", MORE_ENTRIES, ids=[" ".join(e["argv"]) for e in MORE_ENTRIES])
+def test_cli_more_unchanged(
+    entry: dict[str, Any], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """Sensing, noise, payoff, several parts, batch, tables and robot files as they were."""
+    monkeypatch.chdir(ROOT)
+    got = run_more(entry, tmp_path)
+    assert got["exit_code"] == entry["exit_code"]
+    if "numbers" in entry:  # a table may gain lines; the numbers it had stay, in order
+        missing = missing_numbers(entry["numbers"], got["numbers"])
+        assert missing is None, missing
+    for key in ("json", "jsonl", "files"):
+        if key in entry:
+            diff = first_difference(entry[key], got.get(key), f"$.{key}")
+            assert diff is None, diff
+
+
+def missing_numbers(expected: list[float], actual: list[float]) -> str | None:
+    """The first expected number not found, in order, among the actual ones (or ``None``)."""
+    i = 0
+    for k, x in enumerate(expected):
+        while i < len(actual) and not math.isclose(x, actual[i], rel_tol=REL, abs_tol=ABS):
+            i += 1
+        if i == len(actual):
+            return f"number #{k} ({x!r}) of the table is gone (after {expected[:k][-3:]})"
+        i += 1
+    return None
+
+
+def test_missing_numbers() -> None:
+    assert missing_numbers([1.0, 2.0], [1.0, 5.0, 2.0, 7.0]) is None
+    assert missing_numbers([1.0, 2.0], [2.0, 1.0]) is not None
+    assert missing_numbers([1.0], [1.0 + 1e-6]) is not None
+
+
+def test_numbers_of_a_table() -> None:
+    assert numbers("p 0.5, cost -4e+00 at 12 deg\nwall time 0.01 s (3e6 trials/s)\n") == [
+        0.5,
+        -4.0,
+        12.0,
+    ]
 
 
 def test_snapshot_has_no_volatile_keys() -> None:

@@ -263,6 +263,8 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
 
     ``observed`` per orientation is the fraction of all trials (jammed trials end in none).
     """
+    from .sim.result import verdict_document
+
     doc = option_document(res.option)
     plan = {k: (json_float(v) if isinstance(v, float) else v) for k, v in doc.items()}
     lo, hi = res.ci95
@@ -294,6 +296,7 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
     why = res.fit_unavailable
     if why is not None:
         out["p_value_unavailable"] = why
+    out.update(verdict_document(res))  # the noise, the payoff and the verdict
     if part is not None:
         out["part"] = part_document(part)
     return out

@@ -351,11 +351,11 @@ BAD = [
     (["triangle", "--prior", "gauss"], "unknown prior 'gauss'"),
     (["triangle", "--prior", "vonmises:30"], "needs two numbers; got '30'"),
     (["triangle", "--prior", "vonmises:30,-1"], "kappa >= 0"),
-    (["triangle", "--prior", "histogram:{d}/missing.txt"], "cannot be read"),
+    (["triangle", "--prior", "histogram:{d}/missing.txt"], "no such file"),
     (["triangle", "--prior", "histogram:{d}/hist_bad.txt"], "must hold numbers only"),
     (["triangle", "--prior", "histogram:{d}/hist_neg.txt"], "non-negative"),
     (["triangle", "--prior", "histogram:{d}/hist_zero.txt"], "not all zero"),
-    (["triangle", "--prior", "sample:{d}/sample_empty.txt"], "at least one"),
+    (["triangle", "--prior", "sample:{d}/sample_empty.txt"], "the file is empty"),
 ]
 PLAN_BAD = [
     (["triangle", "--squeeze-cost", "-1"], "--squeeze-cost"),

@@ -57,7 +57,7 @@ def test_plan_with_a_payoff_file(tmp_path: Path, capsys: pytest.CaptureFixture[s
         (["--contact-noise", "1.5"], "contact-noise"),
         (["--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
         (["--turn-noise", "normal:1", "--guaranteed"], "do not take noise"),
-        (["--payoff", "missing.csv"], "cannot be read"),
+        (["--payoff", "missing.csv"], "no such file"),
     ],
 )
 def test_bad_options_exit_2(
@@ -80,7 +80,7 @@ def test_simulate_takes_the_turn_noise(capsys: pytest.CaptureFixture[str]) -> No
 
 
 def test_simulate_turn_noise_predicts_under_the_noise(capsys: pytest.CaptureFixture[str]) -> None:
-    """The predicted column is the exact evaluation under the noise, which sampling agrees with."""
+    """The plan is the noise-aware Bayes plan; the predicted column its exact evaluation."""
     from bayesgrasp.planning import plan_exact
     from bayesgrasp.planning.noisy import evaluate_plan
     from bayesgrasp.sim.stats import wilson_interval
@@ -88,12 +88,14 @@ def test_simulate_turn_noise_predicts_under_the_noise(capsys: pytest.CaptureFixt
     argv = ["simulate", "key", "--turn-noise", "uniform:2", "--trials", "40000", "--json"]
     assert main(argv) == 0
     doc = json.loads(capsys.readouterr().out)
-    plan = plan_exact(Problem.build(load("key"))).bayes_plan
-    ev = evaluate_plan(
-        Problem.build(load("key")), NoiseModel(TurnNoise("uniform", math.radians(2))), plan.steps
-    )
+    pb = Problem.build(load("key"))
+    noise = NoiseModel(TurnNoise("uniform", math.radians(2)))
+    plan = plan_noisy(pb, noise).bayes_plan.option
+    assert [s["alpha_rad"] for s in doc["plan"]["steps"]] == [s.alpha for s in plan.steps]
+    ev = evaluate_plan(pb, noise, plan.steps)
     assert_allclose(doc["predicted_success"], ev.success_probability, atol=1e-12)
-    assert abs(ev.success_probability - plan.success_probability) > 0.05  # not noise-free
+    noise_free = plan_exact(pb).bayes_plan.success_probability
+    assert abs(ev.success_probability - noise_free) > 0.05  # not the noise-free claim
     lo, hi = wilson_interval(round(doc["observed_success"] * 40000), 40000, confidence=0.999)
     assert lo <= doc["predicted_success"] <= hi
     assert_allclose(sum(r["predicted"] for r in doc["per_orientation"]), 1.0, atol=1e-9)

@@ -567,10 +567,11 @@ def test_a_device_is_refused_unread() -> None:
 def test_the_byte_limit_is_stated_and_applied(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    import bayesgrasp.files as files
     import bayesgrasp.io._common as common
 
-    assert common.MAX_BYTES == 64 * 2**20
-    monkeypatch.setattr(common, "MAX_BYTES", 1000)
+    assert common.MAX_BYTES == files.MAX_BYTES == 64 * 2**20
+    monkeypatch.setattr(files, "MAX_BYTES", 1000)
     f = write(tmp_path, "big.csv", "0,0\n" * 400)
     refused(f, "larger than the limit of 1000 bytes")
 

@@ -35,7 +35,7 @@ DEG = math.pi / 180
 @given(
     seed=st.integers(0, 10_000),
     kind=st.sampled_from(["normal", "uniform"]),
-    scale=st.floats(0.0, 0.5),
+    scale=st.sampled_from([0.0]) | st.floats(1e-12, 0.5),
     q=st.floats(0.0, 1.0),
     alphas=st.lists(st.floats(-10.0, 10.0), min_size=1, max_size=5),
 )
@@ -168,3 +168,9 @@ def test_parse_and_validate() -> None:
     assert TurnNoise("normal", 0.1).curvature_bound == pytest.approx(
         2 * math.exp(-0.5) / math.sqrt(2 * math.pi) / 0.01
     )
+
+
+@pytest.mark.parametrize("spec", ["normal:1e-300", "normal:1e-310", "uniform:1e-12"])
+def test_a_vanishing_turn_error_is_refused(spec: str) -> None:
+    with pytest.raises(PlanningError, match="exact to rounding: give 0 for exact turns"):
+        parse_turn_noise(spec)

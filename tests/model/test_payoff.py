@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -133,7 +134,34 @@ def test_orientations_must_be_states(tmp_path: Path) -> None:
     s = float(pb.states.stable[2])
     with pytest.raises(PayoffError, match="twice"):
         Payoff(np.array([s, s + 1e-5]), np.array([1.0, 0.5])).vector(pb.states)
-    with pytest.raises(PayoffError, match="cannot be read"):
+    with pytest.raises(PayoffError, match="no such file"):
         read_payoff(tmp_path / "missing.json")
     with pytest.raises(PayoffError, match="needs 8 values"):
         plan_noisy(pb, NoiseModel(), np.ones(3))
+
+
+@pytest.mark.parametrize(
+    ("name", "body", "match"),
+    [
+        ("big.json", '{"payoff": {"80.63": 1' + "0" * 400 + "}}", "401 digits .* beyond"),
+        ("deep.json", "[" * 100_000 + "]" * 100_000, "nested deeper than the limit"),
+        ("field.csv", "orientation_deg,value\n80.63," + "1" * 200_000, "not valid CSV"),
+        ("latin.csv", "orientation_deg,value\n80.63,1 \xe9\n", "not UTF-8"),
+        ("empty.json", "  \n", "the file is empty"),
+    ],
+)
+def test_bad_payoff_files_are_one_clear_error(
+    tmp_path: Path, name: str, body: str, match: str
+) -> None:
+    p = tmp_path / name
+    p.write_bytes(body.encode("latin-1"))
+    with pytest.raises(PayoffError, match=match) as info:
+        read_payoff(p)
+    assert "\n" not in str(info.value)
+
+
+def test_a_fifo_payoff_is_refused_without_blocking(tmp_path: Path) -> None:
+    fifo = tmp_path / "pipe.json"
+    os.mkfifo(fifo)
+    with pytest.raises(PayoffError, match="FIFO"):
+        read_payoff(fifo)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -376,8 +377,8 @@ def test_parse_prior_good(tmp_path: Path) -> None:
         ("vonmises:", "needs two numbers"),
         ("vonmises:30,-1", "kappa >= 0"),
         ("vonmises:nan,1", "finite mean"),
-        ("histogram:/no/such/file.txt", "cannot be read"),
-        ("sample:/no/such/file.txt", "cannot be read"),
+        ("histogram:/no/such/file.txt", "no such file"),
+        ("sample:/no/such/file.txt", "no such file"),
     ],
 )
 def test_parse_prior_bad(spec: str, match: str) -> None:
@@ -389,10 +390,10 @@ def test_parse_prior_bad(spec: str, match: str) -> None:
     ("kind", "text", "match"),
     [
         ("histogram", "1, 2, x", "must hold numbers only"),
-        ("histogram", "", "got 0 weight"),
+        ("histogram", "", "the file is empty"),
         ("histogram", "0 0 0", "not all zero"),
         ("histogram", "1 -2", "non-negative"),
-        ("sample", "", "at least one finite angle"),
+        ("sample", "", "the file is empty"),
         ("sample", "10 nan", "finite"),
         ("sample", "ten", "must hold numbers only"),
     ],
@@ -414,3 +415,14 @@ def test_priors_are_frozen() -> None:
         HistogramPrior([1.0]).name = "x"  # type: ignore[misc]
     with pytest.raises(dataclasses.FrozenInstanceError):
         SamplePrior([1.0]).name = "x"  # type: ignore[misc]
+
+
+def test_prior_files_are_read_safely(tmp_path: Path) -> None:
+    latin = tmp_path / "angles.txt"
+    latin.write_bytes(b"\xff\xfe10\n20\n")
+    with pytest.raises(PriorError, match="not UTF-8"):
+        parse_prior(f"sample:{latin}")
+    fifo = tmp_path / "pipe.txt"
+    os.mkfifo(fifo)
+    with pytest.raises(PriorError, match="FIFO"):
+        parse_prior(f"histogram:{fifo}")

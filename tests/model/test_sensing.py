@@ -119,6 +119,32 @@ def test_noisy_bins_hold_the_quantised_readings() -> None:
         assert np.all(np.abs(freq - b.likelihood[i]) <= 5 * sd + 1e-9)
 
 
+@pytest.mark.parametrize(
+    ("sensor", "match"),
+    [
+        (WidthSensor(0.0, 1e-15), "reading step RES .* below the length tolerance"),
+        (WidthSensor(0.0, 1e-18), "below the length tolerance"),
+        (WidthSensor(1e-12, 0.1), "reading error SIGMA .* below the length tolerance"),
+        (WidthSensor(1.0, 0.001), "cells within 8 SIGMA .* at least 0.0039"),
+        (WidthSensor(100.0, 0.1), "cells"),
+        (WidthSensor(1e300, 1.0), "cells"),
+    ],
+)
+def test_readings_finer_than_the_geometry_or_too_many_cells_are_refused(
+    sensor: WidthSensor, match: str
+) -> None:
+    # The house's widths: theta and theta + pi differ by rounding only (about 1e-15).
+    d = np.array([40.0, 40.0 + 7e-15, 52.5, 56.0])
+    with pytest.raises(SensorError, match=match) as info:
+        sensor.bins(d, length_tol=1e-9)
+    assert "\n" not in str(info.value)
+
+
+def test_a_step_at_the_limit_is_taken() -> None:
+    b = WidthSensor(1.0, 16.0 / 4095).bins(np.array([40.0, 52.5]), length_tol=1e-9)
+    assert_allclose(b.likelihood.sum(axis=1), 1.0, atol=1e-12)
+
+
 def test_far_cells_are_lumped_with_exact_totals() -> None:
     # Widths far apart: the cells between them are lumped, the likelihoods still sum to one.
     b = WidthSensor(0.01, 0.01).bins(np.array([1.0, 9.0]))

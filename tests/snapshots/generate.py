@@ -25,6 +25,7 @@ import contextlib
 import io
 import json
 import os
+import re
 import sys
 import time
 from collections.abc import Sequence
@@ -34,6 +35,8 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 SNAPSHOT = HERE / "cli.json"
+MORE = HERE / "more.json"
+TMP = "{tmp}"  # in a more_cases argv: a fresh folder for the files the command writes
 PARTS = "tests/snapshots/parts"  # relative to ROOT, as it appears in argv
 
 # Machine-dependent fields, dropped from every document before it is stored or compared.
@@ -45,6 +48,8 @@ RANDOM = tuple(
     for name in ("random-1", "random-2", "random-3", "random-4", "ellipse", "lattice")
 )
 HISTOGRAM = f"{PARTS}/histogram.txt"
+PAYOFF = f"{PARTS}/payoff-key.json"
+BATCH = f"{PARTS}/batch.jsonl"
 SAMPLE = f"{PARTS}/sample.txt"
 
 
@@ -172,6 +177,145 @@ def cases() -> list[list[str]]:
     return out
 
 
+def more_cases() -> list[dict[str, Any]]:
+    """The command lines of ``more.json``: sensing, noise, payoff, export, batch, text tables.
+
+    Each case says what to keep of its output: ``"json"`` (one document), ``"jsonl"`` (one
+    document a line: several parts, ``--batch``), ``"text"`` (the numbers of a table, in
+    order) or ``"files"`` (the files written into :data:`TMP`, with the stdout document when
+    ``--json`` is given).
+    """
+    sense = ["--sense", "width:0.5,0.1"]
+    json_cases = [
+        ["plan", "key", "--turn-noise", "normal:2", "--json"],
+        ["plan", "house", "--turn-noise", "uniform:3", "--json"],
+        ["plan", "triangle", "--contact-noise", "0.1", "--json"],
+        ["plan", "example", "--turn-noise", "normal:1", "--contact-noise", "0.05", "--json"],
+        ["plan", "key", "--payoff", PAYOFF, "--json"],
+        ["plan", "key", "--turn-noise", "normal:2", "--payoff", PAYOFF, "--json"],
+        ["plan", "house", "--sense", "width", "--json"],
+        ["plan", "house", *sense, "--json"],
+        ["plan", "key", *sense, "--max-actions", "2", "--json"],
+        ["plan", "triangle", "--sense", "width", "--also", "rectangle", "--json"],
+        [
+            "plan",
+            "rectangle",
+            "--sense",
+            "width:0.2,0.05",
+            "--also",
+            "triangle",
+            "--part-prior",
+            "1,3",
+            "--max-actions",
+            "2",
+            "--json",
+        ],
+        [
+            "plan",
+            "example",
+            "--sense",
+            "width",
+            "--actions",
+            "squeeze,push-grasp",
+            "--max-actions",
+            "2",
+            "--json",
+        ],
+        ["simulate", "house", "--sense", "width", "--trials", "3000", "--seed", "1", "--json"],
+        [
+            "simulate",
+            "key",
+            *sense,
+            "--max-actions",
+            "2",
+            "--trials",
+            "3000",
+            "--seed",
+            "2",
+            "--json",
+        ],
+    ]
+    out: list[dict[str, Any]] = [{"argv": a, "keep": "json"} for a in json_cases]
+    out += [
+        {"argv": ["plan", "key", "house", "--json"], "keep": "jsonl"},
+        {"argv": ["plan", "--batch", BATCH], "keep": "jsonl"},
+        {"argv": ["plan", "--batch", BATCH, "--only", "best", "--guaranteed"], "keep": "jsonl"},
+    ]
+    text_cases = [
+        ["plan", "key"],
+        ["plan", "house", "--actions", "squeeze,push-grasp", "--guaranteed"],
+        ["plan", "key", "--turn-noise", "normal:2"],
+        ["plan", "key", "--payoff", PAYOFF],
+        ["plan", "house", "--sense", "width"],
+        ["plan", "house", *sense, "--max-actions", "2"],
+        ["squeeze", "key"],
+        ["simulate", "key", "--trials", "20000", "--seed", "3"],
+        ["simulate", "house", "--sense", "width", "--trials", "3000", "--seed", "4"],
+    ]
+    out += [{"argv": a, "keep": "text"} for a in text_cases]
+    file_cases = [
+        ["plan", "key", "--export", f"{TMP}/robot.csv"],
+        ["plan", "key", "--export", f"{TMP}/robot.json", "--json"],
+        ["plan", "house", "--actions", "squeeze,push-grasp", "--export", f"{TMP}/robot.csv"],
+        [
+            "plan",
+            "examples/bracket.dxf",
+            "--prior",
+            "vonmises:40,4",
+            "--export",
+            f"{TMP}/robot.json",
+        ],
+    ]
+    out += [{"argv": a, "keep": "files"} for a in file_cases]
+    return out
+
+
+NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|inf|nan")
+
+
+def numbers(text: str) -> list[float]:
+    """The numbers of a text, in order (what a table's snapshot keeps; wall times dropped)."""
+    lines = (x for x in text.splitlines() if not x.startswith("wall time"))
+    return [float(x) for line in lines for x in NUMBER.findall(line)]
+
+
+def run_more(case: dict[str, Any], tmp: Path) -> dict[str, Any]:
+    """Run one of :func:`more_cases` with its files written into ``tmp``; what it keeps."""
+    from bayesgrasp.cli import main
+
+    argv = [a.replace(TMP, str(tmp)) for a in case["argv"]]
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    text, keep = out.getvalue(), case["keep"]
+    got: dict[str, Any] = {"argv": case["argv"], "keep": keep, "exit_code": code}
+    if keep == "json" or (keep == "files" and "--json" in argv):
+        got["json"] = drop_volatile(json.loads(text, parse_constant=_no_constants))
+    elif keep == "jsonl":
+        lines = text.splitlines()
+        got["jsonl"] = [drop_volatile(json.loads(x, parse_constant=_no_constants)) for x in lines]
+    else:  # a table
+        got["numbers"] = numbers(text)
+    if keep == "files":
+        files: dict[str, Any] = {}
+        for f in sorted(tmp.iterdir()):
+            body = f.read_text(encoding="utf-8")
+            files[f.name] = json.loads(body) if f.suffix == ".json" else numbers(body)
+        got["files"] = files
+    return got
+
+
+def generate_more() -> list[dict[str, Any]]:
+    """Run every case of :func:`more_cases`, each with a fresh folder for its files."""
+    import tempfile
+
+    entries = []
+    for case in more_cases():
+        with tempfile.TemporaryDirectory() as d:
+            entries.append(run_more(case, Path(d)))
+    return entries
+
+
 def drop_volatile(doc: Any) -> Any:
     """``doc`` without the keys of :data:`VOLATILE_KEYS`, at any depth."""
     if isinstance(doc, dict):
@@ -277,6 +421,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     entries = generate(times=args.times)
     SNAPSHOT.write_text(json.dumps(entries, indent=1, allow_nan=False) + "\n", encoding="utf-8")
     print(f"wrote {len(entries)} cases to {SNAPSHOT.relative_to(ROOT)}")
+    more = generate_more()
+    MORE.write_text(json.dumps(more, indent=1, allow_nan=False) + "\n", encoding="utf-8")
+    print(f"wrote {len(more)} cases to {MORE.relative_to(ROOT)}")
     return 0
 
 

@@ -52,8 +52,8 @@ def run_batch(
 
     Each line is what ``plan PART --json`` prints for the part, as ``json.dumps`` writes it
     on one line (:func:`~bayesgrasp.io.plans.plan_document_json`); a part that fails gets
-    ``{"part": ..., "error": ..., "exit_code": 2}``. Everything made once per batch is made
-    before the loop: the problem's inputs, the planner, the provenance and its text.
+    ``{"part": ..., "error": ..., "exit_code": 2}``. What the parts share is made once: the
+    problem's inputs and the planner before the loop, the provenance by the first document.
 
     The parts are planned in groups of up to :data:`GROUP`, stage by stage: every part of a
     group read, then every problem built, every plan made, every document written. The
@@ -79,7 +79,7 @@ def run_batch(
     encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
     build, plan = _builder(spec), spec.planner(best_only)
-    memo: dict[str, Any] = {}  # what the documents share (the provenance and its text)
+    memo: dict[str, Any] = {}  # what the documents share (the provenance)
 
     def planned(pb: Problem) -> tuple[PlanReport, GuaranteedPlan | str | None]:
         return plan(pb), guaranteed_plan(pb) if guaranteed else None

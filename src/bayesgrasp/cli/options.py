@@ -86,7 +86,8 @@ TurnNoiseOpt = Annotated[
         "--turn-noise",
         metavar="normal:SIGMA_DEG|uniform:A_DEG",
         help="Gripper turns executed as alpha + e, e ~ Normal(0, SIGMA^2) or uniform on "
-        "[-A, A] degrees: plan gives the noise-aware Bayes plan, simulate draws e.",
+        "[-A, A] degrees: plan gives the noise-aware Bayes plan; simulate runs it, draws e "
+        "and predicts exactly under it.",
     ),
 ]
 ContactNoiseOpt = Annotated[
@@ -96,8 +97,8 @@ ContactNoiseOpt = Annotated[
         metavar="Q",
         min=0.0,
         max=1.0,
-        help="Plan for jaws that touch one after the other with probability Q (either side "
-        "first): such a squeeze acts as a push-grasp from that side.",
+        help="Jaws touch one after the other with probability Q (either side first): such a "
+        "squeeze acts as a push-grasp from that side (plan plans for it, simulate draws it).",
     ),
 ]
 PayoffOpt = Annotated[
@@ -106,7 +107,7 @@ PayoffOpt = Annotated[
         "--payoff",
         metavar="FILE",
         help="Payoff in [0, 1] of final stable orientations (.json or .csv, orientation_deg,"
-        "value): minimise the expected cost per unit payoff.",
+        "value): minimise the expected cost per unit payoff (simulate: judge by the mean).",
     ),
 ]
 
@@ -137,6 +138,26 @@ PartPriorOpt = Annotated[
 ]
 MaxActionsOpt = Annotated[
     int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
+]
+MaxOpeningOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--max-opening",
+        min=0.0,
+        metavar="WIDTH",
+        help="The widest the gripper opens (part units): refuse a plan or policy with a step "
+        "that needs the jaws open wider than the part can lie across them.",
+    ),
+]
+MinOpeningOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--min-opening",
+        min=0.0,
+        metavar="WIDTH",
+        help="The narrowest the gripper closes (part units): refuse a plan or policy with a "
+        "step that may close the jaws on a width narrower than this.",
+    ),
 ]
 # SenseOpt, AlsoOpt, PartPriorOpt and MaxActionsOpt: the options of a sensing policy (plan,
 # simulate and plot --sense), gathered into a SenseSpec.

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import enum
 import functools
+import math
 from pathlib import Path
 from typing import Annotated
 
@@ -24,6 +25,8 @@ from .options import (
     ForceOpt,
     JsonOpt,
     MaxActionsOpt,
+    MaxOpeningOpt,
+    MinOpeningOpt,
     PartPriorOpt,
     PayoffOpt,
     SenseOpt,
@@ -68,7 +71,10 @@ ExportOpt = Annotated[
         "--export",
         metavar="FILE",
         help="Also write the Bayes plan for a robot into FILE (.csv or .json): per step the "
-        "action, the absolute gripper angle (deg and rad) and the jaw widths to expect.",
+        "action, the absolute gripper angle (deg and rad) and the jaw widths to expect. With "
+        "--sense: the policy as a state machine, a row per state and reading range [lo, hi) "
+        "leading to the next state, a declaration or a rejection (units in the CSV's # lines "
+        "and the JSON's units).",
     ),
 ]
 
@@ -124,6 +130,8 @@ def plan(
     export: ExportOpt = None,
     only: OnlyOpt = Only.all,
     batch: BatchOpt = None,
+    max_opening: MaxOpeningOpt = None,
+    min_opening: MinOpeningOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -138,11 +146,18 @@ def plan(
     from ..io.plans import plan_document
     from . import noisy
 
+    stroke = None
+    if max_opening is not None or min_opening is not None:
+        from ..io.export import Stroke
+
+        stroke = Stroke(min_opening or 0.0, math.inf if max_opening is None else max_opening)
     if noisy.asked(turn_noise, contact_noise, payoff):
         if sense is not None or guaranteed or plot_file is not None or export is not None:
             raise typer.BadParameter(
                 "--sense, --guaranteed, --plot and --export do not take noise yet"
             )
+        if stroke is not None:
+            raise typer.BadParameter("--max-opening and --min-opening do not take noise yet")
         if part.part is None or batch is not None or more_parts:
             raise typer.BadParameter("noise options take one PART (no --batch)")
         noisy.plan_noisy_command(part.load(), spec, turn_noise, contact_noise, payoff, as_json)
@@ -153,14 +168,18 @@ def plan(
         from .sensing import plan_policy_command
 
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
+        if export is not None:
+            check_export(export, input_files(part.part, spec.prior, *more), force)
         sensing = SenseSpec(sense, more, part_prior, max_actions)
-        plan_policy_command(part, spec, sensing, as_json, fold_below)
+        plan_policy_command(part, spec, sensing, as_json, fold_below, export, stroke)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
     if batch is not None or more_parts:
         if plot_file is not None:
             raise typer.BadParameter("--plot takes one PART", param_hint="--plot")
+        if stroke is not None:
+            raise typer.BadParameter("--max-opening and --min-opening take one PART")
         from .batch import BatchFileError, run_batch
 
         try:
@@ -179,6 +198,10 @@ def plan(
         check_export(export, input_files(part.part, spec.prior), force)
     pb = spec.build(part.load())
     result = spec.plan(pb, best_only=only is Only.best)
+    if stroke is not None:
+        from ..io.export import check_stroke
+
+        check_stroke(pb, result.bayes_plan, stroke)
     found = guaranteed_plan(pb) if guaranteed else None
     sure, missing = (None, found) if isinstance(found, str) else (found, None)
     if as_json:

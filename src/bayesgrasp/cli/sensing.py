@@ -7,26 +7,43 @@ candidate parts and plans their policy.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from .common import emit_json, list_files, with_progress, write_failed
 from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
 
+if TYPE_CHECKING:
+    from ..io.export import Stroke
+
 
 def plan_policy_command(
-    part: PartSpec, spec: ProblemSpec, sensing: SenseSpec, as_json: bool, fold_below: float = 0.0
+    part: PartSpec,
+    spec: ProblemSpec,
+    sensing: SenseSpec,
+    as_json: bool,
+    fold_below: float = 0.0,
+    export: Path | None = None,
+    stroke: Stroke | None = None,
 ) -> None:
     """Plan and print a sensing policy over PART and the candidate parts.
 
     The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
+    ``export``: also write the policy's robot state machine there (the caller has checked
+    the name); ``stroke``: refuse a policy with a state outside the gripper's stroke.
     """
+    from ..io.export import check_stroke, write_robot
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
 
     parts = sensing.parts(part)
-    _, pol = sensing.policy(parts, spec)
+    problems, pol = sensing.policy(parts, spec)
+    if stroke is not None:
+        check_stroke(problems, pol, stroke)
+    if export is not None:
+        write_robot(export, problems, pol)
+        typer.echo(f"bayesgrasp: wrote {export}", err=True)
     if as_json:
         emit_json(policy_document(pol))
         return

@@ -1,9 +1,19 @@
-"""``simulate``: execute a plan many times and compare with the prediction."""
+"""``simulate``: execute a plan many times and compare with the prediction.
+
+The noise is the model's vocabulary, as ``plan`` takes it: ``--turn-noise`` (every gripper
+angle off by a normal or uniform error) and ``--contact-noise Q`` (one jaw touches first);
+``--noise DEG --noise-kind KIND`` is the older spelling of ``--turn-noise KIND:DEG``. Under
+noise (or with ``--payoff``) the plans ``--plan bayes`` and ``--plan most-certain`` are the
+noise-aware planner's (:func:`~bayesgrasp.planning.noisy.plan_noisy`, the ones ``plan``
+gives with the same options), and every plan is predicted exactly under the noise
+(:func:`~bayesgrasp.planning.noisy.evaluate_plan`).
+"""
 
 from __future__ import annotations
 
 import enum
 import math
+from pathlib import Path
 from typing import Annotated, Any
 
 import typer
@@ -11,9 +21,11 @@ import typer
 from .common import chosen_plan, emit_json, simulate_inputs, with_progress
 from .options import (
     AlsoOpt,
+    ContactNoiseOpt,
     JsonOpt,
     MaxActionsOpt,
     PartPriorOpt,
+    PayoffOpt,
     PlanChoiceOpt,
     SenseOpt,
     TurnNoiseOpt,
@@ -65,9 +77,17 @@ OffsetOpt = Annotated[
     ),
 ]
 NoiseOpt = Annotated[
-    float, typer.Option(min=0, metavar="DEG", help="Gripper angle error: sigma or bound, degrees.")
+    float,
+    typer.Option(
+        min=0,
+        metavar="DEG",
+        hidden=True,
+        help="Same as --turn-noise KIND:DEG, KIND from --noise-kind (sigma or bound, degrees).",
+    ),
 ]
-NoiseKindOpt = Annotated[NoiseKind, typer.Option(help="Gripper error distribution.")]
+NoiseKindOpt = Annotated[
+    NoiseKind, typer.Option(hidden=True, help="The distribution of --noise DEG.")
+]
 SeedOpt = Annotated[int, typer.Option(min=0, help="Seed of the random generator (>= 0).")]
 ForceOpt = Annotated[bool, typer.Option("--force", help="Run a --plan FILE made for another part.")]
 UnitsOpt = Annotated[
@@ -112,6 +132,8 @@ def simulate(
     units: UnitsOpt = None,
     as_json: JsonOpt = False,
     turn_noise: TurnNoiseOpt = None,
+    contact_noise: ContactNoiseOpt = None,
+    payoff: PayoffOpt = None,
     force: ForceOpt = False,
     sense: SenseOpt = None,
     also: AlsoOpt = None,
@@ -121,6 +143,11 @@ def simulate(
     jaw_lag: JawLagOpt = 0.0,
 ) -> None:
     """Execute a plan many times and compare the final orientations with the prediction.
+
+    With --turn-noise, --contact-noise or --payoff the Bayes (or most certain) plan is the
+    noise-aware one that plan gives with the same options; every plan is predicted exactly
+    under the noise, and with --payoff judged by its expected payoff (the mean payoff of
+    the final states). The verdict: each prediction within its observed interval (z = 4).
 
     With --plan FILE the plan must be for PART (else exit 2, unless --force) and runs under
     the prior and goal it was made for, unless --prior or --goal says otherwise.
@@ -132,7 +159,8 @@ def simulate(
     """
     from .. import report
     from ..io.plans import provenance
-    from ..sim.kinematic import GripperNoise
+    from ..sim.noise import GripperNoise
+    from ..sim.result import verdict_lines
     from ..sim.scene import units_scale
 
     if engine is Engine.kinematic and offset > 0:
@@ -155,17 +183,25 @@ def simulate(
     if jaw_lag and engine is Engine.kinematic:
         raise typer.BadParameter(
             "applies to --engine mujoco only (the kinematic model's contact asynchrony is "
-            "plan --contact-noise Q)",
+            "--contact-noise Q)",
             param_hint="--jaw-lag",
         )
-    err = GripperNoise(noise_kind.value, math.radians(noise))
+    if contact_noise is not None and engine is Engine.mujoco:
+        raise typer.BadParameter(
+            "applies to the kinematic engine only: in MuJoCo the jaws' contacts are the "
+            "physics' own (make one jaw touch first with --jaw-lag SECONDS)",
+            param_hint="--contact-noise",
+        )
     if sense is not None:
         if jaw_lag:
             raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
         from .sensing import simulate_policy_command
 
-        if turn_noise is not None:
-            raise typer.BadParameter("does not apply to --sense yet", param_hint="--turn-noise")
+        for given, hint in ((turn_noise, "--turn-noise"), (contact_noise, "--contact-noise"),
+                            (payoff, "--payoff")):  # fmt: skip
+            if given is not None:
+                raise typer.BadParameter("does not apply to --sense yet", param_hint=hint)
+        err = GripperNoise(noise_kind.value, math.radians(noise))
         sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, err, seed, units,
@@ -174,6 +210,7 @@ def simulate(
         return
     if also or part_prior is not None or sensor_error:
         raise typer.BadParameter("--also, --part-prior and --sensor-error need --sense")
+    model, noise_deg, kind = _noise_model(noise, noise_kind, turn_noise, contact_noise)
     p = part.load()
     given = units is not None
     scale = units_scale(units if given else p.units) if offset > 0 or given else 1.0
@@ -185,61 +222,177 @@ def simulate(
             param_hint="--offset",
         )
     params = _lagged(jaw_lag, p, units) if jaw_lag else None
-    pb, option, label = chosen_plan(which, spec, p, force)
+    pay = _read_payoff(payoff)
+    if (not model.exact or pay is not None) and which in ("bayes", "most-certain"):
+        pb, option, label = noise_aware_plan(which, spec, p, model, pay)
+    else:
+        pb, option, label = chosen_plan(which, spec, p, force)
+        _note_plan_file(which, model, pay)
+    u = None if pay is None else _payoff_vector(pay, pb)
     n = trials or (1_000_000 if engine is Engine.kinematic else 200)
-    if turn_noise is not None:  # the spelling of plan --turn-noise
-        from .noisy import turn_noise as parse
-
-        if noise > 0:
-            raise typer.BadParameter("give --noise or --turn-noise, not both", param_hint="--noise")
-        t = parse(turn_noise)
-        err = GripperNoise(t.kind, t.scale)
 
     def run(progress: Any) -> Any:
         if engine is Engine.kinematic:
-            return _kinematic_blocks(pb, option, n, err, seed, progress)
+            return _kinematic_blocks(pb, option, n, model, seed, progress, u)
         from ..sim import simulate_mujoco
+        from ..sim.result import with_prediction
 
         mm = offset / 1000.0  # millimetres to metres
-        return simulate_mujoco(
+        res = simulate_mujoco(
             pb,
             option,
             n,
             offset=mm,
-            noise=err,
+            noise=GripperNoise.of(model.turn),
             rng=seed,
             workers=workers,
             scale=scale if units is not None else None,
             progress=progress,
             params=params,
         )
+        # MuJoCo draws the turn error; the prediction is the exact one under it.
+        return with_prediction(res, pb, model, u) if not model.exact or u is not None else res
 
     res = with_progress(f"{engine.value} trials", n, run)
-    if turn_noise is not None:  # predicted exactly under the noise (--noise: without it)
-        import dataclasses
-
-        from ..model.noise import NoiseModel
-        from ..planning.noisy import evaluate_plan
-
-        ev = evaluate_plan(pb, NoiseModel(t), option.steps)
-        res = dataclasses.replace(res, predicted=ev.distribution)
     if as_json:
         doc = report.simulate_json(res, p)
         mujoco = engine is Engine.mujoco
         how = simulate_inputs(
-            engine.value, which, seed, n, noise, noise_kind.value, offset, units,
+            engine.value, which, seed, n, noise_deg, kind, offset, units,
             workers if mujoco else None,
         )  # fmt: skip
+        how["contact_noise"] = contact_noise
+        how["payoff"] = None if payoff is None else str(payoff)
         how["jaw_lag_s"] = jaw_lag or None
         doc["provenance"] = provenance(pb, None, **how, **run_inputs(part, spec))
         emit_json(doc)
     else:
         title = f"{p.name}: {label} plan, prior {pb.prior.name}; "
-        if turn_noise is not None:
-            title += f"predicted under turn error {t.spec()} deg; "
+        if not model.exact:
+            title += f"predicted under {model.describe()}; "
+        if payoff is not None:
+            title += f"payoff {payoff.name}; "
         if jaw_lag:
             title += f"jaw lag {jaw_lag:g} s; "
-        typer.echo(report.simulate_table(res, title))
+        typer.echo("\n".join([report.simulate_table(res, title), *verdict_lines(res)]))
+
+
+def _noise_model(
+    noise: float, kind: NoiseKind, turn_noise: str | None, contact: float | None
+) -> tuple[Any, float, str]:
+    """The noise model of the options, and the turn error's degrees and kind as given.
+
+    ``--noise DEG --noise-kind KIND`` is ``--turn-noise KIND:DEG``; the degrees and kind go
+    into the document's provenance as ``noise_deg`` and ``noise_kind`` whichever spelling
+    gave them, so both spellings write the same document.
+    """
+    from ..model.noise import MAX_NORMAL_SIGMA, NoiseModel, TurnNoise
+    from .noisy import turn_noise as parse
+
+    if turn_noise is not None:
+        if noise > 0:
+            raise typer.BadParameter("give --noise or --turn-noise, not both", param_hint="--noise")
+        if kind is not NoiseKind.normal:
+            raise typer.BadParameter(
+                "is the distribution of --noise; --turn-noise names its own (KIND:DEG)",
+                param_hint="--noise-kind",
+            )
+        t = parse(turn_noise)
+        deg = float(turn_noise.partition(":")[2])
+    else:
+        top = math.degrees(MAX_NORMAL_SIGMA)
+        if kind is NoiseKind.normal and noise > top:
+            raise typer.BadParameter(
+                f"a normal gripper error of sigma {noise:g} deg is beyond the noise model "
+                f"(at most {top:g} deg: beyond it the turn is a guess)",
+                param_hint="--noise",
+            )
+        t = TurnNoise(kind.value, math.radians(noise))
+        deg = noise
+    return NoiseModel(t, contact or 0.0), deg, t.kind
+
+
+def noise_aware_plan(
+    which: str, spec: ProblemSpec, part: Any, noise: Any, payoff: Any
+) -> tuple[Any, Any, str]:
+    """The problem, the plan ``plan`` gives under the noise and payoff, and its title name.
+
+    ``which`` is ``bayes`` or ``most-certain`` (the highest expected payoff); the planner
+    is :func:`~bayesgrasp.planning.noisy.plan_noisy` with the options ``plan`` passes it.
+    """
+    from ..planning.noisy import plan_noisy
+    from .common import PLAN_NAMES
+
+    if spec.method.value != "exact":
+        raise typer.BadParameter(
+            "the noise-aware planner seeds from the exact planner; drop --method",
+            param_hint="--method",
+        )
+    pb = spec.build(part)
+    res = plan_noisy(pb, noise, payoff, spec.max_actions)
+    chosen = res.bayes if which == "bayes" else res.most_certain
+    what = "noise-aware " if not noise.exact else "payoff "
+    return pb, res.options[chosen].option, what + PLAN_NAMES[which]
+
+
+def _note_plan_file(which: str, noise: Any, payoff: Any) -> None:
+    """Say on stderr when a plan file was made under a noise or payoff the run does not use.
+
+    The run uses the options as given (the same command prints the same numbers); the note
+    names the options that would simulate the plan under the conditions it was made for.
+    """
+    import json
+
+    from ..model.noise import NoiseModel, TurnNoise
+
+    path = Path(which)
+    if path.suffix.lower() != ".json":
+        return
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+        made = doc.get("noise") if isinstance(doc, dict) else None
+        theirs = NoiseModel(
+            TurnNoise(made["turn"]["kind"], made["turn"]["scale_rad"]), made["contact"]
+        ) if isinstance(made, dict) else NoiseModel()  # fmt: skip
+        paid = isinstance(doc, dict) and doc.get("payoff") is not None
+    except (OSError, ValueError, KeyError, TypeError):  # the plan reader has checked the file
+        return
+    missing = []
+    if theirs != noise and not theirs.exact:
+        t, q = theirs.turn, theirs.contact
+        missing += [f"--turn-noise {t.spec()}"] if not t.exact else []
+        missing += [f"--contact-noise {q:g}"] if q > 0 else []
+    if paid and payoff is None:
+        missing.append("--payoff FILE")
+    if missing:
+        typer.echo(
+            f"note: plan file {path.name!r} was made under other conditions "
+            f"({theirs.describe()}{', a payoff' if paid else ''}); to simulate it under them "
+            f"give {' '.join(missing)}",
+            err=True,
+        )
+
+
+def _read_payoff(path: Path | None) -> Any:
+    """The payoff of ``--payoff FILE`` (a bad file: exit 2, one line)."""
+    if path is None:
+        return None
+    from ..model.payoff import PayoffError, read_payoff
+
+    try:
+        return read_payoff(path)
+    except PayoffError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--payoff") from None
+
+
+def _payoff_vector(payoff: Any, problem: Any) -> Any:
+    """The payoff's value on each of the problem's states (a mismatch: exit 2)."""
+    from ..model.payoff import PayoffError, as_vector
+
+    try:
+        return as_vector(payoff, problem.states)
+    except PayoffError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--payoff") from None
 
 
 def _lagged(lag: float, part: Any, units: str | None) -> Any:
@@ -269,7 +422,9 @@ def _lagged(lag: float, part: Any, units: str | None) -> Any:
     return replace(base, jaw_lag=lag, clearance=max(base.clearance, push + 0.001))
 
 
-def _kinematic_blocks(pb: Any, option: Any, n: int, err: Any, seed: int, progress: Any) -> Any:
+def _kinematic_blocks(
+    pb: Any, option: Any, n: int, noise: Any, seed: int, progress: Any, payoff: Any = None
+) -> Any:
     """The kinematic trials in blocks of :data:`BLOCK`, counts added (memory of one block).
 
     One generator runs through the blocks, so the draws are those of one call.
@@ -285,7 +440,8 @@ def _kinematic_blocks(pb: Any, option: Any, n: int, err: Any, seed: int, progres
     while done < n:
         m = min(BLOCK, n - done)
         tick = None if progress is None else (lambda k, _t, d=done: progress(d + k, n))
-        results = [*results, simulate_kinematic(pb, option, m, err, rng=rng, progress=tick)]
+        one = simulate_kinematic(pb, option, m, noise, rng=rng, progress=tick, payoff=payoff)
+        results = [*results, one]
         results = [combine(results)] if len(results) > 1 else results
         done += m
     return results[0]

@@ -16,12 +16,8 @@ Limits on the work a file may cause, each refused with a message that names it:
 
 from __future__ import annotations
 
-import errno
-import json
 import logging
 import math
-import os
-import stat
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +26,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import files
 from ..errors import MissingExtraError, PartError, PartFileError
 from ..geometry import Part, find_crossing
 from ._flatten import Curve, FlattenBudget, Polyline, TooManyPoints, join, predicted_points
@@ -54,7 +51,6 @@ __all__ = [
     "flatten_rings",
     "load_json",
     "need",
-    "nesting_depth",
     "pick",
     "polygon_part",
     "quote",
@@ -77,7 +73,7 @@ MAX_POINTS = 100_000
 DEFAULT_RELATIVE_TOLERANCE = 1e-3
 
 #: Largest part file, in bytes (64 MiB): read from disk or given in memory.
-MAX_BYTES = 64 * 1024 * 1024
+MAX_BYTES = files.MAX_BYTES
 
 #: Largest coordinate magnitude: products of two coordinates (areas, cross products) must
 #: not overflow a float, so :class:`~bayesgrasp.geometry.Part` refuses larger ones too.
@@ -88,7 +84,7 @@ MAX_COORDINATE = 1e150
 MAX_ENTITIES = 100_000
 
 #: Deepest nesting of JSON arrays and objects, XML elements or WKT parentheses.
-MAX_NESTING = 100
+MAX_NESTING = files.MAX_NESTING
 
 
 @dataclass(frozen=True, slots=True)
@@ -179,10 +175,7 @@ def refuse_options(
 
 
 def _too_large(path: Path) -> PartFileError:
-    return fail(
-        path,
-        f"the part file is larger than the limit of {MAX_BYTES} bytes ({MAX_BYTES / 2**20:g} MiB)",
-    )
+    return files.too_large(PartFileError, path, "part file")  # type: ignore[return-value]
 
 
 def check_bytes(path: Path, data: bytes) -> bytes:
@@ -194,66 +187,14 @@ def check_bytes(path: Path, data: bytes) -> bytes:
     return data
 
 
-_KINDS = (
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
-
-
 def read_bytes(path: Path) -> bytes:
-    """The file's bytes: a regular file of at most :data:`MAX_BYTES` bytes, not empty.
-
-    The file is opened without blocking and checked before it is read, so a FIFO or a
-    device is refused at once instead of blocking or reading without end.
-    """
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
-    try:
-        fd = os.open(path, flags)
-    except FileNotFoundError:
-        raise fail(path, "no such file") from None
-    except IsADirectoryError:
-        raise fail(path, "is a directory, not a part file") from None
-    except OSError as exc:
-        if exc.errno == errno.ENXIO:  # a FIFO without a writer, a socket
-            raise fail(path, "is not a regular file (a FIFO or a socket)") from None
-        raise fail(path, f"cannot read the file ({exc.strerror or exc})") from None
-    try:
-        info = os.fstat(fd)
-        mode = info.st_mode
-        if stat.S_ISDIR(mode):
-            raise fail(path, "is a directory, not a part file")
-        if not stat.S_ISREG(mode):
-            kind = next((name for test, name in _KINDS if test(mode)), "not a regular file")
-            raise fail(path, f"is {kind}, not a regular file; give a part file")
-        if info.st_size > MAX_BYTES:  # refused unread (the loop below also stops there)
-            raise _too_large(path)
-        chunks: list[bytes] = []
-        size = 0
-        while size <= MAX_BYTES:
-            chunk = os.read(fd, min(1 << 20, MAX_BYTES + 1 - size))
-            if not chunk:
-                break
-            chunks.append(chunk)
-            size += len(chunk)
-    except OSError as exc:
-        raise fail(path, f"cannot read the file ({exc.strerror or exc})") from None
-    finally:
-        os.close(fd)
-    return check_bytes(path, b"".join(chunks))
+    """The part file's bytes (:func:`bayesgrasp.files.read_bytes`)."""
+    return files.read_bytes(path, PartFileError, "part file")
 
 
 def decode_text(path: Path, data: bytes) -> str:
     """The bytes as UTF-8 text (a byte-order mark is allowed)."""
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise fail(
-            path,
-            f"not UTF-8 text (byte {exc.start} is 0x{data[exc.start]:02x}); save the file as "
-            "UTF-8, or check the format",
-        ) from None
+    return files.decode_text(path, data, PartFileError)
 
 
 def read_text(path: Path) -> str:
@@ -261,54 +202,9 @@ def read_text(path: Path) -> str:
     return decode_text(path, read_bytes(path))
 
 
-class _NumberTooLarge(ValueError):
-    """A JSON number beyond the range of a float."""
-
-
-def _json_int(text: str) -> int:
-    # Python refuses to convert more than 4300 digits to an int (ValueError), and a float
-    # cannot hold more than 308: such numbers are coordinates no part can have.
-    if len(text.lstrip("-")) > 300:
-        raise _NumberTooLarge(f"a number of {len(text.lstrip('-'))} digits")
-    return int(text)
-
-
-def _json_float(text: str) -> float:
-    value = float(text)
-    if math.isinf(value):
-        raise _NumberTooLarge(f"the number {quote(text)}")
-    return value
-
-
-def nesting_depth(data: Any) -> int:
-    """Depth of nested lists and dicts (iterative: safe on any depth)."""
-    if not isinstance(data, dict | list):
-        return 0
-    deepest = 0
-    stack: list[tuple[dict[str, Any] | list[Any], int]] = [(data, 1)]
-    while stack:
-        item, depth = stack.pop()
-        deepest = max(deepest, depth)
-        children = item.values() if isinstance(item, dict) else item
-        stack.extend((c, depth + 1) for c in children if isinstance(c, dict | list))
-    return deepest
-
-
 def load_json(path: Path, text: str) -> Any:
     """Parse JSON text; malformed, too deeply nested or oversized numbers are errors."""
-    try:
-        data = json.loads(text, parse_int=_json_int, parse_float=_json_float)
-    except _NumberTooLarge as exc:
-        raise fail(path, f"coordinates too large: {exc} is beyond the range of a float") from None
-    except json.JSONDecodeError as exc:
-        raise fail(path, f"not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    except RecursionError:
-        raise fail(path, f"JSON nested deeper than the limit of {MAX_NESTING} levels") from None
-    except ValueError as exc:  # a number the parser cannot convert
-        raise fail(path, f"not valid JSON ({str(exc)[:120]})") from None
-    if nesting_depth(data) > MAX_NESTING:
-        raise fail(path, f"JSON nested deeper than the limit of {MAX_NESTING} levels")
-    return data
+    return files.load_json(path, text, PartFileError, "coordinates")
 
 
 def check_coordinates(path: Path, points: FloatArray, what: str) -> None:

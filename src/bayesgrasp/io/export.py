@@ -18,6 +18,47 @@ part's units.
 Two files: :func:`robot_csv` (one row a step) and :func:`robot_document`
 (``bayesgrasp.robot/1``), chosen by :func:`write_robot` from the file name.
 
+Sensing policies
+----------------
+A policy branches on the jaw width read after each action, so its robot file is a state
+machine (:mod:`bayesgrasp.io.machine`, schema ``bayesgrasp.robot-policy/1``): a row for each
+reading interval ``[lo, hi)`` of each state, leading to the next state, a declaration (part
+and final orientation) or a rejection, with the state's absolute gripper angle (deg and
+rad) and jaw opening; units in the ``#`` lines that head the CSV and in the JSON's
+``units``. :func:`write_robot` writes it when given a policy::
+
+    $ bayesgrasp plan house --sense width --export house-robot.csv
+    $ cut -c 1-88 house-robot.csv
+    # bayesgrasp.robot-policy/1; parts: house
+    # units: lengths (opening_before, width_after_min, width_after_max, reading_lo, reading_
+    # start: state 1; after the state's action a reading r takes its row with reading_lo <=
+    state,action,turn_deg,gripper_deg,gripper_rad,opening_before,width_after_min,width_after
+    1,squeeze,0,0,0,61.97576623,40,58.66,-inf,48.26729625,0.5,declare,,house,0,0,0,0
+    1,squeeze,0,0,0,61.97576623,40,58.66,48.26729625,57.59729625,0.2908144585,next,2,,,,,
+    1,squeeze,0,0,0,61.97576623,40,58.66,57.59729625,inf,0.2091855415,declare,,house,270,4.7
+    2,squeeze,34.59407923,34.59407923,0.6037805843,60.95643911,40,58.66,-inf,57.59729625,0.5
+    2,squeeze,34.59407923,34.59407923,0.6037805843,60.95643911,40,58.66,57.59729625,inf,0.5,
+
+After the first squeeze (gripper at 0 deg) a reading below 48.27 mm declares the house at
+0 deg; one in ``[48.27, 57.60)`` goes to state 2, which turns the gripper to 34.59 deg in the
+world frame, squeezes and declares.
+
+A linear plan is the same machine with one row a state (:func:`~.machine.plan_machine`;
+its angles and openings are this module's), but ``write_robot`` keeps the step table above
+for plans.
+
+Gripper stroke
+--------------
+A gripper opens to at most ``max_opening`` and closes to at least ``min_opening`` (part
+units, :class:`Stroke`). A step needs the jaws open wider than the part can lie across them
+(``opening_before``) and closes them to the width of the orientation the part reaches
+(``width_after_min`` is the narrowest, over every orientation it may reach there, not only
+the successful ones). :func:`check_stroke` refuses a strategy with a step outside the
+stroke and names the first such step. The first action sees the part in every orientation,
+so its opening is the largest any step of any strategy needs: a part wider than
+``max_opening`` fits no strategy. The planners do not take the stroke into account; the
+check only refuses what they return.
+
 Examples
 --------
 >>> from bayesgrasp.geometry.polygon import Part
@@ -35,9 +76,10 @@ import csv
 import io
 import json
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -46,13 +88,21 @@ from ..model.problem import Problem, nearest_state
 from ..planning.result import PlanOption
 from .plans import json_float, part_document
 
+if TYPE_CHECKING:  # the policy machinery (and scipy) only when a policy is written
+    from ..planning.policy import Policy
+    from .machine import RobotMachine
+
 __all__ = [
     "EXPORT_FORMATS",
     "ROBOT_SCHEMA",
     "RobotStep",
+    "Stroke",
+    "check_stroke",
     "robot_csv",
     "robot_document",
     "robot_steps",
+    "stroke_violation",
+    "wrap_angle",
     "write_robot",
 ]
 
@@ -73,8 +123,26 @@ CSV_COLUMNS = (
 )
 
 
+class GripperAngles:
+    """The degrees of a step's radians (a base of :class:`RobotStep` and machine states)."""
+
+    __slots__ = ()
+    turn_rad: float
+    gripper_rad: float
+
+    @property
+    def turn_deg(self) -> float:
+        """:attr:`turn_rad` in degrees."""
+        return math.degrees(self.turn_rad)
+
+    @property
+    def gripper_deg(self) -> float:
+        """:attr:`gripper_rad` in degrees, in ``(-180, 180]``."""
+        return math.degrees(self.gripper_rad)
+
+
 @dataclass(frozen=True, slots=True)
-class RobotStep:
+class RobotStep(GripperAngles):
     """One action of a plan as a controller executes it.
 
     Attributes
@@ -104,21 +172,20 @@ class RobotStep:
     width_after_min: float
     width_after_max: float
 
-    @property
-    def turn_deg(self) -> float:
-        """:attr:`turn_rad` in degrees."""
-        return math.degrees(self.turn_rad)
 
-    @property
-    def gripper_deg(self) -> float:
-        """:attr:`gripper_rad` in degrees, in ``(-180, 180]``."""
-        return math.degrees(self.gripper_rad)
+def wrap_angle(angle: float) -> float:
+    """An angle in ``(-pi, pi]`` (plans' and state machines' gripper angles).
 
-
-def _wrap(angle: float) -> float:
-    """An angle in ``(-pi, pi]``."""
+    Examples
+    --------
+    >>> wrap_angle(3 * math.pi) == math.pi, wrap_angle(-math.pi) == math.pi
+    (True, True)
+    """
     out = math.remainder(angle, 2.0 * math.pi)
     return math.pi if out <= -math.pi else out
+
+
+_wrap = wrap_angle
 
 
 def robot_steps(problem: Problem, option: PlanOption) -> list[RobotStep]:
@@ -205,22 +272,164 @@ def robot_csv(problem: Problem, option: PlanOption) -> str:
     return buf.getvalue()
 
 
-def write_robot(path: str | Path, problem: Problem, option: PlanOption) -> Path:
-    """Write a plan for a robot: CSV or JSON by the file's ending (``.csv``, ``.json``).
+@dataclass(frozen=True, slots=True)
+class Stroke:
+    """The jaws' stroke: the narrowest and the widest they open to (part units).
 
     Raises
     ------
     ExportError
-        Another ending, or the file cannot be written.
+        A bound that is not a number, a negative ``min_opening``, a ``max_opening`` that is
+        not positive, or ``min_opening >= max_opening``.
+
+    Examples
+    --------
+    >>> Stroke(max_opening=50.0)
+    Stroke(min_opening=0.0, max_opening=50.0)
+    """
+
+    min_opening: float = 0.0
+    max_opening: float = math.inf
+
+    def __post_init__(self) -> None:
+        lo, hi = self.min_opening, self.max_opening
+        if not (isinstance(lo, int | float) and math.isfinite(lo) and lo >= 0):
+            raise ExportError(f"`min_opening` must be a finite number >= 0; got {lo!r}")
+        if not (isinstance(hi, int | float) and hi > 0 and not math.isnan(hi)):
+            raise ExportError(f"`max_opening` must be a number > 0; got {hi!r}")
+        if lo >= hi:
+            raise ExportError(
+                f"`min_opening` must be less than `max_opening`; got {lo!r} and {hi!r}"
+            )
+        object.__setattr__(self, "min_opening", float(lo))
+        object.__setattr__(self, "max_opening", float(hi))
+
+
+_STROKE_RTOL = 1e-9  # an opening this close to a bound is within it (rounding)
+
+
+def stroke_violation(machine: RobotMachine, stroke: Stroke, kind: str = "step") -> str | None:
+    """Why the first step of a strategy outside the stroke is, or ``None`` if all fit.
+
+    Steps in order (state order for a policy: parents before children). ``kind`` names a
+    step in the message (``step`` for plans, ``state`` for policies).
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.problem import Problem
+    >>> from bayesgrasp.planning import plan_exact
+    >>> from bayesgrasp.io.machine import plan_machine
+    >>> pb = Problem.build(Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)], units="mm"))
+    >>> m = plan_machine(pb, plan_exact(pb).bayes_plan)
+    >>> print(stroke_violation(m, Stroke(max_opening=40.0)))
+    None
+    >>> print(stroke_violation(m, Stroke(max_opening=30.0)))
+    step 1 (squeeze, gripper at 0 deg) needs the jaws open to 36.89 mm, more than the \
+largest opening 30 mm
+    >>> print(stroke_violation(m, Stroke(min_opening=21.0)))
+    step 1 (squeeze, gripper at 0 deg) may close the jaws to 20 mm, less than the least \
+opening 21 mm
+    """
+    found = _outside(machine, stroke, kind)
+    return None if found is None else found[1]
+
+
+def _outside(machine: RobotMachine, stroke: Stroke, kind: str) -> tuple[int, str] | None:
+    """The first state outside the stroke and why (:func:`stroke_violation`)."""
+    units = f" {machine.units}" if machine.units else ""
+    for s in machine.states:
+        where = f"{kind} {s.state} ({s.action}, gripper at {s.gripper_deg:.4g} deg)"
+        hi = stroke.max_opening
+        if s.opening_before > hi * (1 + _STROKE_RTOL):
+            return s.state, (
+                f"{where} needs the jaws open to {s.opening_before:.4g}{units}, more than the "
+                f"largest opening {hi:g}{units}"
+            )
+        lo = stroke.min_opening
+        if s.width_after_min < lo * (1 - _STROKE_RTOL):
+            return s.state, (
+                f"{where} may close the jaws to {s.width_after_min:.4g}{units}, less than the "
+                f"least opening {lo:g}{units}"
+            )
+    return None
+
+
+def check_stroke(
+    problems: Problem | Sequence[Problem], strategy: PlanOption | Policy, stroke: Stroke
+) -> None:
+    """Refuse a plan or policy with a step outside the gripper's stroke.
+
+    Raises
+    ------
+    ExportError
+        Naming the first step (the plan's step, the policy's state) outside the stroke. At
+        the first step the part itself does not fit: that action sees every orientation
+        and, for squeezes under a prior of full support, reaches every stable one, so it
+        needs the widest opening and the narrowest closing of any strategy. A later step
+        could be avoidable: the planners do not take the stroke into account.
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.problem import Problem
+    >>> from bayesgrasp.planning import plan_exact
+    >>> pb = Problem.build(Part.from_points([(0, 0), (31, 0), (31, 20), (0, 20)]))
+    >>> check_stroke(pb, plan_exact(pb).bayes_plan, Stroke(10.0, 40.0))
+    """
+    machine = _machine(problems, strategy)
+    kind = "step" if isinstance(strategy, PlanOption) else "state"
+    found = _outside(machine, stroke, kind)
+    if found is None:
+        return
+    state, why = found
+    if state == 1:  # the first action sees every orientation: no strategy would fit
+        raise ExportError(f"the part does not fit the gripper's stroke: {why}")
+    raise ExportError(
+        f"the gripper's stroke cannot run this strategy (the planners do not avoid it): {why}"
+    )
+
+
+def _machine(problems: Problem | Sequence[Problem], strategy: PlanOption | Policy) -> RobotMachine:
+    from .machine import plan_machine, policy_machine
+
+    if not isinstance(strategy, PlanOption):
+        return policy_machine(problems, strategy)
+    pb = problems if isinstance(problems, Problem) else problems[0]
+    return plan_machine(pb, strategy)
+
+
+def write_robot(
+    path: str | Path, problem: Problem | Sequence[Problem], option: PlanOption | Policy
+) -> Path:
+    """Write a plan or a policy for a robot: CSV or JSON by the file's ending.
+
+    A plan: one row a step (:func:`robot_csv`, :func:`robot_document`). A policy (with its
+    problems, one per candidate part): the state machine of :mod:`bayesgrasp.io.machine`.
+
+    Raises
+    ------
+    ExportError
+        Another ending than ``.csv`` or ``.json``, or the file cannot be written.
     """
     target = Path(path)
     kind = target.suffix.lstrip(".").lower()
     if kind not in EXPORT_FORMATS:
         raise ExportError(f"the robot file must end in .csv or .json; got {target.name!r}")
-    if kind == "csv":
-        text = robot_csv(problem, option)
+    if not isinstance(option, PlanOption):
+        from .machine import machine_csv, machine_document, policy_machine
+
+        machine = policy_machine(problem, option)
+        if kind == "csv":
+            text = machine_csv(machine)
+        else:
+            text = json.dumps(machine_document(machine), indent=2, allow_nan=False) + "\n"
     else:
-        text = json.dumps(robot_document(problem, option), indent=2, allow_nan=False) + "\n"
+        pb = problem if isinstance(problem, Problem) else problem[0]
+        if kind == "csv":
+            text = robot_csv(pb, option)
+        else:
+            text = json.dumps(robot_document(pb, option), indent=2, allow_nan=False) + "\n"
     try:
         target.write_text(text, encoding="utf-8")
     except OSError as exc:

@@ -1,29 +1,61 @@
 """Plan documents: the one module that writes and reads the JSON of plans.
 
-A plan document is what ``bayesgrasp plan --json`` prints and ``bayesgrasp simulate --plan
-FILE`` (or :func:`read_plan_document`) reads back. Two schemas:
+A plan document is what ``bayesgrasp plan --json`` prints (``plan --batch`` one a line, the
+web service's ``/plan`` too) and ``bayesgrasp simulate --plan FILE`` (or
+:func:`read_plan_document`) reads back. :func:`plan_document` builds it, the only writer;
+the standard ``json`` encoder writes its text. Its fields, in the order written (``?``: only
+in some documents)::
 
-- ``bayesgrasp.plan/1``: plans of squeezes only. Each option gives ``first_squeeze_rad``
-  (the world gripper angle of the first squeeze) and ``actions_rad`` (the turns before the
-  further squeezes).
-- ``bayesgrasp.plan/2``: the plan/1 fields, and every option gains ``steps``
-  (``[{"type": ACTION, "alpha_rad": ...}, ...]``, any registered action); written when a
-  plan may use other actions than squeezes or a guaranteed plan was asked for
-  (``"guaranteed"``: an option plus its ``period_rad``, or ``null`` and
-  ``"guaranteed_missing"``, the reason none exists).
+    {
+      "schema": "bayesgrasp.plan/1" | "bayesgrasp.plan/2",     plan_schema()
+      "part": {                                                part_document()
+        "name": str, "vertices": [[x, y], ...],                the hull, counter-clockwise
+        "n_sides": int, "symmetry_order": int, "units"?: str,
+        "center_of_mass": [x, y], "id": "sha256:...",          part_id()
+        "curved"?: {...}                                       a curved part's arcs
+      },
+      "method": "exact" | "bfs",
+      "stable_orientations_rad": [float, ...],
+      "stable_probabilities": [float, ...],                    after the Bayes plan's first action
+      "period_rad": float,
+      "first_squeeze_rad": float,                              the Bayes plan's first angle
+      "options": [OPTION, ...],                                the best plan of each length
+      "bayes": int, "most_certain": int,                       indices into "options"
+      "nodes"?: int,                                           breadth-first search
+      "accuracy_rad"?: float,                                  when not 0
+      "guaranteed"?: OPTION + {"period_rad": float} | null,    asked for (plan/2)
+      "guaranteed_missing"?: str,                              why it is null
+      "provenance": {                                          provenance()
+        "version": str, "prior": PRIOR, "cost": {...}, "goal": str,
+        "actions": [str, ...], "accuracy_rad": float, "method"?: str,
+        ...: the command line's part-file options, the longest plan asked for
+      }
+    }
+    OPTION = {                                                 option_document()
+      "squeezes": int,                                         the number of steps
+      "actions_rad": [float, ...],                             the turns before steps 2...
+      "steps": [{"type": ACTION, "alpha_rad": float}, ...],
+      "first_squeeze_rad": float, "final_orientation_rad": float,
+      "success_probability": float,
+      "expected_cost": float | null, "tolerance_rad": float | null
+    }
+    PRIOR = {"kind": "uniform"} | {"kind": "von-mises", "mean_rad", "kappa", "bins"}
+          | {"kind": "histogram", "weights"} | {"kind": "sample", "angles_rad"}
 
-Both are read; so are a bare option object (as a document's ``options`` hold), a
-``bayesgrasp.simulate/1`` document (its ``"plan"``) and the older option without ``steps``.
-Angles are radians; statistics a reader does not find are unknown (NaN).
+Two schemas: ``bayesgrasp.plan/1`` for plans of squeezes only, read from
+``first_squeeze_rad`` (the world gripper angle of the first squeeze) and ``actions_rad``;
+``bayesgrasp.plan/2`` when a plan may use other actions or a guaranteed plan was asked for,
+read from ``steps`` (any registered action). Both are read; so are a bare option object, a
+``bayesgrasp.simulate/1`` document (its ``"plan"``), the older option without ``steps`` and
+documents written before ``part`` and ``provenance``. Angles are radians; statistics a
+reader does not find are unknown (NaN). JSON has no NaN: a missing or infinite cost or
+tolerance is ``null``.
 
-Every document names its part: the ``part`` object holds the hull's vertices, the centre of
-mass and ``id`` (:func:`part_id`, a hash of the hull about the centre of mass rounded to the
-part's symmetry tolerance), so a plan read for another part is noticed
-(:func:`same_part`). A plan document also records how it was made (``"provenance"``:
-package version, prior, cost model, goal, actions, accuracy, planner; the command line adds
-the part-file options such as the flattening tolerance), and the prior in a form that
-rebuilds it (:func:`prior_document`, :func:`prior_from_document`), so a re-run from the
-document gives the same numbers. Documents written before these fields are read as before.
+``part`` names the part (:func:`part_id`, a hash of the hull about the centre of mass
+rounded to the part's symmetry tolerance), so a plan read for another part is noticed
+(:func:`same_part`). ``provenance`` records how the plans were made, the prior in a form
+that rebuilds it (:func:`prior_from_document`), so a re-run from the document gives the
+same numbers.
 
 Examples
 --------
@@ -45,14 +77,12 @@ import json
 import math
 import os
 from array import array
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from operator import attrgetter
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import orjson
 
 from ..errors import BayesGraspError, SimulationError
 from ..geometry.polygon import ConvexPolygon, Part
@@ -101,11 +131,240 @@ SIMULATE_SCHEMA = "bayesgrasp.simulate/1"
 _PLAN_INDEX = {"bayes": "bayes", "most-certain": "most_certain"}
 
 
+def plan_document(
+    result: PlanReport,
+    schema: str | None = None,
+    *,
+    guaranteed: GuaranteedPlan | None = None,
+    guaranteed_missing: str | None = None,
+    inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The plan document of a planner's result (top-level fields follow the Bayes plan).
+
+    Parameters
+    ----------
+    result : PlanReport
+        The plans of every length (exact or breadth-first planner).
+    schema : str, optional
+        Default :func:`plan_schema`: plan/2 when the problem has other actions than the
+        squeeze or a guaranteed plan was asked for.
+    guaranteed : GuaranteedPlan, optional
+        Written as ``"guaranteed"``.
+    guaranteed_missing : str, optional
+        A guaranteed plan was asked for and none exists, for this reason: ``"guaranteed"``
+        is ``null`` and ``"guaranteed_missing"`` the reason.
+    inputs : mapping, optional
+        More of how the plans were made, added to ``"provenance"`` (:func:`provenance`).
+    memo : dict, optional
+        Kept by the caller across the documents of one run (``plan --batch``): problems
+        made with the same prior, cost model, goal and ``inputs`` (the same objects), and
+        the same actions, accuracy, planner and curve error, share one ``"provenance"``
+        object, made once (so it must not be changed).
+
+    Returns
+    -------
+    dict
+        JSON-ready (no NaN or infinity); the fields of the module's schema, in its order.
+    """
+    pb: Problem = result.problem
+    asked = guaranteed is not None or guaranteed_missing is not None
+    first = result.bayes_plan.steps[0]
+    out: dict[str, Any] = {
+        "schema": schema or plan_schema(pb, asked),
+        "part": part_document(pb.part),
+        "method": result.method,
+        "stable_orientations_rad": pb.states.stable.tolist(),
+        "stable_probabilities": pb.state_probabilities(first.alpha, first.kind),
+        "period_rad": float(pb.states.period),
+        "first_squeeze_rad": first.alpha,
+        "options": [option_document(o) for o in result.options],
+        "bayes": result.bayes,
+        "most_certain": result.most_certain,
+    }
+    if result.nodes is not None:
+        out["nodes"] = result.nodes
+    if pb.accuracy > 0:
+        out["accuracy_rad"] = pb.accuracy
+    if guaranteed is not None:
+        out["guaranteed"] = guaranteed_document(guaranteed)
+    elif guaranteed_missing is not None:
+        out["guaranteed"] = None
+        out["guaranteed_missing"] = guaranteed_missing
+    out["provenance"] = _shared_provenance(pb, result.method, inputs, memo)
+    return out
+
+
+def option_document(option: PlanOption) -> dict[str, Any]:
+    """One plan as an option object (the plan/2 form, which holds the plan/1 fields)."""
+    steps = option.steps
+    return {
+        "squeezes": len(steps),
+        "actions_rad": [s.alpha for s in steps[1:]],
+        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in steps],
+        "first_squeeze_rad": steps[0].alpha,
+        "final_orientation_rad": option.final_orientation,
+        "success_probability": option.success_probability,
+        "expected_cost": json_float(option.expected_cost),
+        "tolerance_rad": json_float(option.tolerance),
+    }
+
+
+def guaranteed_document(plan: GuaranteedPlan) -> dict[str, Any]:
+    """The ``"guaranteed"`` member of a plan/2 document: an option plus its period."""
+    return {**option_document(plan.option), "period_rad": float(plan.period)}
+
+
+def part_document(part: Part) -> dict[str, Any]:
+    """The ``part`` object that every bayesgrasp document embeds (with its :func:`part_id`)."""
+    out: dict[str, Any] = {
+        "name": part.name,
+        "vertices": part.hull.vertices.tolist(),
+        "n_sides": part.hull.n_sides,
+        "symmetry_order": part.hull.symmetry_order,
+    }
+    if part.units is not None:
+        out["units"] = part.units
+    out["center_of_mass"] = part.center_of_mass.tolist()
+    out["id"] = part_id(part)
+    if type(part) is not Part:  # a polygon has no curved member (and needs no import)
+        from ..report_curved import curved_document
+
+        curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts)
+        if curved is not None:
+            out["curved"] = curved
+    return out
+
+
+def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict[str, Any]:
+    """How a result was made: version, prior, cost model, goal, actions, accuracy, planner.
+
+    ``more`` (the command line's part-file options, the longest plan asked for...) is added;
+    ``None`` values (an option not given, its default applied) are left out, so the command
+    line and the web service, which share no part-file options, write the same document.
+    ``flatten_tolerance`` not given is the tolerance the reader flattened a curved part's
+    non-arc curves with (its ``curve_error``), so a re-run with it gives the same numbers;
+    a file of segments and arcs only has none (its arcs are exact).
+    """
+    from .. import __version__
+
+    out: dict[str, Any] = {
+        "version": __version__,
+        "prior": prior_document(problem.prior),
+        "cost": problem.cost.to_json(),
+        "goal": problem.goal.kind,
+        "actions": list(problem.action_kinds),
+        "accuracy_rad": float(problem.accuracy),
+    }
+    if method is not None:
+        out["method"] = method
+    used = getattr(problem.part, "curve_error", 0.0)  # a curved part's flattened curves
+    if more.get("flatten_tolerance") is None and used:
+        # not given: the reader's default, which a curved part keeps as its curve error
+        more = {**more, "flatten_tolerance": float(used)}
+    out.update({k: v for k, v in more.items() if v is not None})
+    return out
+
+
+def _shared_provenance(
+    pb: Problem, method: str, inputs: Mapping[str, Any] | None, memo: dict[str, Any] | None
+) -> dict[str, Any]:
+    """:func:`provenance` of the problem, the memo's when it was made for the same inputs."""
+    if memo is None:
+        return provenance(pb, method, **dict(inputs or {}))
+    same = (pb.prior, pb.cost, pb.goal, inputs)  # frozen values: compared as objects
+    used = 0.0 if type(pb.part) is Part else getattr(pb.part, "curve_error", 0.0)
+    alike = (pb.actions, pb.accuracy, method, used)
+    last = memo.get("provenance")
+    if last is not None:
+        (prior, cost, goal, given), was, doc = last
+        if prior is same[0] and cost is same[1] and goal is same[2] and given is inputs:
+            if was == alike:
+                return doc  # type: ignore[no-any-return]
+    doc = provenance(pb, method, **dict(inputs or {}))
+    memo["provenance"] = (same, alike, doc)
+    return doc
+
+
+def prior_document(prior: Prior) -> dict[str, Any]:
+    """A prior as JSON that :func:`prior_from_document` rebuilds exactly.
+
+    ``{"kind": "uniform"}``; a von Mises prior by its parameters (``mean_rad``, ``kappa``,
+    ``bins``); any other histogram by its normalised ``weights``; a sample by its
+    ``angles_rad``. (Not its display name, which names the file a prior was read from: the
+    same prior given inline or from a file is the same document.)
+
+    Examples
+    --------
+    >>> from bayesgrasp.model.prior import von_mises
+    >>> prior_document(von_mises(0.5, 4.0))["kind"]
+    'von-mises'
+    >>> float(prior_from_document(prior_document(von_mises(0.5, 4.0))).mass(0.0, 1.0))
+    ...  # doctest: +ELLIPSIS
+    0.6...
+    """
+    if isinstance(prior, UniformPrior):
+        return {"kind": "uniform"}
+    if isinstance(prior, HistogramPrior):
+        if prior.recipe:
+            return dict(prior.recipe)
+        return {"kind": "histogram", "weights": prior.weights.tolist()}
+    if isinstance(prior, SamplePrior):
+        return {"kind": "sample", "angles_rad": prior.angles.tolist()}
+    return {"kind": type(prior).__name__, "name": prior.name}  # recorded, not rebuilt
+
+
+def plan_schema(problem: Problem, guaranteed: bool = False) -> str:
+    """The schema of a plan document: plan/1 for squeezes alone, else plan/2."""
+    if guaranteed or any(name != SQUEEZE.name for name in problem.action_kinds):
+        return PLAN_SCHEMA_2
+    return PLAN_SCHEMA_1
+
+
 def json_float(x: float | None) -> float | None:
     """A float for JSON: ``None`` for a missing or non-finite value (JSON has no NaN)."""
     if x is None or not math.isfinite(x):
         return None
     return float(x)
+
+
+# json.dumps(doc, allow_nan=False) without its argument checks (documents are trees).
+_encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
+
+
+def plan_document_json(
+    result: PlanReport,
+    *,
+    guaranteed: GuaranteedPlan | None = None,
+    guaranteed_missing: str | None = None,
+    inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
+) -> str:
+    """The plan document on one line: ``json.dumps(plan_document(...), allow_nan=False)``.
+
+    What ``plan --batch`` writes for each part (``plan --json`` prints the same document
+    indented). A value JSON cannot hold (NaN, an infinity) raises ``ValueError``, as
+    ``json.dumps`` does.
+
+    Examples
+    --------
+    >>> from bayesgrasp.model.problem import Problem
+    >>> from bayesgrasp.planning import plan_exact
+    >>> res = plan_exact(Problem.build(Part.from_points([(0, 0), (3, 0), (3, 2), (0, 2)])))
+    >>> plan_document_json(res) == json.dumps(plan_document(res), allow_nan=False)
+    True
+    """
+    doc = plan_document(
+        result,
+        guaranteed=guaranteed,
+        guaranteed_missing=guaranteed_missing,
+        inputs=inputs,
+        memo=memo,
+    )
+    return str(_encode(doc))
+
+
+# The part's identity
 
 
 def _grid(hull: ConvexPolygon) -> float:
@@ -209,55 +468,6 @@ def same_part(doc: Any, part: Part) -> bool | None:
     return bool(np.hypot(*(there - (part.center_of_mass - part.hull.centroid))) <= q)
 
 
-def part_document(part: Part) -> dict[str, Any]:
-    """The ``part`` object that every bayesgrasp document embeds (with its :func:`part_id`)."""
-    out: dict[str, Any] = {
-        "name": part.name,
-        "vertices": part.hull.vertices.tolist(),
-        "n_sides": part.hull.n_sides,
-        "symmetry_order": part.hull.symmetry_order,
-    }
-    if part.units is not None:
-        out["units"] = part.units
-    out["center_of_mass"] = part.center_of_mass.tolist()
-    out["id"] = part_id(part)
-    if type(part) is not Part:  # a polygon has no curved member (and needs no import)
-        from ..report_curved import curved_document
-
-        curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts)
-        if curved is not None:
-            out["curved"] = curved
-    return out
-
-
-def prior_document(prior: Prior) -> dict[str, Any]:
-    """A prior as JSON that :func:`prior_from_document` rebuilds exactly.
-
-    ``{"kind": "uniform"}``; a von Mises prior by its parameters (``mean_rad``, ``kappa``,
-    ``bins``); any other histogram by its normalised ``weights``; a sample by its
-    ``angles_rad``. (Not its display name, which names the file a prior was read from: the
-    same prior given inline or from a file is the same document.)
-
-    Examples
-    --------
-    >>> from bayesgrasp.model.prior import von_mises
-    >>> prior_document(von_mises(0.5, 4.0))["kind"]
-    'von-mises'
-    >>> float(prior_from_document(prior_document(von_mises(0.5, 4.0))).mass(0.0, 1.0))
-    ...  # doctest: +ELLIPSIS
-    0.6...
-    """
-    if isinstance(prior, UniformPrior):
-        return {"kind": "uniform"}
-    if isinstance(prior, HistogramPrior):
-        if prior.recipe:
-            return dict(prior.recipe)
-        return {"kind": "histogram", "weights": prior.weights.tolist()}
-    if isinstance(prior, SamplePrior):
-        return {"kind": "sample", "angles_rad": prior.angles.tolist()}
-    return {"kind": type(prior).__name__, "name": prior.name}  # recorded, not rebuilt
-
-
 def prior_from_document(doc: Any) -> Prior:
     """The prior of :func:`prior_document` (``SimulationError`` for a form it cannot rebuild)."""
     from ..model.prior import von_mises
@@ -277,394 +487,6 @@ def prior_from_document(doc: Any) -> Prior:
     except (KeyError, TypeError, ValueError, OverflowError, BayesGraspError) as exc:
         raise SimulationError(f"the {kind} prior of the document is malformed ({exc})") from None
     raise SimulationError(f"a prior of kind {kind!r} ({name}) cannot be rebuilt from a document")
-
-
-def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict[str, Any]:
-    """How a result was made: version, prior, cost model, goal, actions, accuracy, planner.
-
-    ``more`` (the command line's part-file options, the longest plan asked for...) is added;
-    ``None`` values (an option not given, its default applied) are left out, so the command
-    line and the web service, which share no part-file options, write the same document.
-    ``flatten_tolerance`` not given is the tolerance the reader flattened a curved part's
-    non-arc curves with (its ``curve_error``), so a re-run with it gives the same numbers;
-    a file of segments and arcs only has none (its arcs are exact).
-    """
-    from .. import __version__
-
-    out: dict[str, Any] = {
-        "version": __version__,
-        "prior": prior_document(problem.prior),
-        "cost": problem.cost.to_json(),
-        "goal": problem.goal.kind,
-        "actions": list(problem.action_kinds),
-        "accuracy_rad": float(problem.accuracy),
-    }
-    if method is not None:
-        out["method"] = method
-    used = getattr(problem.part, "curve_error", 0.0)  # a curved part's flattened curves
-    if more.get("flatten_tolerance") is None and used:
-        # not given: the reader's default, which a curved part keeps as its curve error
-        more = {**more, "flatten_tolerance": float(used)}
-    out.update({k: v for k, v in more.items() if v is not None})
-    return out
-
-
-def option_document(option: PlanOption) -> dict[str, Any]:
-    """One plan as an option object (the plan/2 form, which holds the plan/1 fields)."""
-    steps = option.steps  # (the fields of n_actions, alphas and first_angle, read once)
-    return {
-        "squeezes": len(steps),
-        "actions_rad": [s.alpha for s in steps[1:]],
-        "steps": [{"type": s.kind, "alpha_rad": s.alpha} for s in steps],
-        "first_squeeze_rad": steps[0].alpha,
-        "final_orientation_rad": option.final_orientation,
-        "success_probability": option.success_probability,
-        "expected_cost": json_float(option.expected_cost),
-        "tolerance_rad": json_float(option.tolerance),
-    }
-
-
-def guaranteed_document(plan: GuaranteedPlan) -> dict[str, Any]:
-    """The ``"guaranteed"`` member of a plan/2 document: an option plus its period."""
-    return {**option_document(plan.option), "period_rad": float(plan.period)}
-
-
-def plan_schema(problem: Problem, guaranteed: bool = False) -> str:
-    """The schema of a plan document: plan/1 for squeezes alone, else plan/2."""
-    kinds = problem.action_kinds
-    if guaranteed or (kinds != _SQUEEZES and any(name != SQUEEZE.name for name in kinds)):
-        return PLAN_SCHEMA_2
-    return PLAN_SCHEMA_1
-
-
-_SQUEEZES = (SQUEEZE.name,)
-
-
-def plan_document(
-    result: PlanReport,
-    schema: str | None = None,
-    *,
-    guaranteed: GuaranteedPlan | None = None,
-    guaranteed_missing: str | None = None,
-    inputs: Mapping[str, Any] | None = None,
-    memo: dict[str, Any] | None = None,
-) -> dict[str, Any]:
-    """The plan document of a planner's result (top-level fields follow the Bayes plan).
-
-    Parameters
-    ----------
-    result : PlanReport
-        The plans of every length (exact or breadth-first planner).
-    schema : str, optional
-        Default :func:`plan_schema`: plan/2 when the problem has other actions than the
-        squeeze or a guaranteed plan was asked for.
-    guaranteed : GuaranteedPlan, optional
-        Written as ``"guaranteed"``.
-    guaranteed_missing : str, optional
-        A guaranteed plan was asked for and none exists, for this reason: ``"guaranteed"``
-        is ``null`` and ``"guaranteed_missing"`` the reason.
-    inputs : mapping, optional
-        More of how the plans were made, added to ``"provenance"`` (:func:`provenance`).
-    memo : dict, optional
-        Kept by the caller across the documents of one run (``plan --batch``): problems
-        made with the same prior, cost model, goal and ``inputs`` (the same objects), and
-        the same actions, accuracy, planner and curve error, share one ``"provenance"``
-        object, made once (so it must not be changed).
-
-    Returns
-    -------
-    dict
-        JSON-ready (no NaN or infinity).
-    """
-    pb: Problem = result.problem
-    asked = guaranteed is not None or guaranteed_missing is not None
-    bayes = result.bayes_plan
-    out: dict[str, Any] = {
-        "schema": schema or plan_schema(pb, asked),
-        "part": part_document(pb.part),
-        "method": result.method,
-        "stable_orientations_rad": pb.states.stable.tolist(),
-        "stable_probabilities": pb.state_distribution(
-            bayes.first_angle, bayes.steps[0].kind
-        ).tolist(),
-        "period_rad": float(pb.states.period),
-        "first_squeeze_rad": bayes.first_angle,
-        "options": [option_document(o) for o in result.options],
-        "bayes": result.bayes,
-        "most_certain": result.most_certain,
-    }
-    if result.nodes is not None:
-        out["nodes"] = result.nodes
-    if pb.accuracy > 0:
-        out["accuracy_rad"] = pb.accuracy
-    if guaranteed is not None:
-        out["guaranteed"] = guaranteed_document(guaranteed)
-    elif guaranteed_missing is not None:
-        out["guaranteed"] = None
-        out["guaranteed_missing"] = guaranteed_missing
-    out["provenance"] = _shared_provenance(pb, result.method, inputs, memo)
-    return out
-
-
-# json.dumps(doc, allow_nan=False) without its argument checks (documents are trees).
-_encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
-# What json.dumps writes a str with (ensure_ascii).
-_text = json.encoder.encode_basestring_ascii
-
-
-def plan_document_json(
-    result: PlanReport,
-    *,
-    guaranteed: GuaranteedPlan | None = None,
-    guaranteed_missing: str | None = None,
-    inputs: Mapping[str, Any] | None = None,
-    memo: dict[str, Any] | None = None,
-) -> str:
-    """``json.dumps(plan_document(...), allow_nan=False)``, written without the dicts.
-
-    The same text, byte for byte (``plan --batch`` writes one a line), made from the
-    result's values: every float by one orjson call that writes each as its ``repr``, as
-    the encoder does (:func:`_float_texts`), the provenance shared through ``memo`` encoded
-    once. A value the template does not know (a non-float where it writes floats, a curved
-    part, a non-finite number the encoder refuses) makes :func:`plan_document` and the
-    encoder decide, so their result or error is this one's.
-
-    Examples
-    --------
-    >>> from bayesgrasp.model.problem import Problem
-    >>> from bayesgrasp.planning import plan_exact
-    >>> res = plan_exact(Problem.build(Part.from_points([(0, 0), (3, 0), (3, 2), (0, 2)])))
-    >>> plan_document_json(res) == json.dumps(plan_document(res), allow_nan=False)
-    True
-    """
-    try:
-        text = _document_text(result, guaranteed, guaranteed_missing, inputs, memo)
-    except TypeError:  # a value of another type than the template writes
-        text = None
-    if text is None:
-        doc = plan_document(
-            result,
-            guaranteed=guaranteed,
-            guaranteed_missing=guaranteed_missing,
-            inputs=inputs,
-            memo=memo,
-        )
-        return str(_encode(doc))
-    return text
-
-
-def _int(value: Any) -> str:
-    """An int as JSON writes it (``TypeError`` for anything else, a bool too)."""
-    if type(value) is not int:
-        raise TypeError(f"not an int: {value!r}")
-    return str(value)
-
-
-def _float_texts(values: Sequence[Any]) -> list[str] | None:
-    """``float.__repr__`` of each value (as ``json.dumps`` writes it), by one orjson call.
-
-    ``None`` when a value is not a float (an int, a float subclass, anything else) or not
-    finite (orjson's ``null``): the document then takes the general path, which writes or
-    refuses it as the encoder does. When orjson spells a finite float otherwise than
-    ``repr`` (:func:`_as_repr`), every text is the float's ``repr``, the encoder's own
-    spelling (the study's documents holding a float below 1e-4: 11 of 2000).
-    """
-    if not {*map(type, values)} <= _FLOAT:
-        return None
-    text = orjson.dumps(values).decode()
-    if not _as_repr(text):
-        if "n" in text:  # null: NaN or an infinity
-            return None
-        return [*map(float.__repr__, values)]
-    return text[1:-1].split(",") if values else []
-
-
-_FLOAT = {float}
-
-
-def _as_repr(text: str) -> bool:
-    """Whether orjson's text of a list of floats is each float's ``repr`` (but the spaces).
-
-    orjson writes a finite float with the shortest digits that read back to it, the digits
-    ``repr`` writes (both are "shortest round-trip, nearest", Steele & White / Gay), but
-    spells some differently: a magnitude below 1e-4 positionally (``0.00001`` for
-    ``1e-05``), exponents without their zero (``1e-7``), and NaN and the infinities as
-    ``null``. A text without an ``e``, ``n`` or ``0.0000`` holds none of these (no finite
-    float's text has an ``n``; one written positionally below 1e-4 has four zeros after its
-    point); test: ``tests/io/test_plan_json.py::test_orjson_float_text_is_repr``.
-
-    Searched in the decoded text: ``bytes.__contains__`` first tries its argument as an int,
-    and raises and clears a TypeError for each search (~1.7k instructions).
-    """
-    return not ("e" in text or "n" in text or "0.0000" in text)
-
-
-def _options_floats(
-    options: Sequence[PlanOption], values: list[Any]
-) -> list[tuple[int, bool, bool]]:
-    """Append the floats :func:`option_document` writes of each option to ``values``.
-
-    For each option in turn: each step's angle, the success probability, the expected cost,
-    the tolerance and the final orientation; 0.0 in place of a cost or tolerance that
-    :func:`json_float` makes null (missing or not finite). Returns each option's (steps, has
-    cost, has tolerance), for :func:`_options_text`. (One call for all the options: a call
-    an option cost more than its work.)
-    """
-    layouts = []
-    for option in options:
-        steps = option.steps
-        cost, tol = option.expected_cost, option.tolerance
-        has_cost = cost is not None and math.isfinite(cost)
-        has_tol = tol is not None and math.isfinite(tol)
-        values += map(_ALPHA, steps)
-        values += (
-            option.success_probability,
-            cost if has_cost else 0.0,
-            tol if has_tol else 0.0,
-            option.final_orientation,
-        )
-        layouts.append((len(steps), has_cost, has_tol))
-    return layouts
-
-
-def _options_text(
-    options: Sequence[PlanOption],
-    layouts: list[tuple[int, bool, bool]],
-    texts: list[str],
-    at: int,
-) -> str:
-    """The options as the JSON text of a list of :func:`option_document`.
-
-    From the float texts of :func:`_options_floats`, ``texts[at:]`` starting with them.
-    """
-    written = []
-    for option, (m, has_cost, has_tol) in zip(options, layouts):  # noqa: B905 (as long)
-        alphas = texts[at : at + m]
-        probability, cost, tol, end = texts[at + m : at + m + 4]
-        at += m + 4
-        steps = option.steps
-        if {*map(_KIND, steps)} == _SQUEEZE_KIND:  # every step the same text but its angle
-            walk = f"{_SQUEEZE_STEP}{_SQUEEZE_NEXT.join(alphas)}}}"
-        else:
-            pairs = zip(steps, alphas, strict=True)
-            walk = ", ".join([f'{{"type": {_text(s.kind)}, "alpha_rad": {a}}}' for s, a in pairs])
-        written.append(
-            f'{{"squeezes": {m}, "actions_rad": [{", ".join(alphas[1:])}], '
-            f'"steps": [{walk}], "first_squeeze_rad": {alphas[0]}, '
-            f'"final_orientation_rad": {end}, "success_probability": {probability}, '
-            f'"expected_cost": {cost if has_cost else "null"}, '
-            f'"tolerance_rad": {tol if has_tol else "null"}}}'
-        )
-    return ", ".join(written)
-
-
-# (attrgetter: no comprehension, which makes a function at every call)
-_ALPHA, _KIND = attrgetter("alpha"), attrgetter("kind")
-# A squeeze step's text but its angle: before the first angle, and between two angles.
-_SQUEEZE_KIND = {SQUEEZE.name}
-_SQUEEZE_STEP = f'{{"type": {_text(SQUEEZE.name)}, "alpha_rad": '
-_SQUEEZE_NEXT = f"}}, {_SQUEEZE_STEP}"
-
-
-def _document_text(
-    result: PlanReport,
-    guaranteed: GuaranteedPlan | None,
-    guaranteed_missing: str | None,
-    inputs: Mapping[str, Any] | None,
-    memo: dict[str, Any] | None,
-) -> str | None:
-    """The text of :func:`plan_document_json`; ``None`` where the template does not apply.
-
-    Every float of the document is written by one :func:`_float_texts` call, in this order:
-    the hull's x and y coordinates, the centre of mass, the stable orientations, their
-    probabilities, the period, the first angle, then each option's (:func:`_options_floats`),
-    and the accuracy when it is written.
-    Each is the float the general path writes: the hull's vertices as its Python floats
-    (which its array is made of, or made from), the stable orientations as the states hold
-    them, the probabilities by :meth:`~bayesgrasp.model.problem.Problem.state_probabilities`.
-    """
-    pb: Problem = result.problem
-    part = pb.part
-    if type(part) is not Part:  # a curved part's member: the general path
-        return None
-    asked = guaranteed is not None or guaranteed_missing is not None
-    bayes = result.bayes_plan
-    hull = part.hull
-    units = "" if part.units is None else f', "units": {_text(part.units)}'
-    xs, ys = hull._coords()
-    n = len(xs)
-    states = pb.states
-    stable = states.values[0]
-    k = len(stable)
-    step = bayes.steps[0]  # (its angle is the plan's first_angle)
-    probs = pb.state_probabilities(step.alpha, step.kind)
-    values = [*xs, *ys, *part.center_of_mass.tolist(), *stable, *probs]
-    values += [float(states.period), step.alpha]
-    options = result.options
-    layouts = _options_floats(options, values)
-    if pb.accuracy > 0:
-        values.append(pb.accuracy)
-    texts = _float_texts(values)
-    if texts is None:  # a value of another type, or not finite
-        return None
-    i = 2 * n + 2  # where the stable orientations start
-    j = i + k + len(probs)  # where the probabilities end
-    period, first = texts[j], texts[j + 1]
-    written = _options_text(options, layouts, texts, j + 2)
-    pairs = zip(texts[:n], texts[n : 2 * n])  # noqa: B905 (as long)
-    vertices = "], [".join(map(", ".join, pairs))  # "x0, y0], [x1, y1], [..."
-    cx, cy = texts[2 * n], texts[2 * n + 1]
-    bayes_at, most_certain = result.bayes, result.most_certain
-    if type(bayes_at) is not int or type(most_certain) is not int:  # (a bool, numpy's int)
-        return None
-    more = ""  # what only some documents have
-    if result.nodes is not None:
-        more += f', "nodes": {_int(result.nodes)}'
-    if pb.accuracy > 0:
-        more += f', "accuracy_rad": {texts[-1]}'
-    if guaranteed is not None:
-        more += f', "guaranteed": {_encode(guaranteed_document(guaranteed))}'
-    elif guaranteed_missing is not None:
-        more += f', "guaranteed": null, "guaranteed_missing": {_text(guaranteed_missing)}'
-    provenance = _shared_provenance(pb, result.method, inputs, memo)
-    if memo is None:
-        shared = _encode(provenance)
-    else:
-        if memo.get("provenance_of") is not provenance:  # encoded once for the documents sharing it
-            memo["provenance_of"], memo["provenance_text"] = provenance, _encode(provenance)
-        shared = memo["provenance_text"]
-    return (
-        f'{{"schema": {_text(plan_schema(pb, asked))}, "part": {{"name": {_text(part.name)}, '
-        f'"vertices": [[{vertices}]], "n_sides": {n}, '
-        f'"symmetry_order": {hull.symmetry_order}{units}, '
-        f'"center_of_mass": [{cx}, {cy}], "id": {_text(part_id(part))}}}, '
-        f'"method": {_text(result.method)}, '
-        f'"stable_orientations_rad": [{", ".join(texts[i : i + k])}], '
-        f'"stable_probabilities": [{", ".join(texts[i + k : j])}], '
-        f'"period_rad": {period}, "first_squeeze_rad": {first}, '
-        f'"options": [{written}], "bayes": {bayes_at}, "most_certain": {most_certain}'
-        f'{more}, "provenance": {shared}}}'
-    )
-
-
-def _shared_provenance(
-    pb: Problem, method: str, inputs: Mapping[str, Any] | None, memo: dict[str, Any] | None
-) -> dict[str, Any]:
-    """:func:`provenance` of the problem, the memo's when it was made for the same inputs."""
-    if memo is None:
-        return provenance(pb, method, **dict(inputs or {}))
-    same = (pb.prior, pb.cost, pb.goal, inputs)  # frozen values: compared as objects
-    used = 0.0 if type(pb.part) is Part else getattr(pb.part, "curve_error", 0.0)
-    alike = (pb.actions, pb.accuracy, method, used)
-    last = memo.get("provenance")
-    if last is not None:
-        (prior, cost, goal, given), was, doc = last
-        if prior is same[0] and cost is same[1] and goal is same[2] and given is inputs:
-            if was == alike:
-                return doc  # type: ignore[no-any-return]
-    doc = provenance(pb, method, **dict(inputs or {}))
-    memo["provenance"] = (same, alike, doc)
-    return doc
 
 
 def read_plan_document(

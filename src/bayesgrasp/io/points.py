@@ -35,6 +35,7 @@ import orjson
 from numpy.typing import NDArray
 
 from ..errors import PartError
+from ..files import json_float, json_int, nesting_depth
 from ..geometry import ConvexPolygon, Part, as_points, find_crossing
 from ..sizes import SMALL
 from ..tolerance import DEFAULT_TOLERANCE
@@ -43,15 +44,12 @@ from ._common import (
     MAX_COORDINATE,
     MAX_NESTING,
     ReadOptions,
-    _json_float,
-    _json_int,
     brief,
     check_coordinates,
     check_count,
     decode_text,
     fail,
     load_json,
-    nesting_depth,
     quote,
     read_bytes,
     refuse_options,
@@ -483,7 +481,7 @@ def parse_json(data: bytes, path: Path, options: ReadOptions) -> Part:
 
 
 # load_json's parser (numbers too large refused) and the default options, made once.
-_DECODER = json.JSONDecoder(parse_int=_json_int, parse_float=_json_float)
+_DECODER = json.JSONDecoder(parse_int=json_int, parse_float=json_float)
 # The first reading of a batch line, by orjson: it reads a number as json does (the nearest
 # float, or the int), but an integer beyond 64 bits as a float, where json keeps the int; so a
 # line read by it takes the fast path only when every coordinate is within 2^53, and a float

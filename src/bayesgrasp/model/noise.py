@@ -72,6 +72,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "MAX_NORMAL_SIGMA",
+    "MIN_SCALE",
     "QUADRATURE_NODES",
     "NoiseModel",
     "NoisyTransitions",
@@ -84,6 +85,9 @@ FloatArray = NDArray[np.float64]
 MAX_NORMAL_SIGMA = math.radians(30.0)
 """Largest standard deviation of a normal turn error (beyond it the turn is a guess)."""
 _NORMAL_SUPPORT = 12.0  # the normal error is taken as 0 beyond 12 sigma (mass 4e-33)
+MIN_SCALE = 1e-12
+"""Smallest non-zero turn error (radians): below it every turn is exact to rounding (angles
+carry errors of about 1e-15 rad), and the refinement's bound ``1 / sigma^2`` overflows."""
 QUADRATURE_NODES = 512
 """Nodes of the rule that averages a non-uniform prior over the first action's error."""
 
@@ -145,6 +149,12 @@ class TurnNoise:
             raise PlanningError(
                 f"turn noise `scale` must be a number of radians in [0, {top:.6g}] for "
                 f"{self.kind!r} noise; got {self.scale!r}"
+            )
+        if 0.0 < self.scale < MIN_SCALE:
+            raise PlanningError(
+                f"turn noise `scale` {math.degrees(self.scale):.3g} deg is below "
+                f"{math.degrees(MIN_SCALE):.2g} deg, where every turn is exact to rounding: "
+                "give 0 for exact turns"
             )
         object.__setattr__(self, "scale", float(self.scale))
 

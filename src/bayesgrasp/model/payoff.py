@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,6 +43,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..angles import TWO_PI, circle_distance
 from ..errors import PlanningError
+from ..files import decode_text, load_json, read_bytes
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..geometry.transfer import TransferFunction
@@ -200,7 +200,10 @@ def _entries_json(doc: Any, name: str) -> tuple[list[float], list[float], float]
 
 
 def _entries_csv(text: str, name: str) -> tuple[list[float], list[float], float]:
-    rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    try:
+        rows = [r for r in csv.reader(io.StringIO(text)) if any(c.strip() for c in r)]
+    except csv.Error as exc:  # a field over the csv module's limit (128 KiB), a stray NUL
+        raise PayoffError(f"payoff file {name!r} is not valid CSV ({exc})") from None
     if rows and [c.strip().lower() for c in rows[0]] == ["orientation_deg", "value"]:
         rows = rows[1:]
     degs: list[float] = []
@@ -239,21 +242,13 @@ def read_payoff(path: str | Path) -> Payoff:
     [1.0]
     """
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or exc
-        raise PayoffError(f"payoff file {str(p)!r} cannot be read ({reason})") from None
-    if p.suffix.lower() == ".json":
-        try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise PayoffError(f"payoff file {p.name!r} is not valid JSON ({exc.msg})") from None
-        degs, vals, default = _entries_json(doc, p.name)
-    elif p.suffix.lower() == ".csv":
-        degs, vals, default = _entries_csv(text, p.name)
-    else:
+    if p.suffix.lower() not in (".json", ".csv"):
         raise PayoffError(f"payoff file {p.name!r} must end in .json or .csv")
+    text = decode_text(p, read_bytes(p, PayoffError, "payoff file"), PayoffError)
+    if p.suffix.lower() == ".json":
+        degs, vals, default = _entries_json(load_json(p, text, PayoffError), p.name)
+    else:
+        degs, vals, default = _entries_csv(text, p.name)
     if not all(math.isfinite(d) for d in degs):
         raise PayoffError(f"payoff file {p.name!r}: orientations must be finite")
     return Payoff(np.radians(degs), np.asarray(vals, dtype=np.float64), default, p.name)

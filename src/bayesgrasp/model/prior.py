@@ -350,11 +350,10 @@ def parse_prior(spec: str) -> Prior:
     if kind in ("histogram", "sample"):
         from pathlib import Path
 
+        from ..files import decode_text, read_bytes
+
         path = Path(arg)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise PriorError(f"prior file {arg!r} cannot be read ({exc.strerror or exc})") from None
+        text = decode_text(path, read_bytes(path, PriorError, "prior file"), PriorError)
         try:
             values = [float(x) for x in text.replace(",", " ").split()]
         except ValueError:

@@ -72,6 +72,13 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.intp]
 
+MAX_CELLS_PER_STATE = 4096
+"""Most quantisation cells one state's readings may fall in (within ``tail`` SIGMA of its
+width): a step finer than ``SIGMA / 500`` tells a policy nothing more, and every cell is a
+branch the policy search visits."""
+MAX_CELLS = 1 << 16
+"""Most quantisation cells between the smallest and the largest width (plus the tails)."""
+
 
 class SensorError(BayesGraspError, ValueError):
     """A sensor specification or part prior that cannot be used; the message says why."""
@@ -216,17 +223,49 @@ class WidthSensor:
             raise PlanningError(
                 f"`widths` must be a non-empty 1-d array of finite numbers; got {d}"
             )
+        tol = (
+            DEFAULT_TOLERANCE.length_for(float(np.max(np.abs(d))))
+            if length_tol is None
+            else float(length_tol)
+        )
         if self.kind == "exact":
-            tol = (
-                DEFAULT_TOLERANCE.length_for(float(np.max(np.abs(d))))
-                if length_tol is None
-                else float(length_tol)
-            )
             return _exact_bins(d, tol)
+        self._check_scale(d, tol)
         if self.kind == "quantised":
             cell = np.rint(d / self.resolution).astype(np.int64)
             return _cell_bins(cell, self.resolution)
         return _noisy_bins(d, self.sigma, self.resolution, self.tail, self.min_likelihood)
+
+    def _check_scale(self, d: FloatArray, tol: float) -> None:
+        """Refuse a sensor whose readings would only see rounding, or too many cells.
+
+        Widths closer than the length tolerance ``tol`` are one width (the geometry cannot
+        tell them apart), so a reading step or error below it would "read" rounding errors:
+        between ``theta`` and ``theta + pi`` the widths differ by about ``1e-15``, and a step
+        that fine would claim to separate orientations no squeeze separates.
+        """
+        for name, v in (("reading step RES", self.resolution), ("reading error SIGMA", self.sigma)):
+            if 0 < v < tol:
+                raise SensorError(
+                    f"sensor {self.spec}: the {name} ({v:g}) is below the length tolerance of "
+                    f"these parts ({tol:.3g}): widths that close are one width; use at least "
+                    f"{tol:.3g}"
+                )
+        if self.sigma == 0:
+            return
+        per_state = 2.0 * self.tail * self.sigma / self.resolution + 1.0
+        total = (float(d.max() - d.min()) + 2.0 * self.tail * self.sigma) / self.resolution + 1.0
+        if per_state > MAX_CELLS_PER_STATE or total > MAX_CELLS:
+            least = max(
+                2.0 * self.tail * self.sigma / (MAX_CELLS_PER_STATE - 1),
+                (float(d.max() - d.min()) + 2.0 * self.tail * self.sigma) / (MAX_CELLS - 1),
+            )
+            raise SensorError(
+                f"sensor {self.spec}: a reading step of {self.resolution:g} cuts the readings "
+                f"into {min(per_state, total):.3g} cells within {self.tail:g} SIGMA of the widths "
+                f"(at most {MAX_CELLS_PER_STATE} a width, {MAX_CELLS} in all): use a step RES of "
+                f"at least {least:.3g}"
+            )
 
 
 EXACT = WidthSensor()

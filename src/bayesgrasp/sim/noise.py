@@ -1,9 +1,16 @@
-"""Errors of the gripper: what a simulation adds to every commanded gripper angle.
+"""Errors of the gripper as the simulations draw them.
+
+The noise vocabulary is the model's (:mod:`bayesgrasp.model.noise`): a
+:class:`~bayesgrasp.model.noise.NoiseModel` of a turn error
+(:class:`~bayesgrasp.model.noise.TurnNoise`) and a contact asynchrony ``q``. The simulations
+take it (:func:`~bayesgrasp.sim.kinematic.simulate_kinematic` draws both,
+:func:`~bayesgrasp.sim.engine.simulate_mujoco` the turn error) and predict with its exact
+matrices. :class:`GripperNoise` is the sampler of a turn error, the form the simulators
+draw from (:meth:`GripperNoise.of`); given to a simulator in place of a noise model it means
+the turn error alone (:func:`noise_model`).
 
 A plan's angular tolerance (:attr:`~bayesgrasp.planning.result.PlanOption.tolerance`) bounds
-the error on ``alpha_2 .. alpha_k`` that keeps its success probability; the simulations
-(:func:`~bayesgrasp.sim.kinematic.simulate_kinematic`,
-:func:`~bayesgrasp.sim.engine.simulate_mujoco`) draw such errors to check it.
+the error on ``alpha_2 .. alpha_k`` that keeps its noise-free success probability.
 """
 
 from __future__ import annotations
@@ -15,9 +22,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import SimulationError
+from ..errors import PlanningError, SimulationError
+from ..model.noise import NoiseModel, TurnNoise
 
-__all__ = ["GripperNoise", "as_generator"]
+__all__ = ["AnyNoise", "GripperNoise", "as_generator", "noise_model"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +66,17 @@ class GripperNoise:
             raise SimulationError(
                 f"gripper noise `scale` must be a finite number >= 0; got {self.scale!r}"
             )
+
+    @classmethod
+    def of(cls, turn: TurnNoise) -> GripperNoise:
+        """The sampler of a model's turn error (the same kind and scale).
+
+        Examples
+        --------
+        >>> GripperNoise.of(TurnNoise("uniform", 0.1))
+        GripperNoise(kind='uniform', scale=0.1)
+        """
+        return cls(turn.kind, turn.scale)
 
     def draw(
         self, shape: tuple[int, ...], rng: np.random.Generator | int | None
@@ -103,3 +122,41 @@ def as_generator(rng: object, name: str = "rng") -> np.random.Generator:
         return np.random.default_rng(rng)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         raise SimulationError(want) from None
+
+
+AnyNoise = NoiseModel | GripperNoise | None
+"""What the simulators take as noise: a noise model, a turn error alone, or none."""
+
+
+def noise_model(noise: AnyNoise) -> NoiseModel:
+    """The noise model a simulator draws from and predicts with.
+
+    ``None`` is no noise; a :class:`GripperNoise` is that turn error with simultaneous jaw
+    contacts.
+
+    Raises
+    ------
+    SimulationError
+        A turn error the model cannot evaluate exactly (a normal error of standard deviation
+        above :data:`~bayesgrasp.model.noise.MAX_NORMAL_SIGMA`, a uniform one beyond pi), or
+        something that is no noise.
+
+    Examples
+    --------
+    >>> noise_model(GripperNoise("normal", 0.05)).describe()
+    'turn error normal:2.86479 deg'
+    >>> noise_model(None).exact
+    True
+    """
+    if noise is None:
+        return NoiseModel()
+    if isinstance(noise, NoiseModel):
+        return noise
+    if not isinstance(noise, GripperNoise):
+        raise SimulationError(
+            f"`noise` must be a NoiseModel, a GripperNoise or None; got {type(noise).__name__}"
+        )
+    try:
+        return NoiseModel(TurnNoise(noise.kind, noise.scale))
+    except PlanningError as exc:
+        raise SimulationError(f"no exact prediction for this gripper error: {exc}") from None

@@ -1,31 +1,26 @@
-"""Kinematic Monte Carlo of a plan under a noise model (turn error and contact asynchrony).
+"""Final-state counts of a plan under a noise model (turn error and contact asynchrony).
 
 The independent check of :mod:`bayesgrasp.model.noise`: instead of transition matrices it
 draws what the model says happens, trial by trial, and runs the transfer functions on
-orientations. Each trial draws the initial world orientation from the prior; every commanded
-angle gets an error drawn from the turn noise (as
-:func:`~bayesgrasp.sim.kinematic.simulate_kinematic` does); each squeeze is, with probability
-``q``, a push-grasp from the ``-x`` or the ``+x`` side (equally likely): ``g(theta)`` or
-``g(theta - pi) + pi``, ``g`` the push-grasp function.
+orientations; the draws are :func:`~bayesgrasp.sim.kinematic.simulate_kinematic`'s (its
+module notes say what they are). :func:`simulate_noise` returns only the counts of the
+final states, for a plan given as steps (no goal, no jams: each trial ends in its nearest
+state).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..angles import TWO_PI
 from ..errors import SimulationError
-from ..geometry.push import push_grasp_function
-from ..model.actions import SQUEEZE
 from ..model.noise import NoiseModel
 from ..model.problem import Problem
 from ..model.states import nearest_state
 from ..planning.result import PlanStep
-from .kinematic import sample_prior
+from .kinematic import contact_push, run_trials
 from .noise import GripperNoise, as_generator
 from .result import check_steps, check_trials
 
@@ -73,25 +68,13 @@ def simulate_noise(
     check_trials(trials)
     check_steps(problem, steps)
     gen = as_generator(rng)
-    turn = GripperNoise(noise.turn.kind, noise.turn.scale)
-    q = noise.contact
-    push = push_grasp_function(problem.part, problem.states) if q > 0 else None
+    turn = GripperNoise.of(noise.turn)
+    push = contact_push(problem, noise.contact)
     counts = np.zeros(problem.n_states, dtype=np.intp)
     done = 0
     while done < trials:
         m = min(chunk, trials - done)
-        theta = sample_prior(problem.prior, m, gen)
-        for step in steps:
-            f = problem.transfer(step.kind)
-            x = theta - (step.alpha + turn.draw((m,), gen))
-            out = f(x)
-            if push is not None and step.kind == SQUEEZE.name:
-                event = gen.random(m)
-                left = event < q / 2
-                right = (event >= q / 2) & (event < q)
-                out = np.where(left, push(x), out)
-                out = np.where(right, push(x - math.pi) + math.pi, out)
-            theta = np.mod(out, TWO_PI)
+        theta, _, _ = run_trials(problem, steps, turn, noise.contact, m, gen, push=push)
         counts += np.bincount(nearest_state(problem.states, theta), minlength=problem.n_states)
         done += m
     if int(counts.sum()) != trials:  # pragma: no cover - a bug

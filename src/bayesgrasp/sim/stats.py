@@ -17,7 +17,7 @@ from ..errors import SimulationError
 __all__ = ["goodness_of_fit", "wilson_interval"]
 
 
-def wilson_interval(successes: int, trials: int, confidence: float = 0.95) -> tuple[float, float]:
+def wilson_interval(successes: float, trials: int, confidence: float = 0.95) -> tuple[float, float]:
     """Wilson score interval of a binomial proportion.
 
     Better than the normal approximation near 0 and 1 and for small samples (Wilson 1927;
@@ -25,8 +25,8 @@ def wilson_interval(successes: int, trials: int, confidence: float = 0.95) -> tu
 
     Parameters
     ----------
-    successes : int
-        In ``[0, trials]``.
+    successes : int or float
+        In ``[0, trials]``: a count, or ``trials`` times the mean of a value in [0, 1].
     trials : int
         ``0`` or fewer gives the uninformative interval ``(0, 1)``.
     confidence : float
