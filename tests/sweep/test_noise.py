@@ -133,7 +133,7 @@ def test_bad_noise_options_are_refused(kwargs: dict[str, Any], error: type, matc
 def test_missing_payoff_file_is_one_row_error(parts: list[str], tmp_path: Path) -> None:
     row = plan_part(parts[0], noisy(payoff=str(tmp_path / "none.json")))
     assert row["status"] == "error" and row["error_class"] == "PayoffError"
-    assert "cannot be read" in row["error_message"]
+    assert row["error_message"].endswith("none.json: no such file")
 
 
 # -- resume ----------------------------------------------------------------------------------
@@ -226,7 +226,7 @@ def test_local_cluster_sweep_with_a_payoff_equals_plan(
         (["--payoff", "u.json", "--sense", "width"], "--sense: not with"),
         (["--contact-noise", "0.1", "--method", "bfs"], "--method bfs: not with"),
         (["--contact-noise", "0.1", "--simulate", "kinematic"], "--simulate: not with"),
-        (["--payoff", "missing.json"], "payoff file 'missing.json' cannot be read"),
+        (["--payoff", "missing.json"], "missing.json: no such file"),
         (["--output-format", "csv", "--format", "parquet"], "give --output-format only"),
     ],
 )
