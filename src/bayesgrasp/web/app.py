@@ -591,7 +591,8 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "Bayesian squeeze and push-grasp plans for planar parts. Every answer is the "
             "JSON document `bayesgrasp COMMAND --json` prints. Limits: request bodies up to "
             f"{lim.max_body_bytes} bytes, parts up to {lim.max_vertices} vertices, "
-            f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials."
+            f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials, "
+            f"{lim.noisy_workers} noise-aware plan(s) at a time."
         ),
     )
     app.state.service = service
