@@ -10,9 +10,13 @@ and a few parts are checked in MuJoCo (``--mujoco-parts``, 100 trials each) to m
 a minute and extrapolate a 10^5-part check. The machine's load average is printed before
 and after each run: on a shared machine the figures are only as good as the load allows.
 
+``--turn-noise SPEC`` (and ``--contact-noise Q``) plans every part with the noise-aware
+planner instead (no guaranteed plan), as ``sweep --turn-noise``.
+
 Usage::
 
     .venv/bin/python benchmarks/bench_sweep.py --parts 10000 --mujoco-parts 10
+    .venv/bin/python benchmarks/bench_sweep.py --parts 500 --mujoco-parts 0 --turn-noise normal:2
 """
 
 from __future__ import annotations
@@ -64,13 +68,22 @@ def main() -> None:
     ap.add_argument("--parts", type=int, default=10_000)
     ap.add_argument("--mujoco-parts", type=int, default=10)
     ap.add_argument("--mujoco-trials", type=int, default=100)
+    ap.add_argument("--turn-noise", default=None, metavar="normal:SIGMA_DEG|uniform:A_DEG")
+    ap.add_argument("--contact-noise", type=float, default=None, metavar="Q")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="bench-sweep-"))
     folder = tmp / "parts"
     folder.mkdir()
     files = write_parts(folder, args.parts)
-    options = SweepOptions()
-    print(f"{args.parts} random parts; cores {os.cpu_count()}; {load()}")
+    if args.turn_noise is None and args.contact_noise is None:
+        options = SweepOptions()
+        how = "exact planner"
+    else:
+        options = SweepOptions(
+            guaranteed=False, turn_noise=args.turn_noise, contact_noise=args.contact_noise
+        )
+        how = f"noise-aware planner, turn {args.turn_noise}, contact {args.contact_noise}"
+    print(f"{args.parts} random parts ({how}); cores {os.cpu_count()}; {load()}")
 
     t = time.perf_counter()
     for f in files:

@@ -5,7 +5,10 @@ Starts the server on a free 127.0.0.1 port (a subprocess, stopped at the end), s
 ``--clients`` threads, checks every answer against the library's own document, and prints
 p50/p99 latency and throughput.
 
-    python benchmarks/bench_web.py [--requests 2000] [--clients 8]
+    python benchmarks/bench_web.py [--requests 2000] [--clients 8] [--noisy]
+
+``--noisy``: one body in four also asks for turn or contact noise (the noise-aware
+planner, heavier), and the latencies of the noisy and the other requests are printed apart.
 """
 
 from __future__ import annotations
@@ -34,7 +37,14 @@ def free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def bodies(n_random: int = 24) -> list[dict[str, Any]]:
+NOISE: list[dict[str, Any]] = [
+    {"turn_noise": "normal:1"},
+    {"turn_noise": "uniform:2", "contact_noise": 0.05},
+    {"contact_noise": 0.1},
+]
+
+
+def bodies(n_random: int = 24, noisy: bool = False) -> list[dict[str, Any]]:
     from bayesgrasp.shapes import names
 
     rng = np.random.default_rng(7)
@@ -50,6 +60,10 @@ def bodies(n_random: int = 24) -> list[dict[str, Any]]:
     for i in range(n_random):
         verts = rng.uniform(-40, 40, size=(int(rng.integers(3, 10)), 2)).round(3).tolist()
         out.append({"part": {"vertices": verts}, **options[i % len(options)]})
+    if noisy:  # one body in four: with noise (and so without the guaranteed plan)
+        for i in range(0, len(out), 4):
+            out[i] = {**out[i], **NOISE[(i // 4) % len(NOISE)]}
+            out[i].pop("guaranteed", None)
     return out
 
 
@@ -65,9 +79,10 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--requests", type=int, default=2000)
     ap.add_argument("--clients", type=int, default=8)
+    ap.add_argument("--noisy", action="store_true", help="one body in four with noise")
     args = ap.parse_args()
 
-    cases = bodies()
+    cases = bodies(noisy=args.noisy)
     want = [expected(b) for b in cases]
     port = free_port()
     data = tempfile.mkdtemp(prefix="bench-web-")
@@ -90,6 +105,7 @@ def main() -> int:
             except OSError:
                 time.sleep(0.1)
         latencies: list[float] = []
+        noisy_latencies: list[float] = []
         failures: list[str] = []
 
         def one(i: int) -> None:
@@ -106,7 +122,8 @@ def main() -> int:
             except OSError as exc:
                 failures.append(f"request {i}: {exc}")
                 return
-            latencies.append(time.perf_counter() - t0)
+            noisy = any(key in cases[k] for key in ("turn_noise", "contact_noise"))
+            (noisy_latencies if noisy else latencies).append(time.perf_counter() - t0)
             if doc != want[k]:
                 failures.append(f"request {i}: the answer differs from the library's document")
 
@@ -118,12 +135,17 @@ def main() -> int:
         proc.terminate()
         proc.wait(timeout=10)
 
-    lat = sorted(latencies)
-    p50 = statistics.median(lat) * 1000
-    p99 = lat[min(len(lat) - 1, int(0.99 * len(lat)))] * 1000
+    def p50_p99(values: list[float]) -> str:
+        lat = sorted(values)
+        if not lat:
+            return "none"
+        p99 = lat[min(len(lat) - 1, int(0.99 * len(lat)))] * 1000
+        return f"p50 {statistics.median(lat) * 1000:.1f} ms, p99 {p99:.1f} ms"
+
+    noisy = f" (noisy requests: {p50_p99(noisy_latencies)})" if args.noisy else ""
     print(
         f"bench_web: {args.requests} plan requests ({len(cases)} distinct bodies) from "
-        f"{args.clients} clients: p50 {p50:.1f} ms, p99 {p99:.1f} ms, "
+        f"{args.clients} clients: {p50_p99(latencies)}{noisy}, "
         f"{args.requests / wall:.0f} requests/s, {len(failures)} wrong or failed"
     )
     for f in failures[:10]:

@@ -146,11 +146,12 @@ def test_resume_after_interrupt_gives_each_part_once(
     s = run_sweep([folder], out, options, scheduler=cluster, resume=True)
     assert s.skipped == first.written and s.written == len(files) - first.written
     rows_check(read_results(out), files, options)
-    # a third run has nothing left to do; other options are not the same rows
+    # a third run has nothing left to do; other options would mix rows: refused
     assert run_sweep([folder], out, options, scheduler=cluster, resume=True).written == 0
     other = SweepOptions(verify_cost=2.0)
-    s = run_sweep([folder / "catalogue"], out, other, scheduler=cluster, resume=True)
-    assert s.skipped == 0 and s.written == len(list((folder / "catalogue").iterdir()))
+    with pytest.raises(SweepError, match=r"cannot resume: .*verify_cost 1\.0 -> 2\.0"):
+        run_sweep([folder / "catalogue"], out, other, scheduler=cluster, resume=True)
+    assert len(read_results(out)) == len(files)
 
 
 def test_resume_csv_with_a_cut_last_line(

@@ -286,6 +286,37 @@ def test_catalogue_and_gallery(server: str, page: Any, cli_json: CliJson) -> Non
     page.wait_for_function("document.querySelectorAll('#gallery li').length > 0")
 
 
+def test_noise_fields_reach_the_plan_and_the_link(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    _, exact = cli_json("plan", "key")
+    wait_rows(page, expected_rows(exact))
+    page.select_option("#turn-kind", "normal")
+    page.fill("#turn-deg", "2")
+    page.fill("#contact-noise", "0.1")
+    page.click("#plan")
+    _, noisy = cli_json("plan", "key", "--turn-noise", "normal:2", "--contact-noise", "0.1")
+    assert expected_rows(noisy) != expected_rows(exact)
+    wait_rows(page, expected_rows(noisy))
+    shared = page.url
+    assert "turn_noise=normal%3A2" in shared and "contact_noise=0.1" in shared
+
+    # the link alone gives the noisy plan in a fresh page; clearing the noise gives it back
+    other = page.context.new_page()
+    other.goto(shared)
+    wait_rows(other, expected_rows(noisy))
+    assert other.locator("#turn-kind").input_value() == "normal"
+    assert other.locator("#turn-deg").input_value() == "2"
+    assert other.locator("#contact-noise").input_value() == "0.1"
+    other.select_option("#turn-kind", "")
+    other.fill("#contact-noise", "")
+    other.click("#plan")
+    wait_rows(other, expected_rows(exact))
+    assert "noise" not in other.url
+    other.close()
+
+
 def test_bad_coordinates_show_the_message(server: str, page: Any) -> None:
     page.goto(server + "/")
     page.fill("#coords", "0, 0\n1, 1\n2, 2")

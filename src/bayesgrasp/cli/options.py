@@ -201,7 +201,9 @@ def _part_params(optional: bool = False) -> list[inspect.Parameter]:
     ]
 
 
-def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Parameter]:
+def _problem_params(
+    names: list[str], push_grasp_alias: bool, plan_file: bool = True
+) -> list[inspect.Parameter]:
     money = {"callback": cost_value}
     cost = [
         _opt(f"cost_{i}", float, 1.0, f"--{n}-cost", **money, help=f"Cost of a {n}.")
@@ -220,7 +222,7 @@ def _problem_params(names: list[str], push_grasp_alias: bool) -> list[inspect.Pa
         for i, n in enumerate(names)
     ]
     kinds = ACTIONS_HELP.format(", ".join(names))
-    from_file = " (default: {}; with --plan FILE: the file's)"
+    from_file = " (default: {}; with --plan FILE: the file's)" if plan_file else " (default: {})"
     params = [
         _opt("prior", str | None, None, help=PRIOR_HELP + from_file.format("uniform")),
         cost[0],
@@ -277,7 +279,10 @@ def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:
         from ..model.actions import ACTIONS
 
         names = list(ACTIONS)  # the kinds registered now: one cost option each
-        params = _problem_params(names, push_grasp_alias)
+        # the help names --plan FILE only where the command has --plan
+        hints = inspect.signature(func, eval_str=True).parameters.values()
+        plan_file = any(p.annotation == PlanChoiceOpt for p in hints)
+        params = _problem_params(names, push_grasp_alias, plan_file)
         return _replace(func, "spec", params, functools.partial(problem_spec, names))
 
     return decorate

@@ -42,9 +42,18 @@ def sweep(
     paths: PathsArg,
     spec: ProblemSpec,
     out: Annotated[Path, typer.Option("--out", help="Results: a Parquet folder, or a CSV file.")],
-    fmt: Annotated[ResultFormat, typer.Option("--format", help="Results format.")] = (
-        ResultFormat.parquet
-    ),
+    output_format: Annotated[
+        ResultFormat | None,
+        typer.Option(
+            "--output-format",
+            show_default=False,
+            help="Format of RESULTS (default: csv for a .csv path, else parquet).",
+        ),
+    ] = None,
+    old_format: Annotated[
+        ResultFormat | None,
+        typer.Option("--format", hidden=True, help="The old name of --output-format."),
+    ] = None,
     simulate: Annotated[
         Engine | None, typer.Option(help="Also execute each Bayes plan (kinematic or MuJoCo).")
     ] = None,
@@ -66,7 +75,13 @@ def sweep(
     report_file: Annotated[
         Path | None, typer.Option("--report", metavar="FILE.html", help="Also write a report.")
     ] = None,
-    guaranteed: Annotated[bool, typer.Option(help="Also find each part's guaranteed plan.")] = True,
+    guaranteed: Annotated[
+        bool | None,
+        typer.Option(
+            show_default=False,
+            help="Also find each part's guaranteed plan (default: yes, without noise).",
+        ),
+    ] = None,
     sense: Annotated[
         str | None,
         typer.Option(
@@ -77,6 +92,36 @@ def sweep(
         ),
     ] = None,
     max_actions: MaxActionsOpt = 3,
+    turn_noise: Annotated[
+        str | None,
+        typer.Option(
+            "--turn-noise",
+            metavar="normal:SIGMA_DEG|uniform:A_DEG",
+            help="Plan each part for gripper turns executed as alpha + e, e ~ Normal(0, "
+            "SIGMA^2) or uniform on [-A, A] degrees: the noise-aware Bayes plan, as plan "
+            "--turn-noise.",
+        ),
+    ] = None,
+    contact_noise: Annotated[
+        float | None,
+        typer.Option(
+            "--contact-noise",
+            metavar="Q",
+            min=0.0,
+            max=1.0,
+            help="Plan each part for jaws that touch one after the other with probability Q, "
+            "as plan --contact-noise.",
+        ),
+    ] = None,
+    payoff: Annotated[
+        Path | None,
+        typer.Option(
+            "--payoff",
+            metavar="FILE",
+            help="Payoff in [0, 1] of final stable orientations (.json or .csv), as plan "
+            "--payoff: each part's plan minimises the expected cost per unit payoff.",
+        ),
+    ] = None,
     layer: Annotated[str | None, typer.Option(help="DXF: read only this layer.")] = None,
     flatten_tol: Annotated[float | None, typer.Option(help=FLATTEN_HELP)] = None,
     shape_tol: Annotated[float, typer.Option(min=0, help=SHAPE_HELP)] = 0.0,
@@ -89,11 +134,42 @@ def sweep(
     planned is a row with its error, never a stopped sweep. By default a local cluster of
     worker processes runs the sweep; --scheduler ADDRESS uses an existing cluster
     (`dask scheduler` / `dask worker`).
+
+    With --turn-noise, --contact-noise or --payoff each row is the noise-aware Bayes plan
+    (as plan PATH --turn-noise ...), without a guaranteed plan, --sense or --simulate.
+    --resume continues a RESULTS planned with the same options only.
     """
     from ..sweep import SweepInterrupted, SweepOptions, run_sweep, write_report
     from .common import check_outputs, input_files
 
-    inputs = input_files(None, spec.prior, *paths)  # RESULTS has its own --resume / --force
+    if output_format is not None and old_format is not None and output_format != old_format:
+        raise typer.BadParameter("give --output-format only", param_hint="--format")
+    fmt = output_format or old_format
+    if fmt is None:  # a .csv path is a CSV file (unless a Parquet folder of that name exists)
+        csv = out.suffix.lower() == ".csv" and not out.is_dir()
+        fmt = ResultFormat.csv if csv else ResultFormat.parquet
+    noisy = not (turn_noise is None and contact_noise is None and payoff is None)
+    if noisy:
+        given = [
+            flag
+            for flag, on in (
+                ("--guaranteed", guaranteed),
+                ("--sense", sense is not None),
+                ("--simulate", simulate is not None),
+                ("--method bfs", spec.method.value != "exact"),
+            )
+            if on
+        ]
+        if given:
+            raise typer.BadParameter(
+                f"{', '.join(given)}: not with --turn-noise, --contact-noise or --payoff yet"
+            )
+    if turn_noise is not None:
+        from .noisy import turn_noise as parse_turn
+
+        parse_turn(turn_noise)  # a malformed spec: one line, exit 2
+    extra = () if payoff is None else (str(payoff),)
+    inputs = input_files(None, spec.prior, *paths, *extra)  # RESULTS: its own --resume/--force
     check_outputs([out], inputs, force=True, hint="--out", folders=True)
     if report_file is not None:
         check_outputs([report_file], [*inputs, out], force, "--report")
@@ -111,7 +187,7 @@ def sweep(
         accuracy_deg=spec.accuracy_deg,
         method=spec.method.value,
         max_actions=spec.max_actions,
-        guaranteed=guaranteed,
+        guaranteed=not noisy if guaranteed is None else guaranteed,
         simulate=simulate.value if simulate else None,
         trials=trials,
         seed=seed,
@@ -120,6 +196,9 @@ def sweep(
         shape_tol=shape_tol,
         sense=sense,
         sense_max_actions=max_actions,
+        turn_noise=turn_noise,
+        contact_noise=contact_noise,
+        payoff=None if payoff is None else str(payoff),
     )
 
     def work(progress: Any) -> Any:

@@ -330,6 +330,11 @@ def run_sweep(
         raise SweepError(f"`send` must be 'auto', 'path' or 'bytes'; got {send!r}")
     kind = results_format(Path(out), fmt)
     prior = parse_prior(options.prior)  # once, here: a prior file need not be on the workers
+    payoff = None
+    if options.payoff is not None:  # the same for a payoff file
+        from ..model.payoff import read_payoff
+
+        payoff = read_payoff(options.payoff)
     if options.simulate == "mujoco":
         from ..sim import require_mujoco
 
@@ -399,7 +404,13 @@ def run_sweep(
         while queue and len(running) < window:
             chunk = queue.popleft()
             fut = client.submit(
-                run_chunk, chunk, options, prior, timeout, key=f"bayesgrasp-sweep-{tag}-{sent}"
+                run_chunk,
+                chunk,
+                options,
+                prior,
+                timeout,
+                payoff,
+                key=f"bayesgrasp-sweep-{tag}-{sent}",
             )
             sent += 1
             running[fut] = chunk

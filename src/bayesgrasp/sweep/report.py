@@ -183,6 +183,20 @@ def report_html(
             ("Bayes cost: max", _num(max(costs))),
             ("Bayes plan length: mean", _num(statistics.fmean(lengths), 3)),
         ]
+    paid = [r for r in planned if r.get("bayes_payoff") is not None]
+    if paid:  # rows of a sweep with noise or a payoff: the noise-aware Bayes plans
+        noises = Counter(
+            ", ".join(f"{k} {r[k]}" for k in ("turn_noise", "contact_noise", "payoff") if r.get(k))
+            or "none"
+            for r in paid
+        )
+        summary += [(f"noise: {k}", v) for k, v in noises.most_common()]
+        summary.append(
+            (
+                "Bayes plan expected payoff: mean",
+                _num(statistics.fmean(r["bayes_payoff"] for r in paid)),
+            )
+        )
     sensed = [r for r in planned if r.get("policy_cost") is not None]
     if sensed:  # rows of a sweep with --sense: what reading the jaw width buys
         acts = statistics.fmean(r["policy_actions"] for r in sensed)

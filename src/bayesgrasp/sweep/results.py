@@ -209,8 +209,11 @@ class CsvWriter:
             self._drop_cut_line()
             with open(path, encoding="utf-8", newline="") as f:
                 header = next(csv.reader(f), [])
-            if header != self.columns:
+            if header != self.columns[: len(header)] or not header:
                 raise SweepError(f"{path}: not a results file of this version (its header differs)")
+            # a file written before the last columns existed: its rows keep its columns (the
+            # options of a resumed run are those of the file, so those columns are empty)
+            self.columns = header
         else:
             with open(path, "w", encoding="utf-8", newline="") as f:
                 csv.writer(f).writerow(self.columns)
@@ -254,6 +257,31 @@ def _remove(path: Path) -> None:
         side.unlink()
 
 
+def _check_same_options(out: Path, options: SweepOptions) -> None:
+    """Refuse to resume ``out`` with options none of its runs had (rows would mix).
+
+    Raises
+    ------
+    SweepError
+        Naming the options that differ from the last run's.
+    """
+    runs = read_metadata(out)
+    if not runs or any(r.get("options_key") == options.key for r in runs):
+        return
+    stored = runs[-1].get("options", {})
+    now = options.to_json()
+    differ = [
+        f"{k} {stored.get(k)!r} -> {now.get(k)!r}"
+        for k in sorted(set(stored) | set(now))
+        if stored.get(k) != now.get(k)
+    ]
+    raise SweepError(
+        f"{out}: cannot resume: its rows were planned with other options "
+        f"({'; '.join(differ) or 'a different options key'}); give the same options, "
+        "another --out, or --force to replace it"
+    )
+
+
 def open_results(
     out: Path,
     options: SweepOptions,
@@ -277,6 +305,7 @@ def open_results(
             raise SweepError(f"{out}: cannot resume: not a Parquet results folder")
         if kind == "csv" and out.is_dir():
             raise SweepError(f"{out}: cannot resume: a folder, not a CSV results file")
+        _check_same_options(out, options)
     elif exists:
         if not force:
             raise SweepError(f"{out} exists; resume it (--resume) or replace it (--force)")

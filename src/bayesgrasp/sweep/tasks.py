@@ -25,10 +25,13 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Literal, cast
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 from ..errors import BayesGraspError
 from ..model.prior import Prior, parse_prior
+
+if TYPE_CHECKING:
+    from ..model.payoff import Payoff
 
 __all__ = [
     "ENGINES",
@@ -119,6 +122,20 @@ class SweepOptions:
         out of :meth:`to_json` like ``sense_max_actions``.
     sense_max_actions : int
         The policy's depth (``plan --sense ... --max-actions``).
+    turn_noise : str, optional
+        Error of every gripper turn, ``normal:SIGMA_DEG`` or ``uniform:A_DEG``
+        (``plan --turn-noise``).
+    contact_noise : float, optional
+        Probability in [0, 1] that a squeeze's jaws touch one after the other
+        (``plan --contact-noise``).
+    payoff : str, optional
+        A payoff file (``plan --payoff``), read once by the client.
+
+        With any of these three, each part's plan is the noise-aware Bayes plan
+        (:func:`~bayesgrasp.planning.noisy.plan_noisy`), its row ``plan_json`` the document
+        ``plan PATH --turn-noise ... --json`` prints; they take the exact method and no
+        guaranteed plan, sensing policy or simulation. Left out of :meth:`to_json` when not
+        given, so the keys of sweeps run before them still resume.
 
     Examples
     --------
@@ -153,6 +170,9 @@ class SweepOptions:
     shape_tol: float = 0.0
     sense: str | None = None
     sense_max_actions: int = 3
+    turn_noise: str | None = None
+    contact_noise: float | None = None
+    payoff: str | None = None
 
     def __post_init__(self) -> None:
         for name in ("squeeze_cost", "push_grasp_cost", "verify_cost", "retry_cost"):
@@ -194,6 +214,43 @@ class SweepOptions:
             from ..model.sensing import parse_sensor
 
             parse_sensor(self.sense)  # a malformed sensor: SensorError saying why
+        self._check_noise()
+
+    def _check_noise(self) -> None:
+        """Refuse a malformed noise, and the options the noise-aware planner does not take."""
+        if self.turn_noise is not None:
+            from ..model.noise import parse_turn_noise
+
+            parse_turn_noise(self.turn_noise)  # PlanningError naming the two forms
+        q = self.contact_noise
+        if q is not None and (
+            isinstance(q, bool) or not isinstance(q, int | float) or not 0 <= q <= 1
+        ):
+            raise SweepError(f"`contact_noise` must be a probability in [0, 1]; got {q!r}")
+        if self.payoff is not None and not isinstance(self.payoff, str):
+            raise SweepError(f"`payoff` must be the path of a payoff file; got {self.payoff!r}")
+        if not self.noisy:
+            return
+        refused = [
+            name
+            for name, given in (
+                ("method='bfs'", self.method != "exact"),
+                ("guaranteed", self.guaranteed),
+                ("sense", self.sense is not None),
+                ("simulate", self.simulate is not None),
+            )
+            if given
+        ]
+        if refused:
+            raise SweepError(
+                "turn_noise, contact_noise and payoff plan with the noise-aware planner, which "
+                f"takes no {', '.join(refused)} yet"
+            )
+
+    @property
+    def noisy(self) -> bool:
+        """Whether the parts are planned under noise or a payoff (the noise-aware planner)."""
+        return not (self.turn_noise is None and self.contact_noise is None and self.payoff is None)
 
     @property
     def n_trials(self) -> int:
@@ -210,6 +267,9 @@ class SweepOptions:
             del out["shape_tol"]
         if self.sense is None:
             del out["sense"], out["sense_max_actions"]
+        for name in ("turn_noise", "contact_noise", "payoff"):
+            if out[name] is None:
+                del out[name]
         return out
 
     @classmethod
@@ -256,6 +316,14 @@ class SweepOptions:
             args += ["--accuracy", str(self.accuracy_deg)]
         if self.guaranteed:
             args.append("--guaranteed")
+        for name, flag in (
+            ("turn_noise", "--turn-noise"),
+            ("contact_noise", "--contact-noise"),
+            ("payoff", "--payoff"),
+        ):
+            v = getattr(self, name)
+            if v is not None:
+                args += [flag, str(v)]
         return args
 
 
@@ -343,6 +411,11 @@ ROW_COLUMNS: tuple[tuple[str, type], ...] = (
     ("plan_json", str),  # the document `bayesgrasp plan PATH --json` prints
     ("sim_json", str),  # the document `bayesgrasp simulate PATH --json` prints
     ("worker", str),
+    # last, so that results files written before them still resume
+    ("turn_noise", str),  # `normal:SIGMA_DEG` / `uniform:A_DEG`, as given
+    ("contact_noise", float),
+    ("payoff", str),  # the payoff file
+    ("bayes_payoff", float),  # the Bayes plan's expected payoff (with noise or a payoff)
 )
 
 #: Most outline points a row keeps for drawing (evenly spaced beyond that).
@@ -357,6 +430,9 @@ def _empty_row(path: str, sha256: str, options: SweepOptions) -> dict[str, Any]:
         sha256=sha256 or None,  # None: the bytes could not be read
         options_key=options.key,
         worker=f"{socket.gethostname()}:{os.getpid()}",
+        turn_noise=options.turn_noise,
+        contact_noise=options.contact_noise,
+        payoff=options.payoff,
     )
     return row
 
@@ -417,7 +493,9 @@ def _outline(part: Any) -> str:
     return json.dumps([[round(float(x), 9), round(float(y), 9)] for x, y in pts])
 
 
-def _plan(part: Any, options: SweepOptions, prior: Prior) -> tuple[Any, dict[str, Any], str]:
+def _plan(
+    part: Any, options: SweepOptions, prior: Prior, payoff: Payoff | None = None
+) -> tuple[Any, dict[str, Any], str]:
     """Problem, plan report and plan document, as ``bayesgrasp plan --json`` makes them."""
     from ..io.plans import plan_document
     from ..model.cost import CostModel
@@ -447,6 +525,8 @@ def _plan(part: Any, options: SweepOptions, prior: Prior) -> tuple[Any, dict[str
         actions=options.actions,
         accuracy=math.radians(options.accuracy_deg),
     )
+    if options.noisy:
+        return _plan_noisy(pb, options, payoff)
     if options.method == "bfs":
         from ..planning.bfs import plan_bfs
 
@@ -466,6 +546,24 @@ def _plan(part: Any, options: SweepOptions, prior: Prior) -> tuple[Any, dict[str
     given["flatten_tolerance"] = options.flatten_tol  # what the CLI records
     doc = plan_document(rep, guaranteed=sure, guaranteed_missing=missing, inputs=given)
     return rep, doc, "ok" if missing is None else "no-plan"
+
+
+def _plan_noisy(
+    pb: Any, options: SweepOptions, payoff: Payoff | None
+) -> tuple[Any, dict[str, Any], str]:
+    """The noise-aware Bayes plan and ``plan --turn-noise ... --json``'s document."""
+    from ..cli.noisy import noisy_document
+    from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
+    from ..planning.noisy import plan_noisy
+
+    if payoff is None and options.payoff is not None:
+        from ..model.payoff import read_payoff
+
+        payoff = read_payoff(options.payoff)
+    turn = TurnNoise() if options.turn_noise is None else parse_turn_noise(options.turn_noise)
+    noise = NoiseModel(turn, options.contact_noise or 0.0)
+    res = plan_noisy(pb, noise, payoff, options.max_actions)
+    return res, noisy_document(res), "ok"
 
 
 def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
@@ -546,10 +644,15 @@ def _fill(row: dict[str, Any], part: Any, doc: dict[str, Any]) -> None:
     )
     if doc.get("guaranteed"):
         row["guaranteed_actions"] = doc["guaranteed"]["squeezes"]
+    if "expected_payoff" in doc:
+        row["bayes_payoff"] = doc["expected_payoff"]
 
 
 def plan_part(
-    source: PartSource | str, options: SweepOptions, prior: Prior | None = None
+    source: PartSource | str,
+    options: SweepOptions,
+    prior: Prior | None = None,
+    payoff: Payoff | None = None,
 ) -> dict[str, Any]:
     """Read, plan and optionally simulate one part: one row, never an exception.
 
@@ -561,6 +664,8 @@ def plan_part(
     prior : Prior, optional
         ``options.prior`` already parsed (the engine parses it once, on the client, so
         that a prior file need not exist on the workers).
+    payoff : Payoff, optional
+        ``options.payoff`` already read (the same way).
 
     Returns
     -------
@@ -586,7 +691,7 @@ def plan_part(
         part, digest = _read_part(source, options)
         if digest:
             row.update(sha256=digest, part_id=part_id(source.path, digest))
-        rep, doc, status = _plan(part, options, prior or parse_prior(options.prior))
+        rep, doc, status = _plan(part, options, prior or parse_prior(options.prior), payoff)
         _fill(row, part, doc)
         row["status"] = status
     except Exception as exc:  # a bad part is a row; a bug in it too, with its class
@@ -667,6 +772,7 @@ def run_chunk(
     options: SweepOptions,
     prior: Prior | None = None,
     timeout: float | None = None,
+    payoff: Payoff | None = None,
 ) -> ChunkResult:
     """Plan a few parts (one task): a row each, stopping at the first that times out.
 
@@ -685,9 +791,9 @@ def run_chunk(
     rows: list[dict[str, Any]] = []
     for i, src in enumerate(sources):
         if timeout is None:
-            rows.append(plan_part(src, options, prior))
+            rows.append(plan_part(src, options, prior, payoff))
             continue
-        row = _call_with_timeout(lambda s=src: plan_part(s, options, prior), timeout)  # type: ignore[misc]
+        row = _call_with_timeout(lambda s=src: plan_part(s, options, prior, payoff), timeout)  # type: ignore[misc]
         if row is None:
             rows.append(timeout_row(src, options, timeout))
             return ChunkResult(rows, tuple(sources[i + 1 :]), True, worker)

@@ -6,7 +6,9 @@ library calls (:class:`~bayesgrasp.cli.specs.ProblemSpec`,
 whose ``detail`` is the command line's one-line message; a body over
 :attr:`Limits.max_body_bytes` is a 413 and a part over :attr:`Limits.max_vertices` vertices
 a 422, each naming the limit; work runs in a pool of threads under :attr:`Limits.time_limit`
-seconds (then a 503; the server keeps serving).
+seconds (then a 503; the server keeps serving). Noise-aware plans, which can take minutes,
+run in threads of their own (:attr:`Limits.noisy_workers`), so that they never hold the
+threads of the light requests.
 """
 
 from __future__ import annotations
@@ -82,6 +84,11 @@ class Limits:
         Requests at work or waiting for a thread (more: 503 at once).
     gallery_rows : int
         Rows the gallery keeps.
+    noisy_workers : int
+        Threads for noise-aware plans (``turn_noise``, ``contact_noise``, ``payoff``), apart
+        from the others: such a plan can take minutes, and a thread past its time limit
+        cannot be stopped, so these requests may hold only these threads (more at once: 503
+        at once) and never keep the light requests waiting.
     """
 
     max_body_bytes: int = 1_000_000
@@ -91,6 +98,7 @@ class Limits:
     workers: int = 4
     max_pending: int = 64
     gallery_rows: int = 500
+    noisy_workers: int = 1
 
 
 class LimitError(Exception):
@@ -180,19 +188,37 @@ class Service:
         self.limits = limits
         self.gallery = gallery
         self.pool = ThreadPoolExecutor(max_workers=limits.workers, thread_name_prefix="bg-web")
+        self.noisy_pool = ThreadPoolExecutor(
+            max_workers=limits.noisy_workers, thread_name_prefix="bg-web-noisy"
+        )
         self.pending = 0
+        self.noisy = 0  # noise-aware plans at work (a timed-out one until its thread ends)
         self.lock = threading.Lock()
         self.figure_lock = threading.Lock()
 
-    async def run(self, work: Callable[[], T]) -> T:
-        """Run ``work`` in a worker thread under the time limit (503 when over or busy)."""
+    async def run(self, work: Callable[[], T], noisy: bool = False) -> T:
+        """Run ``work`` in a worker thread under the time limit (503 when over or busy).
+
+        ``noisy``: a noise-aware plan, run in its own threads (:attr:`Limits.noisy_workers`).
+        """
         with self.lock:
             if self.pending >= self.limits.max_pending:
                 raise LimitError(
                     503, f"the server is busy ({self.limits.max_pending} requests at work)"
                 )
+            if noisy and self.noisy >= self.limits.noisy_workers:
+                raise LimitError(
+                    503,
+                    f"the server is busy with noise-aware plans ({self.noisy} at work, the "
+                    f"limit is {self.limits.noisy_workers}); try again later or ask for less "
+                    "(a smaller max_actions)",
+                )
             self.pending += 1
-        future = asyncio.get_running_loop().run_in_executor(self.pool, work)
+            self.noisy += noisy
+        pool = self.noisy_pool if noisy else self.pool
+        future = asyncio.get_running_loop().run_in_executor(pool, work)
+        if noisy:
+            future.add_done_callback(lambda _: self._noisy_done())
         try:
             return await asyncio.wait_for(asyncio.shield(future), self.limits.time_limit)
         except TimeoutError:
@@ -208,6 +234,10 @@ class Service:
     def _done(self) -> None:
         with self.lock:
             self.pending -= 1
+
+    def _noisy_done(self) -> None:
+        with self.lock:
+            self.noisy -= 1
 
     # -- parts and problems ----------------------------------------------------------------
 
@@ -409,16 +439,48 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     spec = problem_spec(req)
     part = service.part(req.part)
     pb = build_problem(part, req, spec)
-    result = spec.plan(pb)
-    found = guaranteed_plan(pb) if req.guaranteed else None
-    sure, missing = (None, found) if isinstance(found, str) else (found, None)
-    inputs = run_inputs(None, spec)  # the provenance the command line writes
-    doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+    if req.noisy:
+        doc = noisy_plan_document(pb, req)
+    else:
+        result = spec.plan(pb)
+        found = guaranteed_plan(pb) if req.guaranteed else None
+        sure, missing = (None, found) if isinstance(found, str) else (found, None)
+        inputs = run_inputs(None, spec)  # the provenance the command line writes
+        doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
     if service.gallery is not None:
         options = req.model_dump(exclude={"part"}, exclude_defaults=True)
         bayes = doc["options"][doc["bayes"]] if doc["options"] else {}
         service.gallery.add(part.name, doc["part"]["vertices"], options, bayes)
     return doc
+
+
+def noisy_plan_document(pb: Problem, req: PlanRequest) -> dict[str, Any]:
+    """``bayesgrasp plan PART --turn-noise ... --contact-noise ... --payoff FILE --json``.
+
+    The same calls as the command line (:func:`~bayesgrasp.planning.noisy.plan_noisy`,
+    :func:`bayesgrasp.cli.noisy.noisy_document`), with the payoff given inline.
+    """
+    from ..cli.noisy import noisy_document
+    from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
+    from ..planning.noisy import plan_noisy
+
+    if req.method != "exact":
+        raise LimitError(
+            422, "`method`: the noise-aware planner seeds from the exact planner; drop `method`"
+        )
+    if req.guaranteed:
+        raise LimitError(422, "`guaranteed` does not take noise yet")
+    turn = TurnNoise() if req.turn_noise is None else parse_turn_noise(req.turn_noise)
+    noise = NoiseModel(turn, req.contact_noise or 0.0)
+    payoff = None
+    if req.payoff is not None:
+        import numpy as np
+
+        from ..model.payoff import Payoff
+
+        degs, values = req.payoff.entries()
+        payoff = Payoff(np.radians(degs), np.array(values), req.payoff.default, "request")
+    return noisy_document(plan_noisy(pb, noise, payoff, req.max_actions))
 
 
 def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
@@ -529,7 +591,8 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "Bayesian squeeze and push-grasp plans for planar parts. Every answer is the "
             "JSON document `bayesgrasp COMMAND --json` prints. Limits: request bodies up to "
             f"{lim.max_body_bytes} bytes, parts up to {lim.max_vertices} vertices, "
-            f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials."
+            f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials, "
+            f"{lim.noisy_workers} noise-aware plan(s) at a time."
         ),
     )
     app.state.service = service
@@ -553,8 +616,8 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     async def _invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
         return _error(422, _one_line(exc), "invalid-request")
 
-    async def answer(work: Callable[[], dict[str, Any]]) -> JSONResponse:
-        return JSONResponse(await service.run(work))
+    async def answer(work: Callable[[], dict[str, Any]], noisy: bool = False) -> JSONResponse:
+        return JSONResponse(await service.run(work, noisy))
 
     @app.get(f"{API}/health", tags=["server"])
     async def health() -> dict[str, Any]:
@@ -583,8 +646,12 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
 
     @app.post(f"{API}/plan", tags=["plans"])
     async def plan(req: PlanRequest) -> JSONResponse:
-        """The best plan of every length, Bayes and most certain (``bayesgrasp plan --json``)."""
-        return await answer(lambda: plan_result_document(service, req))
+        """The best plan of every length, Bayes and most certain (``bayesgrasp plan --json``).
+
+        With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
+        (``plan --turn-noise ... --json``), in the server's threads for such plans.
+        """
+        return await answer(lambda: plan_result_document(service, req), req.noisy)
 
     @app.post(f"{API}/policy", tags=["plans"])
     async def policy(req: PolicyRequest) -> JSONResponse:
@@ -648,7 +715,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "policy": lambda: policy_document_of(service, req),
             "simulate": lambda: simulate_document(service, req),
         }
-        return await answer(work[command])
+        return await answer(work[command], isinstance(req, PlanRequest) and req.noisy)
 
     @app.get(f"{API}/gallery", tags=["server"])
     async def gallery_rows(limit: int = Query(50, ge=1, le=10_000)) -> dict[str, Any]:
@@ -678,4 +745,5 @@ def _limits(lim: Limits) -> dict[str, Any]:
         "max_vertices": lim.max_vertices,
         "time_limit_s": lim.time_limit,
         "max_trials": lim.max_trials,
+        "noisy_workers": lim.noisy_workers,
     }

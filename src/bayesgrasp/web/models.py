@@ -8,15 +8,18 @@ problem options are those of ``bayesgrasp plan``, by the same names without the 
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+import math
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
+from pydantic_core import PydanticCustomError
 
 __all__ = [
     "FigureRequest",
     "FileIn",
     "PartIn",
     "PartRequest",
+    "PayoffIn",
     "PlanRequest",
     "PolicyRequest",
     "ProblemOptions",
@@ -111,10 +114,108 @@ class ProblemOptions(_Strict):
     )
 
 
+Unit = Annotated[float, Field(ge=0, le=1)]
+
+
+class PayoffIn(_Strict):
+    """A payoff, as a payoff file holds it: ``{"payoff": {"80.63": 1.0}, "default": 0.0}``.
+
+    ``payoff`` maps orientations in degrees (the stable orientations ``plan`` prints) to
+    values in [0, 1], as an object or a list of ``{"orientation_deg": DEG, "value": V}``;
+    states not listed get ``default``.
+    """
+
+    payoff: dict[str, Any] | list[Any] = Field(
+        description="Orientation (deg) to payoff in [0, 1]: an object "
+        '{"DEG": V, ...} or a list [{"orientation_deg": DEG, "value": V}, ...].',
+    )
+    default: Unit = Field(0.0, description="Payoff of every state not listed.")
+
+    @field_validator("payoff", mode="before")
+    @classmethod
+    def _entries(cls, v: object) -> object:
+        def bad(message: str) -> PydanticCustomError:
+            return PydanticCustomError("payoff", message)  # no context: braces stay as they are
+
+        if not isinstance(v, dict | list):
+            raise bad(f"must be an object or a list; got {type(v).__name__}")
+        if len(v) > 3600:
+            raise bad(f"at most 3600 orientations; got {len(v)}")
+        pairs: list[tuple[object, object, str]] = []
+        if isinstance(v, dict):
+            pairs = [(k, x, f"the value of {k}") for k, x in v.items()]
+        else:
+            for i, item in enumerate(v):
+                if not isinstance(item, dict) or set(item) != {"orientation_deg", "value"}:
+                    raise bad(f'entry #{i + 1} must be {{"orientation_deg": DEG, "value": V}}')
+                pairs.append((item["orientation_deg"], item["value"], f"entry #{i + 1}"))
+        for key, value, where in pairs:
+            try:
+                ok = not isinstance(key, bool) and math.isfinite(float(key))  # type: ignore[arg-type]
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise bad(f"{key!r} is not an orientation in degrees")
+            number = isinstance(value, int | float) and not isinstance(value, bool)
+            if not (number and 0 <= value <= 1):  # type: ignore[operator]  # NaN fails too
+                raise bad(f"{where} must be a number in [0, 1]; got {value!r}")
+        return v
+
+    def entries(self) -> tuple[list[float], list[float]]:
+        """The orientations (deg) and their values."""
+        if isinstance(self.payoff, dict):
+            return [float(k) for k in self.payoff], [float(x) for x in self.payoff.values()]
+        degs = [float(e["orientation_deg"]) for e in self.payoff]
+        return degs, [float(e["value"]) for e in self.payoff]
+
+
 class PlanRequest(ProblemOptions):
-    """The body of ``plan``."""
+    """The body of ``plan``.
+
+    With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
+    (``plan --turn-noise ... --contact-noise ... --payoff FILE``).
+    """
 
     guaranteed: bool = Field(False, description="Also the shortest guaranteed plan.")
+    turn_noise: str | None = Field(
+        None,
+        max_length=64,
+        description="Gripper turns executed as alpha + e: `normal:SIGMA_DEG` or `uniform:A_DEG` "
+        "(--turn-noise).",
+    )
+    contact_noise: float | None = Field(
+        None,
+        ge=0,
+        le=1,
+        description="Probability that a squeeze's jaws touch one after the other "
+        "(--contact-noise).",
+    )
+    payoff: PayoffIn | None = Field(
+        None, description="Payoff of final orientations (the contents of a --payoff file)."
+    )
+
+    @field_validator("turn_noise")
+    @classmethod
+    def _turn_noise(cls, v: str | None) -> str | None:
+        if v is not None:
+            from ..errors import PlanningError
+            from ..model.noise import parse_turn_noise
+
+            try:
+                parse_turn_noise(v)
+            except PlanningError:
+                raise PydanticCustomError(
+                    "turn_noise",
+                    "must be normal:SIGMA_DEG or uniform:A_DEG with a number of degrees >= 0; "
+                    "got '{v}'",
+                    {"v": v},
+                ) from None
+        return v
+
+    @property
+    def noisy(self) -> bool:
+        """Whether the noise-aware planner is asked for."""
+        return not (self.turn_noise is None and self.contact_noise is None and self.payoff is None)
 
 
 class SimulateRequest(ProblemOptions):

@@ -169,6 +169,14 @@ function options() {
   return o;
 }
 
+// the noise of the plan endpoint (the noise-aware Bayes plan); the other endpoints take none
+function noise() {
+  const o = {};
+  if ($("turn-kind").value) o.turn_noise = `${$("turn-kind").value}:${Number($("turn-deg").value)}`;
+  if ($("contact-noise").value !== "") o.contact_noise = Number($("contact-noise").value);
+  return o;
+}
+
 function partBody() {
   if (state.catalogue) return { catalogue: state.catalogue };
   if (state.file) return { file: { format: state.file.format, data_base64: state.file.data_base64 }, name: state.file.name };
@@ -186,6 +194,8 @@ function writeHash() {
     if (o[k] !== undefined) q.set(k, o[k]);
   q.set("squeeze_cost", o.costs.squeeze);
   q.set("push_grasp_cost", o.costs["push-grasp"]);
+  const n = noise();
+  for (const k of ["turn_noise", "contact_noise"]) if (n[k] !== undefined) q.set(k, n[k]);
   window.history.replaceState(null, "", "#" + q.toString());
 }
 
@@ -212,6 +222,10 @@ function readHash() {
   set("max-actions", "max_actions");
   set("cost-squeeze", "squeeze_cost");
   set("cost-push-grasp", "push_grasp_cost");
+  const [kind, turnDeg] = (q.get("turn_noise") || "").split(":");
+  $("turn-kind").value = kind === "normal" || kind === "uniform" ? kind : "";
+  if ($("turn-kind").value) $("turn-deg").value = turnDeg;
+  $("contact-noise").value = q.has("contact_noise") ? q.get("contact_noise") : "";
   if (q.get("part")) {
     state.catalogue = q.get("part");
     $("catalogue").value = state.catalogue;
@@ -254,7 +268,7 @@ async function run() {
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
-      post("/plan", { part, ...o }),
+      post("/plan", { part, ...o, ...noise() }),
       post("/squeeze", { part, prior: o.prior }),
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
