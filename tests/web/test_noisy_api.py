@@ -40,6 +40,20 @@ def assert_same_document(api: dict[str, Any], cli: dict[str, Any]) -> None:
     assert json.dumps(api, sort_keys=True) == json.dumps(cli, sort_keys=True)
 
 
+@pytest.mark.parametrize("part", ["key", "example"])
+def test_guaranteed_under_bounded_noise_equals_cli(
+    client: TestClient, cli_json: CliJson, part: str
+) -> None:
+    code, doc = cli_json("plan", part, "--turn-noise", "uniform:1", "--guaranteed")
+    r = client.post(
+        "/api/v1/plan",
+        json={"part": {"catalogue": part}, "turn_noise": "uniform:1", "guaranteed": True},
+    )
+    assert r.status_code == 200, r.text
+    assert_same_document(r.json(), doc)
+    assert code == 0 and "guaranteed" in doc
+
+
 @pytest.mark.parametrize("part", ["triangle", "rectangle", "key", "hand"])
 @pytest.mark.parametrize(("body", "args"), NOISE)
 def test_noisy_plan_equals_cli(
@@ -113,7 +127,7 @@ def test_payoff_alone_asks_for_the_noisy_planner(client: TestClient, cli_json: C
         ({"payoff": {"payoff": {"90": 1}, "extra": 1}}, "payoff.extra: Extra inputs"),
         ({"payoff": {"payoff": {"90": 0}}}, "a payoff must be positive somewhere; got all zero"),
         ({"turn_noise": "normal:1", "method": "bfs"}, "seeds from the exact planner"),
-        ({"turn_noise": "normal:1", "guaranteed": True}, "`guaranteed` does not take noise"),
+        ({"turn_noise": "normal:1", "guaranteed": True}, "`guaranteed`: no plan of two or more actions can guarantee"),
     ],
 )
 def test_bad_noise_is_422(client: TestClient, extra: dict[str, Any], match: str) -> None:

@@ -525,8 +525,10 @@ def _plan(
         actions=options.actions,
         accuracy=math.radians(options.accuracy_deg),
     )
+    given: dict[str, Any] = {"max_actions": options.max_actions, "layer": options.layer}
+    given["flatten_tolerance"] = options.flatten_tol  # what the CLI records
     if options.noisy:
-        return _plan_noisy(pb, options, payoff)
+        return _plan_noisy(pb, options, payoff, given)
     if options.method == "bfs":
         from ..planning.bfs import plan_bfs
 
@@ -542,14 +544,12 @@ def _plan(
             sure = found
         else:
             missing = str(found.reason or "no guaranteed plan")
-    given: dict[str, Any] = {"max_actions": options.max_actions, "layer": options.layer}
-    given["flatten_tolerance"] = options.flatten_tol  # what the CLI records
     doc = plan_document(rep, guaranteed=sure, guaranteed_missing=missing, inputs=given)
     return rep, doc, "ok" if missing is None else "no-plan"
 
 
 def _plan_noisy(
-    pb: Any, options: SweepOptions, payoff: Payoff | None
+    pb: Any, options: SweepOptions, payoff: Payoff | None, given: dict[str, Any]
 ) -> tuple[Any, dict[str, Any], str]:
     """The noise-aware Bayes plan and ``plan --turn-noise ... --json``'s document."""
     from ..cli.noisy import noisy_document
@@ -563,7 +563,7 @@ def _plan_noisy(
     turn = TurnNoise() if options.turn_noise is None else parse_turn_noise(options.turn_noise)
     noise = NoiseModel(turn, options.contact_noise or 0.0)
     res = plan_noisy(pb, noise, payoff, options.max_actions)
-    return res, noisy_document(res), "ok"
+    return res, noisy_document(res, inputs=given), "ok"
 
 
 def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:

@@ -440,7 +440,7 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     part = service.part(req.part)
     pb = build_problem(part, req, spec)
     if req.noisy:
-        doc = noisy_plan_document(pb, req)
+        doc = noisy_plan_document(pb, req, run_inputs(None, spec))
     else:
         result = spec.plan(pb)
         found = guaranteed_plan(pb) if req.guaranteed else None
@@ -454,24 +454,27 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     return doc
 
 
-def noisy_plan_document(pb: Problem, req: PlanRequest) -> dict[str, Any]:
+def noisy_plan_document(
+    pb: Problem, req: PlanRequest, inputs: dict[str, Any] | None = None
+) -> dict[str, Any]:
     """``bayesgrasp plan PART --turn-noise ... --contact-noise ... --payoff FILE --json``.
 
-    The same calls as the command line (:func:`~bayesgrasp.planning.noisy.plan_noisy`,
-    :func:`bayesgrasp.cli.noisy.noisy_document`), with the payoff given inline.
+    The command line's run (:class:`bayesgrasp.cli.noisy.NoisyRun`: the noise-aware plans,
+    and with ``guaranteed`` the guaranteed plan under a bounded turn error), with the payoff
+    given inline; ``inputs`` the provenance the command line writes.
     """
-    from ..cli.noisy import noisy_document
+    from ..cli.noisy import NoisyRun
     from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
-    from ..planning.noisy import plan_noisy
+    from ..planning.robust import UNBOUNDED_GUARANTEE
 
     if req.method != "exact":
         raise LimitError(
             422, "`method`: the noise-aware planner seeds from the exact planner; drop `method`"
         )
-    if req.guaranteed:
-        raise LimitError(422, "`guaranteed` does not take noise yet")
     turn = TurnNoise() if req.turn_noise is None else parse_turn_noise(req.turn_noise)
     noise = NoiseModel(turn, req.contact_noise or 0.0)
+    if req.guaranteed and not turn.exact and turn.kind == "normal":
+        raise LimitError(422, f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
     payoff = None
     if req.payoff is not None:
         import numpy as np
@@ -480,7 +483,8 @@ def noisy_plan_document(pb: Problem, req: PlanRequest) -> dict[str, Any]:
 
         degs, values = req.payoff.entries()
         payoff = Payoff(np.radians(degs), np.array(values), req.payoff.default, "request")
-    return noisy_document(plan_noisy(pb, noise, payoff, req.max_actions))
+    run = NoisyRun(noise, payoff, req.max_actions, False, req.guaranteed)
+    return run.document(run.plan(pb), inputs)
 
 
 def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
