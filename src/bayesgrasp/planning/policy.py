@@ -151,7 +151,7 @@ import logging
 import math
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -169,6 +169,9 @@ from ..model.sensing import (
     parse_sensor,
 )
 from .result import PlanStep, short_turns
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..model.noise import NoiseModel
 
 __all__ = [
     "Branch",
@@ -308,6 +311,14 @@ class Policy:
         Every first gripper angle that can be optimal was tried (see the module notes).
     units : str or None
         Units of the readings (the parts' units).
+    noise : NoiseModel or None
+        The action noise the policy was planned and evaluated under
+        (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`; ``None``: exact
+        actions).
+    refinement_bound : float
+        Noisy actions: no single turn of the policy, the rest kept, can lower the value at
+        the policy's ratio by more than this (0 when exact; see
+        :mod:`~bayesgrasp.planning.noisy_policy`).
     """
 
     root: PolicyNode
@@ -327,6 +338,8 @@ class Policy:
     first_angle_exact: bool = True
     units: str | None = None
     searched: int = 0
+    noise: NoiseModel | None = None
+    refinement_bound: float = 0.0
 
     @property
     def expected_total_actions(self) -> float:
@@ -418,6 +431,9 @@ class _Kind:
     half_width: FloatArray  # (A,)
     pi_symmetric: bool
     patterns: dict[bytes, tuple[IntArray, IntArray, int]] = field(default_factory=dict)
+    # Noisy actions (:mod:`.noisy_policy`): the (A, N, N) transition matrix of each row's
+    # turn; ``None``: the one-hot ``transfer``.
+    matrices: FloatArray | None = None
 
 
 @dataclass(slots=True)
@@ -460,6 +476,7 @@ class _Solver:
     use_floor: bool = True  # values at earlier (higher) prices bound later ones from below
     floor_gen: int = 0
     searched: int = 0
+    max_beliefs: int = 0  # most prepared beliefs kept (0: no limit; see `prepared`)
     memo: _Memo = field(default_factory=dict)
     prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
@@ -513,6 +530,8 @@ class _Solver:
 
     def images(self, q: FloatArray, kind: _Kind) -> tuple[FloatArray, IntArray]:
         """Distinct beliefs after each class of ``kind`` (M, N) and the row of each."""
+        if kind.matrices is not None:
+            return self.noisy_images(q, kind.matrices)
         pos = q > 0
         pattern = kind.patterns.get(pos.tobytes())
         if pattern is None:
@@ -521,6 +540,15 @@ class _Solver:
         w = np.broadcast_to(q[pos], (m, len(idx) // m)).ravel()
         out = np.bincount(idx, weights=w, minlength=m * self.space.n_states)
         return np.asarray(out.reshape(m, -1), dtype=np.float64), first
+
+    def noisy_images(self, q: FloatArray, matrices: FloatArray) -> tuple[FloatArray, IntArray]:
+        """Beliefs ``q M_a`` after each candidate turn (M, N), equal ones (to ``2^-40``) once."""
+        imgs = np.asarray(np.tensordot(q, matrices, axes=([0], [1])), dtype=np.float64)
+        _, first = np.unique(np.rint(imgs * _QUANT), axis=0, return_index=True)
+        if len(first) == len(imgs):
+            return imgs, np.arange(len(imgs), dtype=np.intp)
+        first = np.sort(first)
+        return np.ascontiguousarray(imgs[first]), np.asarray(first, dtype=np.intp)
 
     def pattern(self, pos: NDArray[np.bool_], kind: _Kind) -> tuple[IntArray, IntArray, int]:
         """The distinct effects of ``kind`` on a belief of support ``pos``.
@@ -698,6 +726,11 @@ class _Solver:
         """The images of belief ``q`` under kind ``ti``, prepared (kept across prices)."""
         hit = self.prep_cache.get((key, ti))
         if hit is None:
+            if self.max_beliefs and len(self.prep_cache) >= self.max_beliefs:
+                raise PlanningError(
+                    f"the policy search keeps more than {self.max_beliefs:,} beliefs (the "
+                    "memory bound `max_beliefs`): raise it, or plan fewer actions"
+                )
             imgs, rows = self.images(q, self.kinds[ti])
             hit = (self.prepare(imgs), rows)
             self.prep_cache[(key, ti)] = hit
@@ -894,7 +927,10 @@ class _Builder:
             t.add_entropy(level, mass, h)
             kind = s.kinds[dec[1]]
             row = dec[2]
-            mapped = np.bincount(kind.transfer[row], weights=q, minlength=len(q))
+            if kind.matrices is not None:
+                mapped = q @ kind.matrices[row]
+            else:
+                mapped = np.bincount(kind.transfer[row], weights=q, minlength=len(q))
             return self.node(
                 kind,
                 float(kind.mid[row]),
@@ -1194,15 +1230,47 @@ def plan_policy(
         from .exact import plan_exact
 
         sensorless_cost = plan_exact(main, max_actions=max_actions).bayes_plan.expected_cost
-    joint = solver.joint(roots)  # (R, B, N)
-    s, _ = solver.success(joint)
-    p_succ = s.sum(axis=1)
-    c = np.array([kinds[ti].first_cost for ti in root_kind]) + cost.verify
-    ratios = (c + cost.retry * (1 - p_succ)) / p_succ
-    lam = float(np.min(ratios))
+    lam = _start_ratio(solver, roots, root_kind)
     if sensorless_cost is not None and math.isfinite(sensorless_cost):
         lam = min(lam, sensorless_cost)
 
+    deepen = "deepen" in _prune and sens.sigma > 0
+    best_pick, it = _search(solver, roots, root_kind, lam, max_actions, max_iterations, deepen)
+    builder = _Builder(solver, max_actions)
+    k = kinds[root_kind[best_pick]]
+    root = builder.node(
+        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
+    )
+    return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+
+
+def _start_ratio(solver: _Solver, roots: FloatArray, root_kind: Sequence[int]) -> float:
+    """The least ratio of "one action, then declare the likeliest state on every reading"."""
+    joint = solver.joint(roots)  # (R, B, N)
+    s, _ = solver.success(joint)
+    p_succ = s.sum(axis=1)
+    c = np.array([solver.kinds[ti].first_cost for ti in root_kind]) + solver.verify
+    ratios = (c + solver.retry * (1 - p_succ)) / p_succ
+    return float(np.min(ratios))
+
+
+def _search(
+    solver: _Solver,
+    roots: FloatArray,
+    root_kind: Sequence[int],
+    lam: float,
+    max_actions: int,
+    max_iterations: int,
+    deepen: bool,
+) -> tuple[int, int]:
+    """The parametric search (see the module notes) from the known ratio ``lam``.
+
+    ``roots[ri]`` is the belief after the first action of kind ``root_kind[ri]``. Leaves the
+    programme of the best step in ``solver`` (its price and memo, which the builder reads) and
+    returns the best root and the number of parametric steps. ``deepen``: first search
+    within ``max_actions - 1`` actions (worth it with noisy readings).
+    """
+    kinds = solver.kinds
     root_preps = [solver.prepare(roots[ri : ri + 1]) for ri in range(len(roots))]
 
     def solve(lam: float, above: float, depth: int) -> tuple[float, int, float]:
@@ -1265,7 +1333,7 @@ def plan_policy(
     # lower depth (the prepared images, the floors) is of use at the next. (With exact or
     # quantised readings the search is small and the extra solve does not pay.)
     it = 0
-    first = max_actions - 1 if "deepen" in _prune and sens.sigma > 0 else max_actions
+    first = max_actions - 1 if deepen else max_actions
     for depth in range(max(first, 1), max_actions + 1):
         best_lam, best_ratio, best_pick, best_memo, steps = dinkelbach(lam, depth)
         it += steps
@@ -1275,12 +1343,7 @@ def plan_policy(
     if best_lam > solver.lam:
         solver.floor_gen += 1  # the builder may solve more at this higher price
     solver.lam, solver.memo = best_lam, best_memo
-    builder = _Builder(solver, max_actions)
-    k = kinds[root_kind[best_pick]]
-    root = builder.node(
-        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
-    )
-    return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+    return best_pick, it
 
 
 def _finish(
