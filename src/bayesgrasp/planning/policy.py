@@ -1205,7 +1205,6 @@ def plan_policy(
             "every candidate part's problem must have the same gripper `accuracy`; got "
             + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
         )
-    cost = main.cost
     solver = _solver(space, sens, _prune)
     kinds = solver.kinds
     if first_angles is not None:
