@@ -139,10 +139,9 @@ def plan(
     from . import noisy
 
     if noisy.asked(turn_noise, contact_noise, payoff):
-        if sense is not None or guaranteed or plot_file is not None or export is not None:
-            raise typer.BadParameter(
-                "--sense, --guaranteed, --plot and --export do not take noise yet"
-            )
+        if guaranteed or plot_file is not None or export is not None:
+            raise typer.BadParameter("--guaranteed, --plot and --export do not take noise yet")
+    if noisy.asked(turn_noise, contact_noise, payoff) and sense is None:
         if part.part is None or batch is not None or more_parts:
             raise typer.BadParameter("noise options take one PART (no --batch)")
         noisy.plan_noisy_command(part.load(), spec, turn_noise, contact_noise, payoff, as_json)
@@ -150,11 +149,12 @@ def plan(
     if sense is not None:
         if part.part is None or batch is not None:
             raise typer.BadParameter("--sense needs PART and takes no --batch")
-        from .sensing import plan_policy_command
+        from .sensing import plan_policy_command, sense_noise
 
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
         sensing = SenseSpec(sense, more, part_prior, max_actions)
-        plan_policy_command(part, spec, sensing, as_json, fold_below)
+        noise = sense_noise(turn_noise, contact_noise, payoff)
+        plan_policy_command(part, spec, sensing, as_json, fold_below, noise)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")

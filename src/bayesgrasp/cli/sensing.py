@@ -7,39 +7,96 @@ candidate parts and plans their policy.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from .common import emit_json, list_files, with_progress, write_failed
 from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
 
+if TYPE_CHECKING:
+    from ..geometry.polygon import Part
+    from ..model.noise import NoiseModel
+    from ..model.problem import Problem
+    from ..model.sensing import WidthSensor
+    from ..planning.policy import Policy
+
+
+def _policy(
+    sensing: SenseSpec,
+    parts: list[Part],
+    spec: ProblemSpec,
+    noise: NoiseModel | None,
+    sensor: WidthSensor | None = None,
+) -> tuple[list[Problem], Policy]:
+    """The candidates' problems and their Bayes policy, under the action noise if given."""
+    if noise is None:
+        return sensing.policy(parts, spec, sensor)
+    from ..planning.noisy_policy import plan_noisy_policy
+
+    problems = [spec.build(p) for p in parts]
+    pol = plan_noisy_policy(
+        problems,
+        sensing.sense if sensor is None else sensor,
+        sensing.max_actions,
+        noise,
+        part_prior=sensing.part_prior,
+    )
+    return problems, pol
+
+
+def sense_noise(turn: str | None, contact: float | None, payoff: Path | None) -> NoiseModel | None:
+    """The action noise of a --sense command (``None``: none asked); --payoff is refused."""
+    if payoff is not None:
+        raise typer.BadParameter(
+            "a sensing policy declares and verifies a state; --payoff does not take --sense "
+            "yet (plan without --sense for the Bayes plan per unit payoff)",
+            param_hint="--payoff",
+        )
+    if turn is None and contact is None:
+        return None
+    from .noisy import noise_model
+
+    return noise_model(turn, contact)
+
 
 def plan_policy_command(
-    part: PartSpec, spec: ProblemSpec, sensing: SenseSpec, as_json: bool, fold_below: float = 0.0
+    part: PartSpec,
+    spec: ProblemSpec,
+    sensing: SenseSpec,
+    as_json: bool,
+    fold_below: float = 0.0,
+    noise: NoiseModel | None = None,
 ) -> None:
     """Plan and print a sensing policy over PART and the candidate parts.
 
     The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
+    With ``noise`` the policy is planned, and its figures computed, under that action noise.
     """
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
 
     parts = sensing.parts(part)
-    _, pol = sensing.policy(parts, spec)
+    _, pol = _policy(sensing, parts, spec, noise)
     if as_json:
         emit_json(policy_document(pol))
         return
     typer.echo(policy_text(pol, units=parts[0].units, min_probability=fold_below))
     entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
     blind = pol.sensorless_cost
-    versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
+    under = "" if pol.noise is None else " under the noise"
+    versus = "" if blind is None else f" (sensorless Bayes plan{under} {blind:.4f})"
     typer.echo(
         f"expected cost {pol.expected_cost:.4f}{versus}, "
         f"success {pol.success_probability:.4f} a cycle, "
         f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
         f"(bits): {entropy}"
     )
+    if pol.noise is not None:
+        typer.echo(
+            f"noise: {pol.noise.describe()}; every figure is exact under it; no single turn "
+            f"lowers the cost's value by more than {pol.refinement_bound:.2g}"
+        )
 
 
 def simulate_policy_command(
@@ -55,11 +112,14 @@ def simulate_policy_command(
     units: str | None,
     sensor_error: bool,
     as_json: bool,
+    turn: str | None = None,
 ) -> None:
     """Plan the Bayes policy of PART (and the --also parts), run it, print the comparison.
 
     With ``--engine mujoco`` and ``--sense width`` (no SIGMA given) the policy is planned
     for MuJoCo's default reading error (:func:`bayesgrasp.sim.policy.mujoco_sensor`).
+    With ``turn`` (``--turn-noise``) the policy is planned under that turn error and the
+    runs draw it (it replaces ``noise``).
     """
     from ..model.sensing import parse_sensor
     from ..sim.policy import (
@@ -76,7 +136,12 @@ def simulate_policy_command(
     scale = units_scale(units) if units is not None else None
     if engine is Engine.mujoco and sensor.kind == "exact":
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))
-    problems, pol = sensing.policy(parts, spec, sensor)
+    model = sense_noise(turn, None, None)
+    if model is not None:
+        from ..sim.noise import GripperNoise
+
+        noise = GripperNoise(model.turn.kind, model.turn.scale)
+    problems, pol = _policy(sensing, parts, spec, model, sensor)
     n = cycles or (200_000 if engine is Engine.kinematic else 200)
 
     def run(progress: Any) -> Any:
@@ -101,7 +166,10 @@ def simulate_policy_command(
         return
     names = " or ".join(pol.parts)
     most = sensing.max_actions
-    typer.echo(policy_simulation_text(res, f"{names}: Bayes policy of at most {most} actions; "))
+    title = f"{names}: Bayes policy of at most {most} actions; "
+    if model is not None:
+        title += f"planned and predicted under turn error {model.turn.spec()} deg; "
+    typer.echo(policy_simulation_text(res, title))
 
 
 def plot_policy_command(

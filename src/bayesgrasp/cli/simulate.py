@@ -164,12 +164,12 @@ def simulate(
             raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
         from .sensing import simulate_policy_command
 
-        if turn_noise is not None:
-            raise typer.BadParameter("does not apply to --sense yet", param_hint="--turn-noise")
+        if turn_noise is not None and noise > 0:
+            raise typer.BadParameter("give --noise or --turn-noise, not both", param_hint="--noise")
         sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, err, seed, units,
-            sensor_error, as_json,
+            sensor_error, as_json, turn_noise,
         )  # fmt: skip
         return
     if also or part_prior is not None or sensor_error:
