@@ -37,11 +37,12 @@ Fields (angles in radians, readings in the parts' units)::
 
 ``alpha_rad`` is the world gripper angle at the root and the turn relative to the previous
 action below it; ``margin_rad`` is how far that turn may err without changing any state's
-outcome (``null`` at the root; 0 under noisy actions, whose error is in the figures). ``reading`` is the half-open interval ``[lo, hi)``, ``null``
-for an unbounded end; the branches of a node tile every reading in increasing order, and
-``probability`` is that of the branch given that the node is reached. A declared
-``orientation_rad`` is in the frame of the last action, in ``[0, 2 pi)``; ``q`` is the
-probability that the declaration is right given that the leaf is reached.
+outcome (``null`` at the root; 0 under noisy actions, whose error is in the figures).
+``reading`` is the half-open interval ``[lo, hi)``, ``null`` for an unbounded end; the
+branches of a node tile every reading in increasing order, and ``probability`` is that of
+the branch given that the node is reached. A declared ``orientation_rad`` is in the frame of
+the last action, in ``[0, 2 pi)``; ``q`` is the probability that the declaration is right
+given that the leaf is reached.
 """
 
 from __future__ import annotations
