@@ -168,6 +168,32 @@ class _Model:
             out[:, lo:hi, lo:hi] = nt.matrices(kind, alphas)
         return out
 
+    def candidates(
+        self, kind: str, mid: FloatArray, half: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """The candidate turns of ``kind`` and their half widths, widest first.
+
+        The noise-free classes' middles ``mid`` (half widths ``half``); with contact
+        asynchrony also the middles of the common refinement of the classes of every way
+        the action may go (each turn at which some state's basin changes in one of them):
+        with exact turns ``M(alpha)`` is constant on each such class.
+        """
+        comps = [(nt, c) for nt in self.nts for c in nt.components(kind)]
+        if len(comps) == len(self.nts):  # one way to go: the noise-free classes
+            return mid, half
+        crit = np.concatenate(
+            [(nt.stable[:, None] - c.offset - c.hi[None, :]).ravel() for nt, c in comps]
+        )
+        c = np.unique(np.mod(crit, TWO_PI))
+        widths = np.diff(np.append(c, c[0] + TWO_PI))
+        keep = widths > 1e-9
+        c, widths = c[keep], widths[keep]
+        more = np.mod(c + widths / 2 + math.pi, TWO_PI) - math.pi
+        mids = np.concatenate([mid, more])
+        halves = np.concatenate([half, widths / 2])
+        order = np.argsort(-halves, kind="stable")
+        return np.asarray(mids[order]), np.asarray(halves[order])
+
     def initial(self, kind: str, angle: float) -> FloatArray:
         """Joint distribution after the first action at world angle ``angle``."""
         return np.concatenate(
@@ -345,24 +371,33 @@ def _depth(node: _Node) -> int:
 # -- refinement ------------------------------------------------------------------------------
 
 
-def _right(model: _Model, node: _Node, lam: float) -> FloatArray:
-    """Per-state value (``c - lambda P``, per unit mass) of a node's readings and what follows.
+def _rights(model: _Model, root: _Node, lam: float) -> dict[int, FloatArray]:
+    """Per-state value (``c - lambda P``, per unit mass) of each node's readings and after.
 
-    Entry ``j``: the part is in state ``j`` after the node's action.
+    ``out[id(node)][j]``: the part is in state ``j`` after the node's action. One pass from
+    the leaves up.
     """
     v, rho = model.cost.verify, model.cost.retry
-    cols = []
-    for nxt in node.children:
-        if isinstance(nxt, Reject):
-            cols.append(np.full(model.n, rho))
-        elif isinstance(nxt, Declare):
-            g = model.goal[model.state(nxt)].astype(np.float64)
-            cols.append(v + rho - (lam + rho) * g)
-        else:
-            below = _right(model, nxt, lam)
-            m = model.matrix(nxt.kind, nxt.alpha)
-            cols.append(model.cost.action_cost(nxt.kind) + m @ below)
-    return np.asarray((node.lik * np.stack(cols, axis=1)).sum(axis=1), dtype=np.float64)
+    out: dict[int, FloatArray] = {}
+
+    def walk(node: _Node) -> FloatArray:
+        cols = []
+        for nxt in node.children:
+            if isinstance(nxt, Reject):
+                cols.append(np.full(model.n, rho))
+            elif isinstance(nxt, Declare):
+                g = model.goal[model.state(nxt)].astype(np.float64)
+                cols.append(v + rho - (lam + rho) * g)
+            else:
+                below = walk(nxt)
+                m = model.matrix(nxt.kind, nxt.alpha)
+                cols.append(model.cost.action_cost(nxt.kind) + m @ below)
+        r = np.asarray((node.lik * np.stack(cols, axis=1)).sum(axis=1), dtype=np.float64)
+        out[id(node)] = r
+        return r
+
+    walk(root)
+    return out
 
 
 def _best_turn(
@@ -382,11 +417,14 @@ def _best_turn(
         return current, -f0, 0.0
     eps = 0.0
     if turn.exact:
+        # f is constant between critical turns: the middle of each interval, the widest of
+        # the best (intervals of a rounding's width are not turns a gripper can make).
         c = np.unique(np.mod(crit + period / 2, period) - period / 2)
         widths = np.diff(np.append(c, c[0] + period))
         pts = np.mod(c + widths / 2 + period / 2, period) - period / 2
-        vals = model.line(kind, left, neg, pts)
-        i = int(np.argmax(vals))
+        vals = np.where(widths > 1e-9, model.line(kind, left, neg, pts), -np.inf)
+        top = np.flatnonzero(vals >= vals.max() - _GAIN_TOL * max(1.0, abs(float(vals.max()))))
+        i = int(top[np.argmax(widths[top])])
         best, fb = float(pts[i]), float(vals[i])
     elif turn.kind == "uniform":
         raw = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
@@ -408,40 +446,73 @@ def _best_turn(
         span = float(right.max() - right.min())
         eps = turn.curvature_bound * h * h / 8.0 * float(left.sum()) * span
     if fb > f0 + _GAIN_TOL * max(1.0, abs(f0)):
-        return float(math.remainder(best, TWO_PI)), -fb, eps
+        # Checked with the matrix the evaluation uses (the line's sums are arranged
+        # differently, and may round differently right at a critical turn).
+        best = float(math.remainder(best, TWO_PI))
+        f_new = float(left @ model.matrix(kind, best) @ right)
+        f_old = float(left @ model.matrix(kind, current) @ right)
+        if f_new < f_old - _GAIN_TOL * max(1.0, abs(f_old)):
+            return best, f_new, eps
     return current, -f0, eps
 
 
 def _refine(model: _Model, root: _Node, first_angle: float, ratio: float) -> tuple[float, float]:
-    """Coordinate descent over the turns (see the module notes); the new ratio and ``eps``."""
+    """Coordinate descent over the turns (see the module notes); the new ratio and ``eps``.
+
+    A node whose ``mass * span(r)`` (the most any turn can change its value by) is below
+    the grid bound of the heaviest node is left as it is: its bound is that product, no
+    larger than the reported ``eps``.
+    """
+    turn = model.noise.turn
+    # eps = factor * mass * span on the grid (normal error); 0 where the search is exact.
+    factor = 0.0
+    if not turn.exact and turn.kind == "normal":
+        h = turn.scale / GRID_PER_SIGMA
+        factor = turn.curvature_bound * h * h / 8.0
     eps = 0.0
 
-    def sweep(node: _Node, left: FloatArray | None, lam: float) -> bool:
-        """Refine ``node`` (reached by ``left``; the root: None) and the nodes below it."""
-        nonlocal eps
-        moved = False
-        if left is None:
-            img = model.initial(node.kind, first_angle)
-        else:
-            if np.any(left > 0):
-                right = _right(model, node, lam)
-                new, _, e = _best_turn(model, node.kind, left, right, node.alpha)
-                eps = max(eps, e)
-                if new != node.alpha:
-                    node.alpha, moved = new, True
-            img = left @ model.matrix(node.kind, node.alpha)
+    def weights(node: _Node, left: FloatArray, rights: dict[int, FloatArray]) -> float:
+        """The largest ``mass * span(r)`` over the nodes below (``left``: after the action)."""
+        top = 0.0
         for j, nxt in enumerate(node.children):
             if isinstance(nxt, _Node):
-                moved |= sweep(nxt, img * node.lik[:, j], lam)
+                q = left * node.lik[:, j]
+                r = rights[id(nxt)]
+                top = max(top, float(q.sum()) * float(r.max() - r.min()))
+                top = max(top, weights(nxt, q @ model.matrix(nxt.kind, nxt.alpha), rights))
+        return top
+
+    def sweep(node: _Node, left: FloatArray, rights: dict[int, FloatArray], tau: float) -> bool:
+        """Refine the nodes below ``node`` (``left``: the belief after its action)."""
+        nonlocal eps
+        moved = False
+        for j, nxt in enumerate(node.children):
+            if not isinstance(nxt, _Node):
+                continue
+            q = left * node.lik[:, j]
+            r = rights[id(nxt)]
+            weight = float(q.sum()) * float(r.max() - r.min())
+            if weight > 0 and weight > tau:
+                new, _, e = _best_turn(model, nxt.kind, q, r, nxt.alpha)
+                eps = max(eps, e)
+                if new != nxt.alpha:
+                    nxt.alpha, moved = new, True
+            else:
+                eps = max(eps, weight)
+            moved |= sweep(nxt, q @ model.matrix(nxt.kind, nxt.alpha), rights, tau)
         return moved
 
+    q0 = model.initial(root.kind, first_angle)
     for _ in range(MAX_SWEEPS):
         eps = 0.0
-        moved = sweep(root, None, ratio)
+        rights = _rights(model, root, ratio)
+        tau = max(factor * weights(root, q0, rights), 1e-15)
+        moved = sweep(root, q0, rights, tau)
         new_ratio = _exact(model, root, first_angle).expected_cost
-        if not moved or new_ratio >= ratio * (1.0 - 1e-13):
-            return min(ratio, new_ratio), eps
+        done = not moved or new_ratio >= ratio * (1.0 - 1e-13)
         ratio = new_ratio
+        if done:
+            break
     return ratio, eps
 
 
@@ -554,7 +625,14 @@ def plan_noisy_policy(
     solver = _solver(space, sens, _PRUNE)
     solver.max_beliefs = max_beliefs
     for k in solver.kinds:
-        k.matrices = np.ascontiguousarray(model.matrices(k.name, np.asarray(k.mid)))
+        mid, half = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
+        if main.accuracy > 0:  # only turns that keep their class under the accuracy
+            keep = half >= main.accuracy
+            mid, half = mid[keep], half[keep]
+        k.mid, k.half_width = mid, half
+        k.classes = np.arange(len(mid), dtype=np.intp)
+        k.transfer = np.zeros((len(mid), space.n_states), dtype=np.intp)  # unused: matrices
+        k.matrices = np.ascontiguousarray(model.matrices(k.name, mid))
     kinds = solver.kinds
     angles, angles_exact = _first_angles(space, main.action_kinds, max_first_angles)
     roots = np.array([model.initial(k.name, a) for k in kinds for a in angles])  # (R, N)
@@ -600,10 +678,12 @@ def plan_noisy_policy(
     dp = _mutable(root, model)
     cands = [(_exact(model, dp, root.step.alpha).expected_cost, dp, root.step.alpha, "dp")]
     cands += evaluated
+    # Refinement (the dominant work) for the programme's policy, and for a known one only
+    # if it is already better than that.
     out: list[tuple[float, float, int, _Node, float, str]] = []
     for order, (c, tree, a, label) in enumerate(cands):
         eps = 0.0
-        if refine and math.isfinite(c):
+        if refine and math.isfinite(c) and (order == 0 or c < out[0][0]):
             c, eps = _refine(model, tree, a, c)
         out.append((c, eps, order, tree, a, label))
     c, eps, _, tree, a, label = min(out, key=lambda x: (x[0], x[2]))
