@@ -62,7 +62,6 @@ def _reference(pb: Problem, sensor: WidthSensor, noise: NoiseModel, turns, depth
     """
     nt = NoisyTransitions(pb, noise)
     lik = sensor.bins(np.asarray(pb.widths)).likelihood  # (K, B)
-    k = pb.n_states
     goal = np.array([pb.success_states(float(s)) for s in pb.states.stable], dtype=float)
     cost = pb.cost
     c1, c, v, rho = (
