@@ -655,7 +655,11 @@ def policy_simulation_text(sim: PolicySimulation, title: str = "") -> str:
 
 
 def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
-    """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals."""
+    """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals.
+
+    A policy planned under noisy actions adds ``noise`` (the model its figures are exact
+    under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`).
+    """
     e = sim.reading_errors if len(sim.reading_errors) else np.full(1, math.nan)
     keys = ["success_probability", "cycle_cost", "expected_actions", "expected_cost"]
     figs = {
@@ -667,6 +671,7 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
         "engine": sim.engine,
         "parts": list(sim.policy.parts),
         "sensor": sim.policy.sensor.to_json(),
+        **({} if sim.policy.noise is None else {"noise": sim.policy.noise.to_json()}),
         "cycles": sim.cycles,
         "successes": sim.successes,
         "rejects": sim.rejects,
