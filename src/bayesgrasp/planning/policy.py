@@ -476,7 +476,8 @@ class _Solver:
     use_floor: bool = True  # values at earlier (higher) prices bound later ones from below
     floor_gen: int = 0
     searched: int = 0
-    max_beliefs: int = 0  # most prepared beliefs kept (0: no limit; see `prepared`)
+    max_bytes: int = 0  # most memory (about) for prepared beliefs (0: no limit; `prepared`)
+    prep_bytes: int = 0
     memo: _Memo = field(default_factory=dict)
     prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
@@ -726,14 +727,16 @@ class _Solver:
         """The images of belief ``q`` under kind ``ti``, prepared (kept across prices)."""
         hit = self.prep_cache.get((key, ti))
         if hit is None:
-            if self.max_beliefs and len(self.prep_cache) >= self.max_beliefs:
+            if self.max_bytes and self.prep_bytes > self.max_bytes:
                 raise PlanningError(
-                    f"the policy search keeps more than {self.max_beliefs:,} beliefs (the "
-                    "memory bound `max_beliefs`): raise it, or plan fewer actions"
+                    f"the policy search's beliefs take more than {self.max_bytes / 2**20:,.0f} "
+                    "MB (the memory bound `max_memory_mb`): raise it, or plan fewer actions"
                 )
             imgs, rows = self.images(q, self.kinds[ti])
             hit = (self.prepare(imgs), rows)
             self.prep_cache[(key, ti)] = hit
+            if self.max_bytes:  # the images, reading masses, successes, bounds and floors
+                self.prep_bytes += imgs.nbytes + 6 * hit[0].mass.nbytes + 200
         return hit
 
     def value(
