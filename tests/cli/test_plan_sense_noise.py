@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import pytest
 from numpy.testing import assert_allclose
@@ -54,10 +55,30 @@ def test_simulate_replays_the_noisy_policy(capsys: pytest.CaptureFixture[str]) -
     assert "planned and predicted under turn error normal:3 deg" in capsys.readouterr().out
 
 
+def test_plan_sense_with_a_payoff(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    f = tmp_path / "u.csv"
+    f.write_text("orientation_deg,value\n0,1\n46.99,0.5\n")
+    argv = ["plan", "house", *SENSE, "--payoff", str(f), "--turn-noise", "uniform:2"]
+    assert main([*argv, "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    u = [1.0, 0.5] + [0.0] * 6
+    assert doc["payoff"] == u
+    noise = NoiseModel(TurnNoise("uniform", math.radians(2)))
+    pol = plan_noisy_policy(Problem.build(load("house")), "width:0.5,0.25", 2, noise, payoff=u)
+    assert_allclose(doc["expected_cost"], pol.expected_cost, rtol=1e-12)
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "stop, verify (expected payoff" in out and "per unit payoff" in out
+    assert (
+        main(["plan", "house", "--sense", "width", "--also", "triangle", "--payoff", str(f)]) == 2
+    )
+    assert "a payoff is for one part" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize(
     ("argv", "match"),
     [
-        (["plan", "house", "--sense", "width", "--payoff", "x.json"], "--payoff does not take"),
+        (["plan", "house", "--sense", "width", "--payoff", "x.json"], "x.json"),
         (["plan", "house", "--sense", "width", "--turn-noise", "normal:x"], "normal:SIGMA_DEG"),
         (["plan", "house", "--sense", "width", "--turn-noise", "normal:1", "--guaranteed"],
          "do not take noise"),

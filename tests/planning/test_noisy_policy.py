@@ -52,17 +52,22 @@ def _sensor(part: Part, noisy: bool) -> WidthSensor:
 # -- an independent exhaustive reference (one part, squeezes, uniform prior) ---------------
 
 
-def _reference(pb: Problem, sensor: WidthSensor, noise: NoiseModel, turns, depth: int) -> float:
+def _reference(
+    pb: Problem, sensor: WidthSensor, noise: NoiseModel, turns, depth: int, payoff=None
+) -> float:
     """Least expected cost over every policy of at most ``depth`` (1 or 2) actions.
 
     The first squeeze at world angle 0 (any angle under the uniform prior); after its
     reading, each reading bin either stops (declare a state, or reject) or, at depth 2,
     squeezes once more after any turn of ``turns`` and stops after each reading. The ratio
-    is minimised by Dinkelbach's iteration over an exhaustive AND-OR search.
+    is minimised by Dinkelbach's iteration over an exhaustive AND-OR search. With a payoff
+    ``u``, stopping earns ``q . u`` instead of the best declaration's success.
     """
     nt = NoisyTransitions(pb, noise)
     lik = sensor.bins(np.asarray(pb.widths)).likelihood  # (K, B)
     goal = np.array([pb.success_states(float(s)) for s in pb.states.stable], dtype=float)
+    if payoff is not None:
+        goal = np.asarray(payoff, dtype=float)[None, :]
     cost = pb.cost
     c1, c, v, rho = (
         cost.action_cost("squeeze", first=True),
@@ -335,3 +340,48 @@ def test_bad_input() -> None:
         plan_noisy_policy(pb, "width", 2, "normal:2")  # type: ignore[arg-type]
     with pytest.raises(PlanningError, match="max_actions"):
         plan_noisy_policy(pb, "width", 0, nm)
+
+
+PAYOFF_PARTS = [TRIANGLE, HOUSE, random_polygon(3)]
+
+
+def _payoff(pb: Problem) -> np.ndarray:
+    u = np.zeros(pb.n_states)
+    u[0], u[1], u[-1] = 1.0, 0.6, 0.3
+    return u
+
+
+@pytest.mark.parametrize("part", PAYOFF_PARTS, ids=lambda p: p.name)
+@pytest.mark.parametrize("noise", ["none", "normal", "contact"], ids=str)
+def test_payoff_against_the_reference(part: Part, noise: str) -> None:
+    """A payoff replaces the goal: exhaustive reference, the sensorless plan, a replay."""
+    pb = Problem.build(part)
+    nm = NOISES.get(noise, NoiseModel())
+    u = _payoff(pb)
+    size = float(pb.diameter.lengths.max())
+    sensor = WidthSensor(0.03 * size, 0.03 * size)
+    pol = plan_noisy_policy(pb, sensor, 2, nm, payoff=u)
+    assert pol.payoff == tuple(u)
+    ref_mid = _reference(pb, sensor, nm, _middles(pb), 2, u)
+    grid = np.radians(np.arange(-180.0, 180.0, 0.5))
+    ref_fine = _reference(pb, sensor, nm, [*_middles(pb), *grid], 2, u)
+    assert pol.expected_cost <= ref_mid + 1e-9
+    assert pol.expected_cost <= ref_fine * (1 + 2e-4)
+    blind = plan_noisy(pb, nm, u, max_actions=2).bayes_plan.option.expected_cost
+    assert pol.expected_cost <= blind + 1e-9
+    again = evaluate_policy(pb, pol, nm)
+    assert_allclose(_figures(again), _figures(pol), atol=1e-12)
+    sim = simulate_policy(pb, pol, 60_000, nm, rng=5)
+    assert sim.agrees
+
+
+def test_payoff_everywhere_one_stops_at_once() -> None:
+    pb = Problem.build(HOUSE)
+    pol = plan_noisy_policy(pb, "width", 3, NOISES["normal"], payoff=np.ones(pb.n_states))
+    assert pol.expected_cost == pytest.approx(2.0, abs=1e-12)  # one squeeze, verify
+    assert pol.depth == 1
+
+
+def test_payoff_needs_one_part() -> None:
+    with pytest.raises(PlanningError, match="a payoff is for one part"):
+        plan_noisy_policy([Problem.build(HOUSE)] * 2, "width", 2, None, payoff=np.ones(8))

@@ -6,6 +6,7 @@ candidate parts and plans their policy.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -22,42 +23,50 @@ if TYPE_CHECKING:
     from ..planning.policy import Policy
 
 
+@dataclass(frozen=True)
+class ActionModel:
+    """The noise and payoff options of a --sense command (either may be absent)."""
+
+    noise: NoiseModel | None = None
+    payoff: Path | None = None
+
+
 def _policy(
     sensing: SenseSpec,
     parts: list[Part],
     spec: ProblemSpec,
-    noise: NoiseModel | None,
+    model: ActionModel | None,
     sensor: WidthSensor | None = None,
 ) -> tuple[list[Problem], Policy]:
     """The candidates' problems and their Bayes policy, under the action noise if given."""
-    if noise is None:
+    if model is None:
         return sensing.policy(parts, spec, sensor)
+    from ..model.payoff import read_payoff
     from ..planning.noisy_policy import plan_noisy_policy
 
+    payoff = read_payoff(model.payoff) if model.payoff is not None else None
+    if payoff is not None and len(parts) > 1:
+        raise typer.BadParameter("a payoff is for one part: drop --also", param_hint="--payoff")
     problems = [spec.build(p) for p in parts]
     pol = plan_noisy_policy(
         problems,
         sensing.sense if sensor is None else sensor,
         sensing.max_actions,
-        noise,
+        model.noise,
+        payoff=payoff,
         part_prior=sensing.part_prior,
     )
     return problems, pol
 
 
-def sense_noise(turn: str | None, contact: float | None, payoff: Path | None) -> NoiseModel | None:
-    """The action noise of a --sense command (``None``: none asked); --payoff is refused."""
-    if payoff is not None:
-        raise typer.BadParameter(
-            "a sensing policy declares and verifies a state; --payoff does not take --sense "
-            "yet (plan without --sense for the Bayes plan per unit payoff)",
-            param_hint="--payoff",
-        )
-    if turn is None and contact is None:
+def sense_noise(turn: str | None, contact: float | None, payoff: Path | None) -> ActionModel | None:
+    """The action noise and payoff of a --sense command (``None``: neither asked)."""
+    if turn is None and contact is None and payoff is None:
         return None
     from .noisy import noise_model
 
-    return noise_model(turn, contact)
+    noise = noise_model(turn, contact) if turn is not None or contact is not None else None
+    return ActionModel(noise, payoff)
 
 
 def plan_policy_command(
@@ -66,12 +75,13 @@ def plan_policy_command(
     sensing: SenseSpec,
     as_json: bool,
     fold_below: float = 0.0,
-    noise: NoiseModel | None = None,
+    noise: ActionModel | None = None,
 ) -> None:
     """Plan and print a sensing policy over PART and the candidate parts.
 
     The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
-    With ``noise`` the policy is planned, and its figures computed, under that action noise.
+    With ``noise`` the policy is planned, and its figures computed, under that action noise
+    (and payoff).
     """
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
@@ -92,6 +102,8 @@ def plan_policy_command(
         f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
         f"(bits): {entropy}"
     )
+    if pol.payoff is not None:
+        typer.echo("payoff: success is the expected payoff earned, the cost is per unit payoff")
     if pol.noise is not None:
         typer.echo(
             f"noise: {pol.noise.describe()}; every figure is exact under it; no single turn "
@@ -137,10 +149,10 @@ def simulate_policy_command(
     if engine is Engine.mujoco and sensor.kind == "exact":
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))
     model = sense_noise(turn, None, None)
-    if model is not None:
+    if model is not None and model.noise is not None:
         from ..sim.noise import GripperNoise
 
-        noise = GripperNoise(model.turn.kind, model.turn.scale)
+        noise = GripperNoise(model.noise.turn.kind, model.noise.turn.scale)
     problems, pol = _policy(sensing, parts, spec, model, sensor)
     n = cycles or (200_000 if engine is Engine.kinematic else 200)
 
@@ -167,8 +179,8 @@ def simulate_policy_command(
     names = " or ".join(pol.parts)
     most = sensing.max_actions
     title = f"{names}: Bayes policy of at most {most} actions; "
-    if model is not None:
-        title += f"planned and predicted under turn error {model.turn.spec()} deg; "
+    if model is not None and model.noise is not None:
+        title += f"planned and predicted under turn error {model.noise.turn.spec()} deg; "
     typer.echo(policy_simulation_text(res, title))
 
 

@@ -28,6 +28,11 @@ Fields (angles in radians, readings in the parts' units)::
                                        figure and probability is exact under that noise
       "refinement_bound": eps,         with "noise": no single turn, the rest kept, lowers
                                        cycle_cost - expected_cost * P by more
+      "payoff": [U, ...],              only for a policy with a payoff (plan --sense
+                                       --payoff FILE): the value of each stable state; a
+                                       declaring leaf stops and earns the payoff of the state
+                                       reached, P is the expected payoff of a cycle and C
+                                       the expected cost per unit payoff
       "root": NODE
     }
     NODE = {"action": {"type": "squeeze" | "push-grasp", "alpha_rad": a, "margin_rad": m},
@@ -122,5 +127,7 @@ def policy_document(policy: Policy) -> dict[str, Any]:
     if policy.noise is not None:
         doc["noise"] = policy.noise.to_json()
         doc["refinement_bound"] = policy.refinement_bound
+    if policy.payoff is not None:
+        doc["payoff"] = list(policy.payoff)
     doc["root"] = _node(policy.root)
     return doc

@@ -78,8 +78,14 @@ actions make almost every belief new (the memo of the noise-free programme helps
 so the work grows like ``(A B)^(K - 1)`` beliefs for ``A`` candidate turns, ``B`` reading
 bins and ``K`` actions, less what the bounds prune.
 
-Not supported here: a payoff (``--payoff``): the policy's leaves declare a state and
-verify, as without noise.
+Payoff (the paper, section 6.4; :mod:`bayesgrasp.model.payoff`, one part): the value
+``u_j`` in [0, 1] of ending in state ``j`` replaces the goal. A declaring leaf then stops,
+verifies and earns the payoff of the state the part is in: per unit mass it costs
+``v + rho (1 - q . u)`` and succeeds ``q . u`` (the leaf names the state of most
+``q_j u_j``). The policy minimises the expected cost per unit payoff,
+``E[cycle cost] / E[payoff]``, as :func:`.noisy.plan_noisy` does for plans (for a 0/1
+payoff that is today's cost); a payoff needs no noise. The pi-pair bound is not used
+(both states of a pair may pay).
 
 Examples
 --------
@@ -101,13 +107,15 @@ import logging
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from typing import Any, cast
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..model.noise import NoiseModel, NoisyTransitions
+from ..model.payoff import Payoff, as_vector
 from ..model.problem import Problem
 from ..model.sensing import StateSpace, WidthSensor, parse_sensor
 from ..model.states import nearest_state
@@ -156,6 +164,7 @@ class _Model:
         self.nts = [NoisyTransitions(p, noise) for p in space.problems]
         self.bins = space.bins(sensor)
         self.goal = space.success_matrix()
+        self.payoff: FloatArray | None = None  # one part's payoff vector, if any
         self.cost = space.problems[0].cost
         self.n = space.n_states
         self.blocks = [
@@ -237,6 +246,12 @@ class _Model:
         """The reading bins of each branch (a branch's interval is a union of bins)."""
         lo, hi = self.bins.lo, self.bins.hi
         return [np.flatnonzero((lo >= b.lo) & (hi <= b.hi)) for b in branches]
+
+    def earned(self, leaf: Declare) -> FloatArray:
+        """What a declaring leaf earns in each state: the payoff, or its goal's success set."""
+        if self.payoff is not None:
+            return self.payoff
+        return np.asarray(self.goal[self.state(leaf)], dtype=np.float64)
 
     def state(self, leaf: Declare) -> int:
         """The joint state a declaration names."""
@@ -327,10 +342,17 @@ def _evaluate(
                 fig.reject += pb
                 out = nxt
             else:
-                s = float(per[:, model.goal[model.state(nxt)]].sum())
+                if model.payoff is None:
+                    s = float(per[:, model.goal[model.state(nxt)]].sum())
+                    out = nxt
+                else:  # the payoff earned; the leaf names the state of most value
+                    total = per.sum(axis=0)
+                    s = float(total @ model.payoff)
+                    j = int(np.argmax(total * model.payoff))
+                    out = Declare(0, model.space.names[0], float(model.space.stable(j)[1]), 0.0)
                 fig.success += s
                 fig.verify_cost += pb * cost.verify
-                out = dataclasses.replace(nxt, success_probability=s / pb if pb > 0 else 0.0)
+                out = dataclasses.replace(out, success_probability=s / pb if pb > 0 else 0.0)
         branches.append(Branch(b.lo, b.hi, prob, out))
     return PolicyNode(PlanStep(node.kind, node.alpha), tuple(branches), node.margin)
 
@@ -397,7 +419,7 @@ def _rights(model: _Model, root: _Node, lam: float) -> dict[int, FloatArray]:
             if isinstance(nxt, Reject):
                 cols.append(np.full(model.n, rho))
             elif isinstance(nxt, Declare):
-                g = model.goal[model.state(nxt)].astype(np.float64)
+                g = model.earned(nxt)
                 cols.append(v + rho - (lam + rho) * g)
             else:
                 below = walk(nxt)
@@ -550,6 +572,7 @@ def plan_noisy_policy(
     max_actions: int = _DEFAULT_MAX_ACTIONS,
     noise: NoiseModel | None = None,
     *,
+    payoff: Payoff | ArrayLike | None = None,
     part_prior: str | Sequence[float] | None = None,
     max_first_angles: int = 512,
     max_iterations: int = 50,
@@ -569,7 +592,13 @@ def plan_noisy_policy(
     max_actions : int
         At most this many actions on any path (>= 1; default 3).
     noise : NoiseModel, optional
-        The action noise; ``None`` or no noise: :func:`.policy.plan_policy`'s policy.
+        The action noise; ``None`` or no noise (and no payoff): :func:`.policy.plan_policy`'s
+        policy.
+    payoff : Payoff or array_like of shape (K,), optional
+        One part only: the value in [0, 1] of each final state
+        (:mod:`bayesgrasp.model.payoff`). A declaring leaf then stops and earns the payoff
+        of the state the part is in, and the policy minimises the expected cost per unit
+        payoff (see the module notes).
     part_prior : str or sequence of float, optional
         Prior weights of the candidate parts (default equal).
     max_first_angles : int
@@ -620,7 +649,7 @@ def plan_noisy_policy(
         raise PlanningError(f"`max_memory_mb` must be a number > 0; got {max_memory_mb!r}")
     if noise is not None and not isinstance(noise, NoiseModel):
         raise PlanningError(f"`noise` must be a NoiseModel; got {type(noise).__name__}")
-    if noise is None or (noise.exact and not _always):
+    if payoff is None and (noise is None or (noise.exact and not _always)):
         return plan_policy(
             problems,
             sens,
@@ -630,6 +659,7 @@ def plan_noisy_policy(
             max_iterations=max_iterations,
             sensorless=sensorless,
         )
+    noise = noise or NoiseModel()
     space = StateSpace.build(problems, part_prior)
     main = space.problems[0]
     if any(p.accuracy != main.accuracy for p in space.problems):
@@ -639,6 +669,18 @@ def plan_noisy_policy(
         )
     model = _Model(space, sens, noise)
     solver = _solver(space, sens, _PRUNE)
+    u: FloatArray | None = None
+    if payoff is not None:
+        if space.n_parts > 1:
+            raise PlanningError("a payoff is for one part; got several candidate parts")
+        u = as_vector(payoff, main.states)
+        model.payoff = u
+        # Stopping earns ``q . u``: the programme's success is that one row (no pi-pair
+        # bound: both states of a pair may pay; the payoff is at most 1, so the bound
+        # ``U = total`` holds).
+        solver.goal = cast(Any, u[None, :])
+        solver.goal_is_identity = False
+        solver.use_pairs = False
     solver.max_bytes = max(1, int(max_memory_mb * 2**20))
     for k in solver.kinds:
         mid, half = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
@@ -669,7 +711,7 @@ def plan_noisy_policy(
     known.append((_mutable(free.root, model), free.root.step.alpha, "noise-free policy"))
     sensorless_cost: float | None = None
     if sensorless and space.n_parts == 1:
-        res = plan_noisy(main, noise, max_actions=max_actions)
+        res = plan_noisy(main, noise, u, max_actions=max_actions)
         opt = res.bayes_plan
         sensorless_cost = opt.option.expected_cost
         kinds_ = [s.kind for s in opt.option.steps]
@@ -725,8 +767,9 @@ def plan_noisy_policy(
         angles_exact,
         main.part.units,
         solver.searched,
-        noise,
+        None if noise.exact else noise,
         eps,
+        None if u is None else tuple(float(x) for x in u),
     )
 
 
@@ -766,6 +809,8 @@ def evaluate_policy(
     noise = noise or NoiseModel()
     space = StateSpace.build(problems, list(policy.part_prior))
     model = _Model(space, policy.sensor, noise)
+    if policy.payoff is not None:
+        model.payoff = np.asarray(policy.payoff, dtype=np.float64)
     tree = _mutable(policy.root, model)
     ev = _exact(model, tree, policy.root.step.alpha)
     return dataclasses.replace(

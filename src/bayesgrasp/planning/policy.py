@@ -319,6 +319,11 @@ class Policy:
         Noisy actions: no single turn of the policy, the rest kept, can lower the value at
         the policy's ratio by more than this (0 when exact; see
         :mod:`~bayesgrasp.planning.noisy_policy`).
+    payoff : tuple of float or None
+        With a payoff (:mod:`~bayesgrasp.planning.noisy_policy`), the value of each state:
+        a declaring leaf stops and earns the payoff of the state the part is in (its
+        ``success_probability`` is then the expected payoff, and ``success_probability``
+        of the policy the expected payoff of a cycle).
     """
 
     root: PolicyNode
@@ -340,6 +345,7 @@ class Policy:
     searched: int = 0
     noise: NoiseModel | None = None
     refinement_bound: float = 0.0
+    payoff: tuple[float, ...] | None = None
 
     @property
     def expected_total_actions(self) -> float:
@@ -950,7 +956,9 @@ class _Builder:
             t.reject += mass
             return Reject()
         o = int(dec[1])
-        succ = float(q[s.goal[o]].sum())
+        g = s.goal[o]
+        # a payoff (noisy_policy) is one row of values; a goal, rows of success sets
+        succ = float(q[g].sum()) if g.dtype == np.bool_ else float(q @ g)
         t.success += mass * succ
         t.verify_cost += mass * s.verify
         return self.declare(o, succ, carry)
@@ -1459,6 +1467,12 @@ def policy_text(
     def leaf(x: Declare | Reject) -> str:
         if isinstance(x, Reject):
             return "reject (back to the feeder)"
+        if policy.payoff is not None:
+            likeliest = f"{math.degrees(x.orientation):.{digits}f} deg"
+            return (
+                f"stop, verify (expected payoff {x.success_probability:.{digits}f}; most "
+                f"valued at {likeliest})"
+            )
         what = f"{math.degrees(x.orientation):.{digits}f} deg"
         if several:
             what = f"part {x.part_name!r} at {what}"

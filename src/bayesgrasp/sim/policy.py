@@ -220,6 +220,7 @@ class _Run:
     rejected: BoolArray
     errors: list[FloatArray]
     contact: float = 0.0  # probability that a squeeze's jaws touch one after the other
+    payoff: FloatArray | None = None  # the policy's payoff of each state, if it has one
     pushes: dict[int, Any] = field(default_factory=dict)  # each part's push-grasp function
 
     def act(self, j: int, kind: str, x: FloatArray) -> FloatArray:
@@ -279,8 +280,13 @@ class _Run:
             self.cost[idx] += cost.verify
             pb = self.problems[leaf.part]
             mine = idx[self.part[idx] == leaf.part]
-            good = pb.success_states(leaf.orientation)[nearest_state(pb.states, self.theta[mine])]
-            self.ok[mine] = good
+            state = nearest_state(pb.states, self.theta[mine])
+            if self.payoff is not None:
+                # a payoff u: the cycle succeeds with probability u of the state reached
+                # (so the successes count the payoff earned, in expectation)
+                self.ok[mine] = self.gen.random(len(mine)) < self.payoff[state]
+            else:
+                self.ok[mine] = pb.success_states(leaf.orientation)[state]
         else:
             self.rejected[idx] = True
         failed = idx[~self.ok[idx]]
@@ -387,6 +393,7 @@ def simulate_policy(
             np.zeros(m, dtype=bool),
             [],
             contact,
+            None if policy.payoff is None else np.asarray(policy.payoff, dtype=np.float64),
         )
         run.node(policy.root, np.arange(m), True)
         out["cost"].append(run.cost)
