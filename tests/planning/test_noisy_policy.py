@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from bayesgrasp.errors import PlanningError
@@ -186,8 +188,8 @@ def test_zero_noise_is_todays_policy(part: Part, noisy: bool) -> None:
     pb = Problem.build(part)
     sensor = _sensor(part, noisy)
     today = plan_policy(pb, sensor, 3)
-    assert plan_noisy_policy(pb, sensor, 3, None) is not today  # planned again, same figures
-    assert _figures(plan_noisy_policy(pb, sensor, 3, NoiseModel())) == _figures(today)
+    for none in (None, NoiseModel()):  # today's planner, the same figures exactly
+        assert _figures(plan_noisy_policy(pb, sensor, 3, none)) == _figures(today)
     # The noisy machinery itself, with no noise, finds the same policy's figures.
     generic = plan_noisy_policy(pb, sensor, 3, NoiseModel(), _always=True)
     assert_allclose(_figures(generic), _figures(today), atol=1e-9)
@@ -385,3 +387,28 @@ def test_payoff_everywhere_one_stops_at_once() -> None:
 def test_payoff_needs_one_part() -> None:
     with pytest.raises(PlanningError, match="a payoff is for one part"):
         plan_noisy_policy([Problem.build(HOUSE)] * 2, "width", 2, None, payoff=np.ones(8))
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    sigma_deg=st.floats(0.5, 8.0),
+    kind=st.sampled_from(["normal", "uniform"]),
+    contact=st.sampled_from([0.0, 0.2]),
+)
+def test_invariants_on_random_polygons(
+    seed: int, sigma_deg: float, kind: str, contact: float
+) -> None:
+    """Exact figures, probabilities that add up, never worse than the known policies."""
+    pb = Problem.build(random_polygon(seed))
+    nm = NoiseModel(TurnNoise(kind, math.radians(sigma_deg)), contact)  # type: ignore[arg-type]
+    sensor = _sensor(pb.part, True)
+    pol = plan_noisy_policy(pb, sensor, 2, nm)
+    cycle, succ, rej, acts = _evaluate(pb, pol, nm)
+    assert_allclose([pol.cycle_cost, pol.success_probability, pol.reject_probability],
+                    [cycle, succ, rej], atol=1e-12)  # fmt: skip
+    assert_allclose(pol.expected_actions, acts, atol=1e-12)
+    assert_allclose(sum(p for p, _ in pol.leaves()), 1.0, atol=1e-12)
+    free = evaluate_policy(pb, plan_policy(pb, sensor, 2), nm)
+    assert pol.expected_cost <= free.expected_cost + 1e-9
+    assert pol.sensorless_cost is not None and pol.expected_cost <= pol.sensorless_cost + 1e-9

@@ -33,7 +33,9 @@ What is optimal, what is bounded
    programme over beliefs, its exact bounds: the pi-pair bound stays valid because the
    turn error and the contact events are symmetric under a turn by pi) finds the least
    ``R``, up to the ``1e-12`` of the belief memo and of the leaf rule. Beliefs that
-   coincide to ``2^-40`` count once.
+   coincide to ``2^-40`` count once. (A gripper ``accuracy`` restricts these candidates
+   as it restricts the noise-free classes; the refinement below does not keep to it: the
+   noise model says what errors do.)
 2. *Known policies.* The noise-free Bayes policy (:func:`.policy.plan_policy`) and, for one
    part, the noise-aware sensorless Bayes plan (:func:`.noisy.plan_noisy` within
    ``max_actions``, a policy that never branches) are evaluated under the noise too; the

@@ -135,6 +135,10 @@ and its figures are exactly those of the model for every such error (the first a
 angle is in the world frame, as for plans, and is not bounded by it). The policy is the
 best of those policies; ``accuracy = 0`` is the unrestricted search.
 
+Noisy actions (turn error, contact asynchrony) and a payoff: :mod:`.noisy_policy` runs this
+programme with the noisy transition matrices of candidate turns in place of the one-hot
+classes, and refines the turns.
+
 Examples
 --------
 >>> from bayesgrasp.geometry import Part
