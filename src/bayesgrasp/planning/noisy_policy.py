@@ -135,6 +135,7 @@ from .policy import (
     _first_angles,
     _search,
     _solver,
+    _space,
     _start_ratio,
     plan_policy,
 )
@@ -641,8 +642,6 @@ def plan_noisy_policy(
     True
     """
     sens = parse_sensor(sensor)
-    if isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1:
-        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
     if (
         isinstance(max_memory_mb, bool)
         or not isinstance(max_memory_mb, int | float)
@@ -662,13 +661,8 @@ def plan_noisy_policy(
             sensorless=sensorless,
         )
     noise = noise or NoiseModel()
-    space = StateSpace.build(problems, part_prior)
+    space = _space(problems, part_prior, max_actions)
     main = space.problems[0]
-    if any(p.accuracy != main.accuracy for p in space.problems):
-        raise PlanningError(
-            "every candidate part's problem must have the same gripper `accuracy`; got "
-            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
-        )
     model = _Model(space, sens, noise)
     solver = _solver(space, sens, _PRUNE)
     u: FloatArray | None = None

@@ -1211,15 +1211,8 @@ def plan_policy(
     8.0
     """
     sens = parse_sensor(sensor)
-    if isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1:
-        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
-    space = StateSpace.build(problems, part_prior)
+    space = _space(problems, part_prior, max_actions)
     main = space.problems[0]
-    if any(p.accuracy != main.accuracy for p in space.problems):
-        raise PlanningError(
-            "every candidate part's problem must have the same gripper `accuracy`; got "
-            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
-        )
     solver = _solver(space, sens, _prune)
     kinds = solver.kinds
     if first_angles is not None:
@@ -1256,6 +1249,24 @@ def plan_policy(
         k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
     )
     return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+
+
+def _space(
+    problems: Problem | Iterable[Problem],
+    part_prior: str | Sequence[float] | None,
+    max_actions: int,
+) -> StateSpace:
+    """The state space of the candidate parts, their inputs checked (see :func:`plan_policy`)."""
+    if isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1:
+        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
+    space = StateSpace.build(problems, part_prior)
+    main = space.problems[0]
+    if any(p.accuracy != main.accuracy for p in space.problems):
+        raise PlanningError(
+            "every candidate part's problem must have the same gripper `accuracy`; got "
+            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
+        )
+    return space
 
 
 def _start_ratio(solver: _Solver, roots: FloatArray, root_kind: Sequence[int]) -> float:
