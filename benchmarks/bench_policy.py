@@ -4,7 +4,11 @@
   (target: under 5 s on one core);
 - noisy readings, SIGMA = 1% of each polygon's largest diameter, RES = SIGMA / 2
   (target: under 60 s);
-- a 3-part recognition policy for catalogue parts (target: under 1 s).
+- a 3-part recognition policy for catalogue parts (target: under 1 s);
+- noisy actions too (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`): the 2000
+  polygons with SIGMA = 1% of each diameter (RES = SIGMA / 2) and a normal turn error of
+  2 deg, depth <= 3 (target: under 120 s on one core); ``--noisy-actions N`` runs only
+  this, on the first N polygons.
 
 Run: ``python benchmarks/bench_policy.py [--polygons N] [--depth K] [--noisy-polygons N]``;
 ``--polygon I`` times the noisy polygon ``I`` of the draw alone (1402 is the slowest).
@@ -25,6 +29,7 @@ import numpy as np
 
 from bayesgrasp import shapes
 from bayesgrasp.model import Problem
+from bayesgrasp.model.noise import NoiseModel, TurnNoise
 from bayesgrasp.model.sensing import WidthSensor
 from bayesgrasp.paper.study import random_polygon
 from bayesgrasp.planning.policy import plan_policy
@@ -82,6 +87,38 @@ def bench_random(n: int, depth: int, noisy: float | None, with_sensorless: bool)
     )
 
 
+def bench_noisy_actions(n: int, depth: int = 3, turn_deg: float = 2.0) -> None:
+    """Noisy readings (SIGMA 1% of the diameter, RES SIGMA/2) and a normal turn error."""
+    from bayesgrasp.planning.noisy_policy import plan_noisy_policy
+
+    noise = NoiseModel(TurnNoise("normal", math.radians(turn_deg)))
+    t0 = time.perf_counter()
+    c0 = time.process_time()
+    pbs = polygons(n)
+    t1 = time.perf_counter()
+    c1 = time.process_time()
+    costs, searched, bounds, times = [], [], [], []
+    for pb in pbs:
+        sigma = 0.01 * float(pb.diameter.lengths.max())
+        p0 = time.process_time()
+        pol = plan_noisy_policy(pb, WidthSensor(sigma, sigma / 2), depth, noise, sensorless=False)
+        times.append(time.process_time() - p0)
+        costs.append(pol.expected_cost)
+        searched.append(pol.searched)
+        bounds.append(pol.refinement_bound)
+    t2 = time.perf_counter()
+    cpu = time.process_time() - c0
+    worst = int(np.argmax(times))
+    print(
+        f"{n} polygons, noisy actions (normal {turn_deg:g} deg) and readings (SIGMA 1% of "
+        f"diameter, RES SIGMA/2), depth <= {depth}: {t2 - t0:.2f} s wall, {cpu:.2f} s CPU "
+        f"({time.process_time() - c1:.2f} s CPU planning, {t1 - t0:.2f} s building problems); "
+        f"mean cost {np.mean(costs):.4f}; beliefs searched/polygon mean "
+        f"{np.mean(searched):.1f} max {max(searched)}; refinement bound max {max(bounds):.2g}; "
+        f"slowest polygon {worst} ({times[worst]:.3f} s CPU)"
+    )
+
+
 def bench_recognition(names: tuple[str, ...], depth: int, sensor: str) -> None:
     t0 = time.perf_counter()
     c0 = time.process_time()
@@ -103,7 +140,13 @@ def main() -> None:
     ap.add_argument("--depth", type=int, default=4)
     ap.add_argument("--noisy-polygons", type=int, default=None)
     ap.add_argument("--polygon", type=int, default=None, help="only this noisy polygon")
+    ap.add_argument(
+        "--noisy-actions", type=int, default=None, help="only noisy actions, N polygons"
+    )
     args = ap.parse_args()
+    if args.noisy_actions is not None:
+        bench_noisy_actions(args.noisy_actions)
+        return
     if args.polygon is not None:
         bench_one(args.polygon, args.depth, 0.01)
         return
@@ -115,6 +158,7 @@ def main() -> None:
         bench_recognition(parts, 3, sensor)
         bench_recognition(parts, 4, sensor)
     bench_recognition(("triangle", "example", "allen-wrench"), 3, "width:0.5,0.1")
+    bench_noisy_actions(args.noisy_polygons or args.polygons)
 
 
 if __name__ == "__main__":

@@ -371,8 +371,8 @@ def test_mujoco_results_are_predicted_under_the_noise(
         (["--turn-noise", "normal:2", "--noise", "1"], "not both"),
         (["--turn-noise", "normal:50"], "scale"),
         (["--payoff", "missing.json"], "no such file"),
-        (["--contact-noise", "0.2", "--sense", "width"], "--sense"),
-        (["--payoff", "missing.json", "--sense", "width"], "--sense"),
+        (["--engine", "mujoco", "--contact-noise", "0.2", "--sense", "width"], "physics' own"),
+        (["--payoff", "missing.json", "--sense", "width"], "no such file"),
         (["--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
     ],
 )

@@ -170,10 +170,6 @@ def plan(
         need = "needs" if len(given) == 1 else "need"
         raise typer.BadParameter(f"{' and '.join(given)} {need} --sense")
     noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
-    if noise_asked and sense is not None:
-        raise typer.BadParameter(
-            "--sense does not take --turn-noise, --contact-noise or --payoff yet"
-        )
     if sense is not None:
         if part.part is None or batch is not None:
             raise typer.BadParameter("--sense needs PART and takes no --batch")
@@ -190,13 +186,14 @@ def plan(
         ]
         if refused:
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
-        from .sensing import plan_policy_command
+        from .sensing import plan_policy_command, sense_noise
 
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
         if export is not None:
             check_export(export, input_files(part.part, spec.prior, *more), force)
         sensing = SenseSpec(sense, more, part_prior, max_actions)
-        plan_policy_command(part, spec, sensing, as_json, fold_below, export, stroke)
+        noise = sense_noise(turn_noise, contact_noise, payoff)
+        plan_policy_command(part, spec, sensing, as_json, fold_below, export, stroke, noise)
         return
     several = batch is not None or bool(more_parts)
     if part.part is None and not several:

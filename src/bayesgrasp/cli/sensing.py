@@ -6,6 +6,7 @@ candidate parts and plans their policy.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -15,7 +16,58 @@ from .common import emit_json, list_files, with_progress, write_failed
 from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
 
 if TYPE_CHECKING:
+    from ..geometry.polygon import Part
     from ..io.export import Stroke
+    from ..model.noise import NoiseModel
+    from ..model.problem import Problem
+    from ..model.sensing import WidthSensor
+    from ..planning.policy import Policy
+
+
+@dataclass(frozen=True)
+class ActionModel:
+    """The noise and payoff options of a --sense command (either may be absent)."""
+
+    noise: NoiseModel | None = None
+    payoff: Path | None = None
+
+
+def _policy(
+    sensing: SenseSpec,
+    parts: list[Part],
+    spec: ProblemSpec,
+    model: ActionModel | None,
+    sensor: WidthSensor | None = None,
+) -> tuple[list[Problem], Policy]:
+    """The candidates' problems and their Bayes policy, under the action noise if given."""
+    if model is None:
+        return sensing.policy(parts, spec, sensor)
+    from ..model.payoff import read_payoff
+    from ..planning.noisy_policy import plan_noisy_policy
+
+    payoff = read_payoff(model.payoff) if model.payoff is not None else None
+    if payoff is not None and len(parts) > 1:
+        raise typer.BadParameter("a payoff is for one part: drop --also", param_hint="--payoff")
+    problems = [spec.build(p) for p in parts]
+    pol = plan_noisy_policy(
+        problems,
+        sensing.sense if sensor is None else sensor,
+        sensing.max_actions,
+        model.noise,
+        payoff=payoff,
+        part_prior=sensing.part_prior,
+    )
+    return problems, pol
+
+
+def sense_noise(turn: str | None, contact: float | None, payoff: Path | None) -> ActionModel | None:
+    """The action noise and payoff of a --sense command (``None``: neither asked)."""
+    if turn is None and contact is None and payoff is None:
+        return None
+    from .noisy import noise_model
+
+    noise = noise_model(turn, contact) if turn is not None or contact is not None else None
+    return ActionModel(noise, payoff)
 
 
 def plan_policy_command(
@@ -26,23 +78,27 @@ def plan_policy_command(
     fold_below: float = 0.0,
     export: Path | None = None,
     stroke: Stroke | None = None,
+    noise: ActionModel | None = None,
 ) -> None:
     """Plan and print a sensing policy over PART and the candidate parts.
 
     The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
     ``export``: also write the policy's robot state machine there (the caller has checked
     the name); ``stroke``: refuse a policy with a state outside the gripper's stroke.
+    With ``noise`` the policy is planned, and its figures computed, under that action noise
+    (and payoff).
     """
     from ..io.export import check_stroke, write_robot
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
 
     parts = sensing.parts(part)
-    problems, pol = sensing.policy(parts, spec)
+    problems, pol = _policy(sensing, parts, spec, noise)
     if stroke is not None:
         check_stroke(problems, pol, stroke)
     if export is not None:
-        write_robot(export, problems, pol)
+        meta = {} if pol.noise is None else {"noise": pol.noise.to_json()}
+        write_robot(export, problems, pol, meta)
         typer.echo(f"bayesgrasp: wrote {export}", err=True)
     if as_json:
         emit_json(policy_document(pol))
@@ -50,13 +106,21 @@ def plan_policy_command(
     typer.echo(policy_text(pol, units=parts[0].units, min_probability=fold_below))
     entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
     blind = pol.sensorless_cost
-    versus = "" if blind is None else f" (sensorless Bayes plan {blind:.4f})"
+    under = "" if pol.noise is None else " under the noise"
+    versus = "" if blind is None else f" (sensorless Bayes plan{under} {blind:.4f})"
     typer.echo(
         f"expected cost {pol.expected_cost:.4f}{versus}, "
         f"success {pol.success_probability:.4f} a cycle, "
         f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
         f"(bits): {entropy}"
     )
+    if pol.payoff is not None:
+        typer.echo("payoff: success is the expected payoff earned, the cost is per unit payoff")
+    if pol.noise is not None:
+        typer.echo(
+            f"noise: {pol.noise.describe()}; every figure is exact under it; no single turn "
+            f"lowers the cost's value by more than {pol.refinement_bound:.2g}"
+        )
 
 
 def simulate_policy_command(
@@ -67,16 +131,19 @@ def simulate_policy_command(
     cycles: int | None,
     workers: int,
     offset_mm: float,
-    noise: Any,
     seed: int,
     units: str | None,
     sensor_error: bool,
     as_json: bool,
+    action: ActionModel | None = None,
 ) -> None:
     """Plan the Bayes policy of PART (and the --also parts), run it, print the comparison.
 
     With ``--engine mujoco`` and ``--sense width`` (no SIGMA given) the policy is planned
     for MuJoCo's default reading error (:func:`bayesgrasp.sim.policy.mujoco_sensor`).
+    With ``action`` (the noise and payoff options) the policy is planned under that noise
+    (and payoff) and the runs draw the noise: turn error and contact asynchrony in the
+    kinematic runs, the turn error in MuJoCo (whose contacts are its own).
     """
     from ..model.sensing import parse_sensor
     from ..sim.policy import (
@@ -93,7 +160,11 @@ def simulate_policy_command(
     scale = units_scale(units) if units is not None else None
     if engine is Engine.mujoco and sensor.kind == "exact":
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))
-    problems, pol = sensing.policy(parts, spec, sensor)
+    from ..sim.noise import GripperNoise
+
+    model = action
+    noise = None if model is None else model.noise
+    problems, pol = _policy(sensing, parts, spec, model, sensor)
     n = cycles or (200_000 if engine is Engine.kinematic else 200)
 
     def run(progress: Any) -> Any:
@@ -104,7 +175,7 @@ def simulate_policy_command(
             pol,
             n,
             offset=offset_mm / 1000.0,
-            noise=noise,
+            noise=None if noise is None else GripperNoise.of(noise.turn),
             rng=seed,
             workers=workers,
             scale=scale,
@@ -118,7 +189,10 @@ def simulate_policy_command(
         return
     names = " or ".join(pol.parts)
     most = sensing.max_actions
-    typer.echo(policy_simulation_text(res, f"{names}: Bayes policy of at most {most} actions; "))
+    title = f"{names}: Bayes policy of at most {most} actions; "
+    if noise is not None and not (noise.exact and noise.contact == 0):
+        title += f"planned and predicted under {noise.describe()}; "
+    typer.echo(policy_simulation_text(res, title))
 
 
 def plot_policy_command(

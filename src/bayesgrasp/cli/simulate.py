@@ -195,17 +195,15 @@ def simulate(
     if sense is not None:
         if jaw_lag:
             raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
-        from .sensing import simulate_policy_command
+        from .sensing import ActionModel, simulate_policy_command
 
-        for given, hint in ((turn_noise, "--turn-noise"), (contact_noise, "--contact-noise"),
-                            (payoff, "--payoff")):  # fmt: skip
-            if given is not None:
-                raise typer.BadParameter("does not apply to --sense yet", param_hint=hint)
-        err = GripperNoise(noise_kind.value, math.radians(noise))
+        model, _, _ = _noise_model(noise, noise_kind, turn_noise, contact_noise)
+        asked = not model.exact or model.contact > 0 or payoff is not None
+        action = ActionModel(model, payoff) if asked else None
         sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
         simulate_policy_command(
-            part, spec, sensing, engine, trials, workers, offset, err, seed, units,
-            sensor_error, as_json,
+            part, spec, sensing, engine, trials, workers, offset, seed, units,
+            sensor_error, as_json, action,
         )  # fmt: skip
         return
     if also or part_prior is not None or sensor_error:

@@ -22,6 +22,17 @@ Fields (angles in radians, readings in the parts' units)::
                                        (paths that ended keep their last belief)
       "sensorless_cost": C0 | null,    the sensorless Bayes plan's expected cost (one part)
       "first_angle_exact": bool,       every first angle that can be optimal was tried
+      "noise": {"turn": {"kind": "normal" | "uniform", "scale_rad": s}, "contact": q},
+                                       only for a policy planned under noisy actions
+                                       (plan --sense --turn-noise / --contact-noise): every
+                                       figure and probability is exact under that noise
+      "refinement_bound": eps,         with "noise": no single turn, the rest kept, lowers
+                                       cycle_cost - expected_cost * P by more
+      "payoff": [U, ...],              only for a policy with a payoff (plan --sense
+                                       --payoff FILE): the value of each stable state; a
+                                       declaring leaf stops and earns the payoff of the state
+                                       reached, P is the expected payoff of a cycle and C
+                                       the expected cost per unit payoff
       "root": NODE
     }
     NODE = {"action": {"type": "squeeze" | "push-grasp", "alpha_rad": a, "margin_rad": m},
@@ -31,11 +42,12 @@ Fields (angles in radians, readings in the parts' units)::
 
 ``alpha_rad`` is the world gripper angle at the root and the turn relative to the previous
 action below it; ``margin_rad`` is how far that turn may err without changing any state's
-outcome (``null`` at the root). ``reading`` is the half-open interval ``[lo, hi)``, ``null``
-for an unbounded end; the branches of a node tile every reading in increasing order, and
-``probability`` is that of the branch given that the node is reached. A declared
-``orientation_rad`` is in the frame of the last action, in ``[0, 2 pi)``; ``q`` is the
-probability that the declaration is right given that the leaf is reached.
+outcome (``null`` at the root; 0 under noisy actions, whose error is in the figures).
+``reading`` is the half-open interval ``[lo, hi)``, ``null`` for an unbounded end; the
+branches of a node tile every reading in increasing order, and ``probability`` is that of
+the branch given that the node is reached. A declared ``orientation_rad`` is in the frame of
+the last action, in ``[0, 2 pi)``; ``q`` is the probability that the declaration is right
+given that the leaf is reached.
 """
 
 from __future__ import annotations
@@ -96,7 +108,7 @@ def policy_document(policy: Policy) -> dict[str, Any]:
     >>> doc["schema"], doc["parts"], doc["root"]["branches"][0]["reading"]
     ('bayesgrasp.policy/1', ['rect'], [None, 1.5])
     """
-    return {
+    doc: dict[str, Any] = {
         "schema": POLICY_SCHEMA,
         "parts": list(policy.parts),
         "part_prior": list(policy.part_prior),
@@ -111,5 +123,11 @@ def policy_document(policy: Policy) -> dict[str, Any]:
         "expected_entropy_bits": list(policy.expected_entropy),
         "sensorless_cost": policy.sensorless_cost,
         "first_angle_exact": policy.first_angle_exact,
-        "root": _node(policy.root),
     }
+    if policy.noise is not None:
+        doc["noise"] = policy.noise.to_json()
+        doc["refinement_bound"] = policy.refinement_bound
+    if policy.payoff is not None:
+        doc["payoff"] = list(policy.payoff)
+    doc["root"] = _node(policy.root)
+    return doc

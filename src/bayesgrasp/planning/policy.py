@@ -135,6 +135,10 @@ and its figures are exactly those of the model for every such error (the first a
 angle is in the world frame, as for plans, and is not bounded by it). The policy is the
 best of those policies; ``accuracy = 0`` is the unrestricted search.
 
+Noisy actions (turn error, contact asynchrony) and a payoff: :mod:`.noisy_policy` runs this
+programme with the noisy transition matrices of candidate turns in place of the one-hot
+classes, and refines the turns.
+
 Examples
 --------
 >>> from bayesgrasp.geometry import Part
@@ -151,7 +155,7 @@ import logging
 import math
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -169,6 +173,9 @@ from ..model.sensing import (
     parse_sensor,
 )
 from .result import PlanStep, short_turns
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..model.noise import NoiseModel
 
 __all__ = [
     "Branch",
@@ -308,6 +315,19 @@ class Policy:
         Every first gripper angle that can be optimal was tried (see the module notes).
     units : str or None
         Units of the readings (the parts' units).
+    noise : NoiseModel or None
+        The action noise the policy was planned and evaluated under
+        (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`; ``None``: exact
+        actions).
+    refinement_bound : float
+        Noisy actions: no single turn of the policy, the rest kept, can lower the value at
+        the policy's ratio by more than this (0 when exact; see
+        :mod:`~bayesgrasp.planning.noisy_policy`).
+    payoff : tuple of float or None
+        With a payoff (:mod:`~bayesgrasp.planning.noisy_policy`), the value of each state:
+        a declaring leaf stops and earns the payoff of the state the part is in (its
+        ``success_probability`` is then the expected payoff, and ``success_probability``
+        of the policy the expected payoff of a cycle).
     """
 
     root: PolicyNode
@@ -327,6 +347,9 @@ class Policy:
     first_angle_exact: bool = True
     units: str | None = None
     searched: int = 0
+    noise: NoiseModel | None = None
+    refinement_bound: float = 0.0
+    payoff: tuple[float, ...] | None = None
 
     @property
     def expected_total_actions(self) -> float:
@@ -418,6 +441,9 @@ class _Kind:
     half_width: FloatArray  # (A,)
     pi_symmetric: bool
     patterns: dict[bytes, tuple[IntArray, IntArray, int]] = field(default_factory=dict)
+    # Noisy actions (:mod:`.noisy_policy`): the (A, N, N) transition matrix of each row's
+    # turn; ``None``: the one-hot ``transfer``.
+    matrices: FloatArray | None = None
 
 
 @dataclass(slots=True)
@@ -460,6 +486,8 @@ class _Solver:
     use_floor: bool = True  # values at earlier (higher) prices bound later ones from below
     floor_gen: int = 0
     searched: int = 0
+    max_bytes: int = 0  # most memory (about) for prepared beliefs (0: no limit; `prepared`)
+    prep_bytes: int = 0
     memo: _Memo = field(default_factory=dict)
     prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
@@ -513,6 +541,8 @@ class _Solver:
 
     def images(self, q: FloatArray, kind: _Kind) -> tuple[FloatArray, IntArray]:
         """Distinct beliefs after each class of ``kind`` (M, N) and the row of each."""
+        if kind.matrices is not None:
+            return self.noisy_images(q, kind.matrices)
         pos = q > 0
         pattern = kind.patterns.get(pos.tobytes())
         if pattern is None:
@@ -521,6 +551,15 @@ class _Solver:
         w = np.broadcast_to(q[pos], (m, len(idx) // m)).ravel()
         out = np.bincount(idx, weights=w, minlength=m * self.space.n_states)
         return np.asarray(out.reshape(m, -1), dtype=np.float64), first
+
+    def noisy_images(self, q: FloatArray, matrices: FloatArray) -> tuple[FloatArray, IntArray]:
+        """Beliefs ``q M_a`` after each candidate turn (M, N), equal ones (to ``2^-40``) once."""
+        imgs = np.asarray(np.tensordot(q, matrices, axes=([0], [1])), dtype=np.float64)
+        _, first = np.unique(np.rint(imgs * _QUANT), axis=0, return_index=True)
+        if len(first) == len(imgs):
+            return imgs, np.arange(len(imgs), dtype=np.intp)
+        first = np.sort(first)
+        return np.ascontiguousarray(imgs[first]), np.asarray(first, dtype=np.intp)
 
     def pattern(self, pos: NDArray[np.bool_], kind: _Kind) -> tuple[IntArray, IntArray, int]:
         """The distinct effects of ``kind`` on a belief of support ``pos``.
@@ -698,9 +737,16 @@ class _Solver:
         """The images of belief ``q`` under kind ``ti``, prepared (kept across prices)."""
         hit = self.prep_cache.get((key, ti))
         if hit is None:
+            if self.max_bytes and self.prep_bytes > self.max_bytes:
+                raise PlanningError(
+                    f"the policy search's beliefs take more than {self.max_bytes / 2**20:,.0f} "
+                    "MB (the memory bound `max_memory_mb`): raise it, or plan fewer actions"
+                )
             imgs, rows = self.images(q, self.kinds[ti])
             hit = (self.prepare(imgs), rows)
             self.prep_cache[(key, ti)] = hit
+            if self.max_bytes:  # the images, reading masses, successes, bounds and floors
+                self.prep_bytes += imgs.nbytes + 6 * hit[0].mass.nbytes + 200
         return hit
 
     def value(
@@ -894,7 +940,10 @@ class _Builder:
             t.add_entropy(level, mass, h)
             kind = s.kinds[dec[1]]
             row = dec[2]
-            mapped = np.bincount(kind.transfer[row], weights=q, minlength=len(q))
+            if kind.matrices is not None:
+                mapped = q @ kind.matrices[row]
+            else:
+                mapped = np.bincount(kind.transfer[row], weights=q, minlength=len(q))
             return self.node(
                 kind,
                 float(kind.mid[row]),
@@ -911,7 +960,9 @@ class _Builder:
             t.reject += mass
             return Reject()
         o = int(dec[1])
-        succ = float(q[s.goal[o]].sum())
+        g = s.goal[o]
+        # a payoff (noisy_policy) is one row of values; a goal, rows of success sets
+        succ = float(q[g].sum()) if g.dtype == np.bool_ else float(q @ g)
         t.success += mass * succ
         t.verify_cost += mass * s.verify
         return self.declare(o, succ, carry)
@@ -1160,16 +1211,8 @@ def plan_policy(
     8.0
     """
     sens = parse_sensor(sensor)
-    if isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1:
-        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
-    space = StateSpace.build(problems, part_prior)
+    space = _space(problems, part_prior, max_actions)
     main = space.problems[0]
-    if any(p.accuracy != main.accuracy for p in space.problems):
-        raise PlanningError(
-            "every candidate part's problem must have the same gripper `accuracy`; got "
-            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
-        )
-    cost = main.cost
     solver = _solver(space, sens, _prune)
     kinds = solver.kinds
     if first_angles is not None:
@@ -1194,15 +1237,65 @@ def plan_policy(
         from .exact import plan_exact
 
         sensorless_cost = plan_exact(main, max_actions=max_actions).bayes_plan.expected_cost
-    joint = solver.joint(roots)  # (R, B, N)
-    s, _ = solver.success(joint)
-    p_succ = s.sum(axis=1)
-    c = np.array([kinds[ti].first_cost for ti in root_kind]) + cost.verify
-    ratios = (c + cost.retry * (1 - p_succ)) / p_succ
-    lam = float(np.min(ratios))
+    lam = _start_ratio(solver, roots, root_kind)
     if sensorless_cost is not None and math.isfinite(sensorless_cost):
         lam = min(lam, sensorless_cost)
 
+    deepen = "deepen" in _prune and sens.sigma > 0
+    best_pick, it = _search(solver, roots, root_kind, lam, max_actions, max_iterations, deepen)
+    builder = _Builder(solver, max_actions)
+    k = kinds[root_kind[best_pick]]
+    root = builder.node(
+        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
+    )
+    return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+
+
+def _space(
+    problems: Problem | Iterable[Problem],
+    part_prior: str | Sequence[float] | None,
+    max_actions: int,
+) -> StateSpace:
+    """The state space of the candidate parts, their inputs checked (see :func:`plan_policy`)."""
+    if isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1:
+        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
+    space = StateSpace.build(problems, part_prior)
+    main = space.problems[0]
+    if any(p.accuracy != main.accuracy for p in space.problems):
+        raise PlanningError(
+            "every candidate part's problem must have the same gripper `accuracy`; got "
+            + ", ".join(f"{math.degrees(p.accuracy):g} deg" for p in space.problems)
+        )
+    return space
+
+
+def _start_ratio(solver: _Solver, roots: FloatArray, root_kind: Sequence[int]) -> float:
+    """The least ratio of "one action, then declare the likeliest state on every reading"."""
+    joint = solver.joint(roots)  # (R, B, N)
+    s, _ = solver.success(joint)
+    p_succ = s.sum(axis=1)
+    c = np.array([solver.kinds[ti].first_cost for ti in root_kind]) + solver.verify
+    ratios = (c + solver.retry * (1 - p_succ)) / p_succ
+    return float(np.min(ratios))
+
+
+def _search(
+    solver: _Solver,
+    roots: FloatArray,
+    root_kind: Sequence[int],
+    lam: float,
+    max_actions: int,
+    max_iterations: int,
+    deepen: bool,
+) -> tuple[int, int]:
+    """The parametric search (see the module notes) from the known ratio ``lam``.
+
+    ``roots[ri]`` is the belief after the first action of kind ``root_kind[ri]``. Leaves the
+    programme of the best step in ``solver`` (its price and memo, which the builder reads) and
+    returns the best root and the number of parametric steps. ``deepen``: first search
+    within ``max_actions - 1`` actions (worth it with noisy readings).
+    """
+    kinds = solver.kinds
     root_preps = [solver.prepare(roots[ri : ri + 1]) for ri in range(len(roots))]
 
     def solve(lam: float, above: float, depth: int) -> tuple[float, int, float]:
@@ -1265,7 +1358,7 @@ def plan_policy(
     # lower depth (the prepared images, the floors) is of use at the next. (With exact or
     # quantised readings the search is small and the extra solve does not pay.)
     it = 0
-    first = max_actions - 1 if "deepen" in _prune and sens.sigma > 0 else max_actions
+    first = max_actions - 1 if deepen else max_actions
     for depth in range(max(first, 1), max_actions + 1):
         best_lam, best_ratio, best_pick, best_memo, steps = dinkelbach(lam, depth)
         it += steps
@@ -1275,12 +1368,7 @@ def plan_policy(
     if best_lam > solver.lam:
         solver.floor_gen += 1  # the builder may solve more at this higher price
     solver.lam, solver.memo = best_lam, best_memo
-    builder = _Builder(solver, max_actions)
-    k = kinds[root_kind[best_pick]]
-    root = builder.node(
-        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
-    )
-    return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+    return best_pick, it
 
 
 def _finish(
@@ -1394,6 +1482,12 @@ def policy_text(
     def leaf(x: Declare | Reject) -> str:
         if isinstance(x, Reject):
             return "reject (back to the feeder)"
+        if policy.payoff is not None:
+            likeliest = f"{math.degrees(x.orientation):.{digits}f} deg"
+            return (
+                f"stop, verify (expected payoff {x.success_probability:.{digits}f}; most "
+                f"valued at {likeliest})"
+            )
         what = f"{math.degrees(x.orientation):.{digits}f} deg"
         if several:
             what = f"part {x.part_name!r} at {what}"

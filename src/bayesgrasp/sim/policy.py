@@ -47,7 +47,7 @@ import math
 import multiprocessing
 import time
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -56,7 +56,9 @@ from numpy.typing import NDArray
 from ..angles import TWO_PI, circle_distance
 from ..errors import SimulationError
 from ..geometry.polygon import Part
-from ..model.actions import get_action
+from ..geometry.push import push_grasp_function
+from ..model.actions import SQUEEZE, get_action
+from ..model.noise import NoiseModel
 from ..model.problem import Problem, nearest_state
 from ..model.sensing import WidthSensor
 from ..planning.policy import Declare, Policy, PolicyNode, Reject
@@ -217,6 +219,29 @@ class _Run:
     ok: BoolArray
     rejected: BoolArray
     errors: list[FloatArray]
+    contact: float = 0.0  # probability that a squeeze's jaws touch one after the other
+    payoff: FloatArray | None = None  # the policy's payoff of each state, if it has one
+    pushes: dict[int, Any] = field(default_factory=dict)  # each part's push-grasp function
+
+    def act(self, j: int, kind: str, x: FloatArray) -> FloatArray:
+        """Part ``j`` at ``x`` in the gripper frame after action ``kind`` (contact events drawn).
+
+        With contact asynchrony ``q`` a squeeze is, with probability ``q / 2`` each, the
+        push-grasp from the ``-x`` side, ``g(x)``, or from the ``+x`` side,
+        ``g(x - pi) + pi`` (:mod:`bayesgrasp.model.noise`).
+        """
+        pb = self.problems[j]
+        out = np.asarray(pb.transfer(kind)(x), dtype=np.float64)
+        if self.contact <= 0 or kind != SQUEEZE.name:
+            return out
+        if j not in self.pushes:
+            self.pushes[j] = push_grasp_function(pb.part, pb.states)
+        g = self.pushes[j]
+        event = self.gen.random(len(x))
+        left = event < self.contact / 2
+        right = (event >= self.contact / 2) & (event < self.contact)
+        out = np.where(left, g(x), out)
+        return np.asarray(np.where(right, g(x - math.pi) + math.pi, out), dtype=np.float64)
 
     def node(self, node: PolicyNode, idx: IntArray, first: bool) -> None:
         """Run the cycles ``idx`` through ``node`` and what follows it."""
@@ -230,7 +255,7 @@ class _Run:
         for j in np.unique(parts):
             m = parts == j
             pb = self.problems[int(j)]
-            th[m] = pb.transfer(step.kind)(th[m])
+            th[m] = self.act(int(j), step.kind, th[m])
             width[m] = pb.diameter(th[m])
             truth[m] = pb.widths[nearest_state(pb.states, th[m])]
         self.theta[idx] = th
@@ -255,8 +280,13 @@ class _Run:
             self.cost[idx] += cost.verify
             pb = self.problems[leaf.part]
             mine = idx[self.part[idx] == leaf.part]
-            good = pb.success_states(leaf.orientation)[nearest_state(pb.states, self.theta[mine])]
-            self.ok[mine] = good
+            state = nearest_state(pb.states, self.theta[mine])
+            if self.payoff is not None:
+                # a payoff u: the cycle succeeds with probability u of the state reached
+                # (so the successes count the payoff earned, in expectation)
+                self.ok[mine] = self.gen.random(len(mine)) < self.payoff[state]
+            else:
+                self.ok[mine] = pb.success_states(leaf.orientation)[state]
         else:
             self.rejected[idx] = True
         failed = idx[~self.ok[idx]]
@@ -290,7 +320,7 @@ def simulate_policy(
     problems: Problem | Iterable[Problem],
     policy: Policy,
     cycles: int,
-    noise: GripperNoise | None = None,
+    noise: GripperNoise | NoiseModel | None = None,
     rng: np.random.Generator | int | None = None,
     chunk: int = 1 << 16,
     progress: Progress | None = None,
@@ -304,9 +334,12 @@ def simulate_policy(
         first one's prior and cost model are used.
     policy : Policy
     cycles : int
-    noise : GripperNoise, optional
+    noise : GripperNoise or NoiseModel, optional
         Error added to every commanded gripper angle (default none; each node's
-        ``margin`` bounds the error that changes nothing).
+        ``margin`` bounds the error that changes nothing). A
+        :class:`~bayesgrasp.model.noise.NoiseModel` also draws its contact asynchrony
+        (a policy of :func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy` claims its
+        figures under that noise).
     rng : numpy.random.Generator or int or None
     chunk : int
         Cycles per vectorised batch.
@@ -337,6 +370,10 @@ def simulate_policy(
         raise SimulationError(f"`chunk` must be >= 1; got {chunk}")
     pbs = _problems(problems, policy)
     gen = as_generator(rng)
+    contact = 0.0
+    if isinstance(noise, NoiseModel):
+        contact = noise.contact
+        noise = GripperNoise(noise.turn.kind, noise.turn.scale)
     noise = noise or GripperNoise()
     out: dict[str, list[Any]] = {k: [] for k in ("cost", "acts", "ok", "rej", "err")}
     t0 = time.perf_counter()
@@ -355,6 +392,8 @@ def simulate_policy(
             np.zeros(m, dtype=bool),
             np.zeros(m, dtype=bool),
             [],
+            contact,
+            None if policy.payoff is None else np.asarray(policy.payoff, dtype=np.float64),
         )
         run.node(policy.root, np.arange(m), True)
         out["cost"].append(run.cost)
@@ -623,7 +662,11 @@ def policy_simulation_text(sim: PolicySimulation, title: str = "") -> str:
 
 
 def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
-    """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals."""
+    """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals.
+
+    A policy planned under noisy actions adds ``noise`` (the model its figures are exact
+    under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`).
+    """
     e = sim.reading_errors if len(sim.reading_errors) else np.full(1, math.nan)
     keys = ["success_probability", "cycle_cost", "expected_actions", "expected_cost"]
     figs = {
@@ -635,6 +678,7 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
         "engine": sim.engine,
         "parts": list(sim.policy.parts),
         "sensor": sim.policy.sensor.to_json(),
+        **({} if sim.policy.noise is None else {"noise": sim.policy.noise.to_json()}),
         "cycles": sim.cycles,
         "successes": sim.successes,
         "rejects": sim.rejects,
