@@ -131,7 +131,6 @@ from .policy import (
     PolicyNode,
     Reject,
     _Builder,
-    _entropies,
     _first_angles,
     _search,
     _solver,
@@ -140,6 +139,7 @@ from .policy import (
     plan_policy,
 )
 from .result import PlanStep
+from .strategy import Evaluation, evaluate_tree
 
 __all__ = ["MAX_SWEEPS", "evaluate_policy", "plan_noisy_policy"]
 
@@ -294,72 +294,6 @@ def _nodes(node: _Node, first: bool = True) -> list[tuple[_Node, bool]]:
     return out
 
 
-@dataclass(slots=True)
-class _Figures:
-    success: float = 0.0
-    action_cost: float = 0.0
-    verify_cost: float = 0.0
-    reject: float = 0.0
-    actions: float = 0.0
-    entropy: list[float] = field(default_factory=list)  # per level, acting histories
-    leaves: list[tuple[int, float, float]] = field(default_factory=list)  # level, mass, mass*H
-
-
-def _evaluate(
-    model: _Model, node: _Node, hist: FloatArray, level: int, first: bool, fig: _Figures
-) -> PolicyNode:
-    """The node with exact probabilities, given the beliefs ``hist`` (H, N) reaching it.
-
-    ``hist`` holds one unnormalised belief per reading history (the root: the belief after
-    its first action, already applied by the caller when ``first``).
-    """
-    cost = model.cost
-    if first:
-        img = hist
-    else:
-        img = hist @ model.matrix(node.kind, node.alpha)
-    mass = float(img.sum())
-    fig.actions += mass
-    fig.action_cost += mass * cost.action_cost(node.kind, first=first)
-    branches: list[Branch] = []
-    for b, ix, nxt in zip(node.branches, node.bins, node.children, strict=True):
-        # (H * bins, N): every history continued by every reading of the branch
-        per = (img[:, None, :] * model.bins.likelihood[:, ix].T[None, :, :]).reshape(-1, model.n)
-        w = per.sum(axis=1)
-        keep = w > 0
-        per, w = per[keep], w[keep]
-        pb = float(w.sum())
-        prob = pb / mass if mass > 0 else 0.0
-        h = float((w * _entropies(per / w[:, None])).sum()) if len(w) else 0.0
-        out: PolicyNode | Declare | Reject
-        if isinstance(nxt, _Node):
-            while len(fig.entropy) < level:
-                fig.entropy.append(0.0)
-            fig.entropy[level - 1] += h
-            out = (
-                _evaluate(model, nxt, per, level + 1, False, fig) if len(w) else _frozen(nxt, model)
-            )
-        else:
-            fig.leaves.append((level, pb, h))
-            if isinstance(nxt, Reject):
-                fig.reject += pb
-                out = nxt
-            else:
-                if model.payoff is None:
-                    s = float(per[:, model.goal[model.state(nxt)]].sum())
-                    out = nxt
-                else:  # the payoff earned; the leaf names the state of most value
-                    total = per.sum(axis=0)
-                    s = float(total @ model.payoff)
-                    j = int(np.argmax(total * model.payoff))
-                    out = Declare(0, model.space.names[0], float(model.space.stable(j)[1]), 0.0)
-                fig.success += s
-                fig.verify_cost += pb * cost.verify
-                out = dataclasses.replace(out, success_probability=s / pb if pb > 0 else 0.0)
-        branches.append(Branch(b.lo, b.hi, prob, out))
-    return PolicyNode(PlanStep(node.kind, node.alpha), tuple(branches), node.margin)
-
-
 def _frozen(node: _Node, model: _Model) -> PolicyNode:
     """A subtree no history reaches (probabilities 0)."""
     kids = [_frozen(k, model) if isinstance(k, _Node) else k for k in node.children]
@@ -370,34 +304,11 @@ def _frozen(node: _Node, model: _Model) -> PolicyNode:
     )
 
 
-@dataclass(frozen=True, slots=True)
-class _Evaluated:
-    root: PolicyNode
-    expected_cost: float
-    success: float
-    cycle: float
-    reject: float
-    actions: float
-    entropy: tuple[float, ...]
-
-
-def _exact(model: _Model, root: _Node, first_angle: float) -> _Evaluated:
-    """Exact figures of a tree (see the module notes)."""
-    fig = _Figures()
-    q0 = model.initial(root.kind, first_angle)[None, :]
-    node = _evaluate(model, root, q0, 1, True, fig)
-    depth = max(1, _depth(root))
-    ent = [0.0] * depth
-    for x, e in enumerate(fig.entropy[:depth]):
-        ent[x] += e
-    for lv, _, h in fig.leaves:
-        for x in range(lv, depth + 1):
-            ent[x - 1] += h
-    p = fig.success
-    rho = model.cost.retry
-    cycle = fig.action_cost + fig.verify_cost + rho * (1.0 - p)
-    expected = cycle / p if p > 0 else math.inf
-    return _Evaluated(node, expected, p, cycle, fig.reject, fig.actions, tuple(ent))
+def _exact(model: _Model, root: _Node, first_angle: float) -> Evaluation:
+    """Exact figures of a tree: :func:`.strategy.evaluate_tree` under the model's matrices."""
+    tree = _frozen(root, model)
+    tree = dataclasses.replace(tree, step=PlanStep(tree.step.kind, first_angle))
+    return evaluate_tree(model.space, tree, model, model.bins, model.payoff)
 
 
 def _depth(node: _Node) -> int:
@@ -746,17 +657,17 @@ def plan_noisy_policy(
         node.margin = math.inf if first else 0.0
     ev = _exact(model, tree, a)
     return Policy(
-        ev.root,
+        ev.strategy,
         space.names,
         tuple(float(w) for w in space.part_prior),
         sens,
         max_actions,
         ev.expected_cost,
-        ev.success,
-        ev.cycle,
-        ev.reject,
-        ev.actions,
-        ev.entropy,
+        ev.success_probability,
+        ev.cycle_cost,
+        ev.reject_probability,
+        ev.expected_actions,
+        ev.expected_entropy,
         sensorless_cost,
         it,
         len(solver.memo),
@@ -811,12 +722,12 @@ def evaluate_policy(
     ev = _exact(model, tree, policy.root.step.alpha)
     return dataclasses.replace(
         policy,
-        root=ev.root,
+        root=ev.strategy,
         expected_cost=ev.expected_cost,
-        success_probability=ev.success,
-        cycle_cost=ev.cycle,
-        reject_probability=ev.reject,
-        expected_actions=ev.actions,
-        expected_entropy=ev.entropy,
+        success_probability=ev.success_probability,
+        cycle_cost=ev.cycle_cost,
+        reject_probability=ev.reject_probability,
+        expected_actions=ev.expected_actions,
+        expected_entropy=ev.expected_entropy,
         noise=None if noise.exact else noise,
     )

@@ -54,9 +54,11 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -64,13 +66,23 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import PlanningError
 from ..model.noise import NoiseModel, NoisyTransitions
 from ..model.problem import Problem, nearest_state
-from ..model.sensing import StateSpace, WidthSensor, entropy_bits, parse_sensor
+from ..model.sensing import ReadingBins, StateSpace, WidthSensor, parse_sensor
 from .policy import Branch, Declare, PolicyNode, Reject
 from .result import PlanOption
 
-__all__ = ["Evaluation", "evaluate", "plan_strategy"]
+__all__ = [
+    "Evaluation",
+    "ExactTransitions",
+    "NoisyJointTransitions",
+    "Transitions",
+    "evaluate",
+    "evaluate_tree",
+    "plan_strategy",
+    "transitions",
+]
 
 FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.intp]
 Leaf = Declare | Reject
 
 
@@ -96,6 +108,10 @@ class Evaluation:
     final_distribution : ndarray of shape (N,)
         Probability of ending a cycle at each joint state (frame of the last action), over
         every leaf.
+    strategy : PolicyNode
+        The tree with its probabilities under the model: each branch's given its node, each
+        declaration's success given its leaf (with a payoff, the leaf names the state of most
+        value and its success is the payoff earned).
     """
 
     success_probability: float
@@ -105,6 +121,7 @@ class Evaluation:
     expected_actions: float
     expected_entropy: tuple[float, ...]
     final_distribution: FloatArray
+    strategy: PolicyNode
 
     @property
     def expected_total_actions(self) -> float:
@@ -140,122 +157,220 @@ def plan_strategy(problem: Problem, option: PlanOption, part: int = 0) -> Policy
     return nxt
 
 
+class Transitions(Protocol):
+    """What the evaluation asks of an action model (joint states of every candidate part)."""
+
+    def initial(self, kind: str, angle: float) -> FloatArray:
+        """Joint belief (part prior times state mass) after the first action at ``angle``."""
+        ...
+
+    def matrix(self, kind: str, alpha: float) -> FloatArray:
+        """The (N, N) row-stochastic matrix of an action turned by ``alpha``."""
+        ...
+
+
+class ExactTransitions:
+    """Exact actions: state ``i`` goes to the state of ``F_t(S_i - alpha)``, part by part."""
+
+    def __init__(self, space: StateSpace) -> None:
+        self.space = space
+
+    def initial(self, kind: str, angle: float) -> FloatArray:
+        """The prior mass of each state's basins, shifted by ``angle``, times the part prior."""
+        return self.space.initial(kind, angle)
+
+    def matrix(self, kind: str, alpha: float) -> FloatArray:
+        """The one-hot matrix of the transfer functions turned by ``alpha``."""
+        sp = self.space
+        m = np.zeros((sp.n_states, sp.n_states))
+        for j, pb in enumerate(sp.problems):
+            lo = int(sp.offsets[j])
+            theta = pb.transfer(kind)(np.asarray(pb.states.stable) - alpha)
+            to = nearest_state(pb.states, np.asarray(theta, dtype=np.float64))
+            m[lo + np.arange(pb.n_states), lo + to] = 1.0
+        return m
+
+
+class NoisyJointTransitions:
+    """Noisy actions: the block-diagonal matrices of each part's :class:`NoisyTransitions`."""
+
+    def __init__(self, space: StateSpace, noise: NoiseModel) -> None:
+        self.space = space
+        self.parts = [NoisyTransitions(p, noise) for p in space.problems]
+
+    def initial(self, kind: str, angle: float) -> FloatArray:
+        """The prior convolved with the first action's error, times the part prior."""
+        weights = self.space.part_prior
+        return np.concatenate(
+            [w * nt.initial(kind, angle) for w, nt in zip(weights, self.parts, strict=True)]
+        )
+
+    def matrix(self, kind: str, alpha: float) -> FloatArray:
+        """The block-diagonal matrix of every part's noisy action turned by ``alpha``."""
+        sp = self.space
+        m = np.zeros((sp.n_states, sp.n_states))
+        for j, nt in enumerate(self.parts):
+            lo, hi = int(sp.offsets[j]), int(sp.offsets[j + 1])
+            m[lo:hi, lo:hi] = nt.matrix(kind, alpha)
+        return m
+
+
+def transitions(space: StateSpace, noise: NoiseModel | None = None) -> Transitions:
+    """The action model of a state space: exact, or under ``noise``."""
+    if noise is None or (noise.exact and noise.contact == 0):
+        return ExactTransitions(space)
+    return NoisyJointTransitions(space, noise)
+
+
 class _Walk:
-    """The propagation of one evaluation: the model's matrices and the running sums."""
+    """One evaluation: the model, and the sums the leaves and nodes add to."""
 
     def __init__(
         self,
         space: StateSpace,
-        sensor: WidthSensor | None,
-        noise: NoiseModel | None,
+        model: Transitions,
+        bins: ReadingBins | None,
         payoff: FloatArray | None,
     ) -> None:
-        self.space = space
-        self.noisy = (
-            None
-            if noise is None or (noise.exact and noise.contact == 0)
-            else [NoisyTransitions(p, noise) for p in space.problems]
-        )
-        self.bins = None if sensor is None else space.bins(sensor)
-        self.payoff = payoff
+        self.space, self.model, self.bins, self.payoff = space, model, bins, payoff
         self.cost = space.problems[0].cost
         self.success = self.action_cost = self.verify_cost = self.reject = self.actions = 0.0
         self.final = np.zeros(space.n_states)
-        self.entropy: list[tuple[int, float, float]] = []  # (level, mass, entropy) at leaves
-        self.passing: list[tuple[int, float, float]] = []  # (level, mass, entropy) at nodes
+        self.passing: dict[int, float] = {}  # level -> sum of mass * entropy, acting histories
+        self.ended: list[tuple[int, float]] = []  # (level, mass * entropy) at the leaves
 
-    def first(self, kind: str, angle: float) -> FloatArray:
-        """Joint belief (unnormalised by nothing: part prior times state mass) after the root."""
-        sp = self.space
-        if self.noisy is None:
-            return sp.initial(kind, angle)
-        parts = [
-            w * nt.initial(kind, angle) for w, nt in zip(sp.part_prior, self.noisy, strict=True)
-        ]
-        return np.concatenate(parts)
-
-    def act(self, q: FloatArray, kind: str, alpha: float) -> FloatArray:
-        """``q M_kind(alpha)``, part by part."""
-        sp = self.space
-        out = np.zeros_like(q)
-        for j, pb in enumerate(sp.problems):
-            lo, hi = int(sp.offsets[j]), int(sp.offsets[j + 1])
-            qj = q[lo:hi]
-            if self.noisy is None:
-                theta = pb.transfer(kind)(np.asarray(pb.states.stable) - alpha)
-                to = nearest_state(pb.states, np.asarray(theta, dtype=np.float64))
-                out[lo:hi] = np.bincount(to, weights=qj, minlength=hi - lo)
-            else:
-                out[lo:hi] = qj @ self.noisy[j].matrix(kind, alpha)
-        return out
-
-    def readings(self, branches: Sequence[Branch]) -> tuple[FloatArray, NDArray[np.intp]]:
-        """The likelihood ``L[i, b]`` of a reading in bin ``b`` in state ``i``; each bin's branch.
+    def readings(self, branches: Sequence[Branch]) -> tuple[FloatArray, list[IntArray]]:
+        """The likelihood ``L[i, b]`` of a reading in bin ``b`` in state ``i``; each branch's bins.
 
         The robot's belief after a reading is the prior times the likelihood of the reading's
-        bin, whichever branch the bin belongs to: the belief (and its entropy) is carried bin
-        by bin, and the branch only says what to do next. Without a sensor there is one bin.
+        bin, whichever branch the bin belongs to: beliefs (and their entropies) are carried a
+        reading history at a time, and the branch only says what to do next. Without a
+        sensor there is one bin.
         """
         if self.bins is None:
             if len(branches) != 1:
                 raise PlanningError(
                     "a strategy that branches on readings needs the sensor it was planned for"
                 )
-            return np.ones((self.space.n_states, 1)), np.zeros(1, dtype=np.intp)
+            return np.ones((self.space.n_states, 1)), [np.zeros(1, dtype=np.intp)]
         b = self.bins
         # A bin lies inside one branch (the planners' branches join whole bins): its lower
         # end (for the first bin, -inf) falls in that branch.
         his = np.array([br.hi for br in branches])
-        return b.likelihood, np.searchsorted(his[:-1], b.lo, side="right")
+        owner = np.searchsorted(his[:-1], b.lo, side="right")
+        return b.likelihood, [np.flatnonzero(owner == k) for k in range(len(branches))]
 
-    def node(self, node: PolicyNode, q: FloatArray, level: int, first: bool) -> None:
-        mass = float(q.sum())
-        if mass <= 0.0:
-            return
+    def node(self, node: PolicyNode, hist: FloatArray, level: int, first: bool) -> PolicyNode:
+        """The node with its exact probabilities, given the beliefs ``hist`` (H, N) reaching it.
+
+        Each row of ``hist`` is the unnormalised belief of one reading history before the
+        node's action (the root: after it, as the first action is the prior's).
+        """
+        img = hist if first else hist @ self.model.matrix(node.step.kind, node.step.alpha)
+        mass = float(img.sum())
         self.actions += mass
         self.action_cost += mass * self.cost.action_cost(node.step.kind, first)
-        lik, branch = self.readings(node.branches)
-        joint = q[:, None] * lik  # (N, B) mass of each state and reading
-        masses = joint.sum(axis=0)
-        for b in np.flatnonzero(masses > 0):
-            qb, m = joint[:, b], float(masses[b])
-            h = entropy_bits(qb / m)
-            nxt = node.branches[int(branch[b])].next
-            if isinstance(nxt, PolicyNode):
-                self.passing.append((level, m, h))
-                self.node(nxt, self.act(qb, nxt.step.kind, nxt.step.alpha), level + 1, False)
+        lik, bins = self.readings(node.branches)
+        n = self.space.n_states
+        out: list[Branch] = []
+        for br, ix in zip(node.branches, bins, strict=True):
+            # (H * bins, N): every history continued by every reading of the branch
+            per = (img[:, None, :] * lik[:, ix].T[None, :, :]).reshape(-1, n)
+            w = per.sum(axis=1)
+            keep = w > 0
+            per, w = per[keep], w[keep]
+            pb = float(w.sum())
+            h = float((w * _entropies(per / w[:, None])).sum()) if len(w) else 0.0
+            nxt: PolicyNode | Leaf
+            if isinstance(br.next, PolicyNode):
+                self.passing[level] = self.passing.get(level, 0.0) + h
+                nxt = self.node(br.next, per, level + 1, False) if len(w) else _unreached(br.next)
             else:
-                self.entropy.append((level, m, h))
-                self.leaf(nxt, qb)
+                self.ended.append((level, h))
+                nxt = self.leaf(br.next, per.sum(axis=0), pb)
+            out.append(Branch(br.lo, br.hi, pb / mass if mass > 0 else 0.0, nxt))
+        return PolicyNode(node.step, tuple(out), node.margin)
 
-    def leaf(self, leaf: Leaf, q: FloatArray) -> None:
+    def leaf(self, leaf: Leaf, q: FloatArray, mass: float) -> Leaf:
+        """The leaf reached with the (unnormalised) belief ``q`` of mass ``mass``."""
         self.final += q
         if isinstance(leaf, Reject):
-            self.reject += float(q.sum())
-            return
-        sp = self.space
-        self.verify_cost += float(q.sum()) * self.cost.verify
-        if self.payoff is not None:
-            self.success += float(q @ self.payoff)
-            return
-        lo = int(sp.offsets[leaf.part])
-        good = sp.problems[leaf.part].success_states(leaf.orientation)
-        self.success += float(q[lo : lo + len(good)][good].sum())
+            self.reject += mass
+            return leaf
+        self.verify_cost += mass * self.cost.verify
+        if self.payoff is not None:  # the payoff earned; the leaf names the state of most value
+            s = float(q @ self.payoff)
+            part, theta = self.space.stable(int(np.argmax(q * self.payoff)))
+            leaf = Declare(part, self.space.names[part], theta, leaf.success_probability)
+        else:
+            lo = int(self.space.offsets[leaf.part])
+            good = self.space.problems[leaf.part].success_states(leaf.orientation)
+            s = float(q[lo : lo + len(good)][good].sum())
+        self.success += s
+        return dataclasses.replace(leaf, success_probability=s / mass if mass > 0 else 0.0)
 
     def entropies(self, depth: int) -> tuple[float, ...]:
         """Expected entropy after each level's reading (ended paths keep their last belief)."""
-        out = [0.0] * depth
-        for level, m, h in self.passing:
-            out[level - 1] += m * h
-        for level, m, h in self.entropy:
+        out = [self.passing.get(level, 0.0) for level in range(1, depth + 1)]
+        for level, h in self.ended:
             for x in range(level, depth + 1):
-                out[x - 1] += m * h
+                out[x - 1] += h
         return tuple(out)
+
+
+def _unreached(node: PolicyNode) -> PolicyNode:
+    """A subtree no reading history reaches: its probabilities 0."""
+    return PolicyNode(
+        node.step,
+        tuple(
+            Branch(
+                b.lo, b.hi, 0.0, _unreached(b.next) if isinstance(b.next, PolicyNode) else b.next
+            )
+            for b in node.branches
+        ),
+        node.margin,
+    )
+
+
+def _entropies(q: FloatArray) -> FloatArray:
+    """Shannon entropy (bits) of each row of normalised beliefs ``q`` (M, N)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        terms = np.where(q > 0, q * np.log2(np.where(q > 0, q, 1.0)), 0.0)
+    return np.asarray(-terms.sum(axis=1), dtype=np.float64)
 
 
 def _depth(node: PolicyNode) -> int:
     return 1 + max(
         (_depth(b.next) for b in node.branches if isinstance(b.next, PolicyNode)), default=0
+    )
+
+
+def evaluate_tree(
+    space: StateSpace,
+    strategy: PolicyNode,
+    model: Transitions,
+    bins: ReadingBins | None = None,
+    payoff: FloatArray | None = None,
+) -> Evaluation:
+    """:func:`evaluate` on a built state space, action model and reading bins.
+
+    For planners that evaluate many trees of one problem (the matrices of ``model`` may be
+    kept between calls).
+    """
+    walk = _Walk(space, model, bins, payoff)
+    q = model.initial(strategy.step.kind, strategy.step.alpha)[None, :]
+    root = walk.node(strategy, q, 1, True)
+    p = walk.success
+    cycle = walk.action_cost + walk.verify_cost + walk.cost.retry * (1.0 - p)
+    return Evaluation(
+        success_probability=p,
+        expected_cost=cycle / p if p > 0 else math.inf,
+        cycle_cost=cycle,
+        reject_probability=walk.reject,
+        expected_actions=walk.actions,
+        expected_entropy=walk.entropies(_depth(strategy)),
+        final_distribution=walk.final,
+        strategy=root,
     )
 
 
@@ -303,17 +418,5 @@ def evaluate(
             raise PlanningError(
                 f"`payoff` must have one value per state ({space.n_states}); got shape {u.shape}"
             )
-    walk = _Walk(space, None if sensor is None else parse_sensor(sensor), noise, u)
-    q = walk.first(strategy.step.kind, strategy.step.alpha)
-    walk.node(strategy, q, 1, True)
-    p = walk.success
-    cycle = walk.action_cost + walk.verify_cost + walk.cost.retry * (1.0 - p)
-    return Evaluation(
-        success_probability=p,
-        expected_cost=cycle / p if p > 0 else math.inf,
-        cycle_cost=cycle,
-        reject_probability=walk.reject,
-        expected_actions=walk.actions,
-        expected_entropy=walk.entropies(_depth(strategy)),
-        final_distribution=walk.final,
-    )
+    bins = None if sensor is None else space.bins(parse_sensor(sensor))
+    return evaluate_tree(space, strategy, transitions(space, noise), bins, u)
