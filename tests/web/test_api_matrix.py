@@ -65,3 +65,54 @@ def test_api_equals_the_command_line(
         return
     assert r.status_code == 200, r.text
     assert _strip_times(r.json()) == _strip_times(doc)
+
+
+POLICY_CELLS: dict[str, tuple[dict[str, Any], list[str]]] = {
+    "exact": ({}, []),
+    "turn normal": ({"turn_noise": "normal:2"}, ["--turn-noise", "normal:2"]),
+    "contact": ({"contact_noise": 0.1}, ["--contact-noise", "0.1"]),
+    "payoff": (
+        {"payoff": json.loads((ROOT / PAYOFF).read_text(encoding="utf-8"))},
+        ["--payoff", PAYOFF],
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(POLICY_CELLS))
+def test_api_policy_equals_the_command_line(
+    name: str, client: Any, cli_json: CliJson, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(ROOT)
+    body, args = POLICY_CELLS[name]
+    sense = {"sense": "width:0.5,0.1", "max_actions": 2}
+    r = client.post("/api/v1/policy", json={"part": {"catalogue": "key"}, **sense, **body})
+    code, doc = cli_json("plan", "key", "--sense", "width:0.5,0.1", "--max-actions", "2", *args)
+    assert code == 0, doc
+    assert r.status_code == 200, r.text
+    assert _strip_times(r.json()) == _strip_times(doc)
+
+
+SIMULATE_CELLS: dict[str, tuple[dict[str, Any], list[str]]] = {
+    "exact": ({}, []),
+    "noise (older spelling)": ({"noise": 3.0}, ["--noise", "3"]),
+    "turn uniform": ({"turn_noise": "uniform:3"}, ["--turn-noise", "uniform:3"]),
+    "contact": ({"contact_noise": 0.2}, ["--contact-noise", "0.2"]),
+    "guaranteed under noise": (
+        {"plan": "guaranteed", "turn_noise": "uniform:2"},
+        ["--plan", "guaranteed", "--turn-noise", "uniform:2"],
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(SIMULATE_CELLS))
+def test_api_simulate_equals_the_command_line(
+    name: str, client: Any, cli_json: CliJson, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(ROOT)
+    body, args = SIMULATE_CELLS[name]
+    run = {"trials": 20000, "seed": 3}
+    r = client.post("/api/v1/simulate", json={"part": {"catalogue": "key"}, **run, **body})
+    code, doc = cli_json("simulate", "key", "--trials", "20000", "--seed", "3", *args)
+    assert code == 0, doc
+    assert r.status_code == 200, r.text
+    assert _strip_times(r.json()) == _strip_times(doc)

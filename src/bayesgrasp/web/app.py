@@ -464,60 +464,92 @@ def noisy_plan_document(
     given inline; ``inputs`` the provenance the command line writes.
     """
     from ..cli.noisy import NoisyRun
-    from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
     from ..planning.robust import UNBOUNDED_GUARANTEE
 
+    _exact_method(req)
+    noise = req.noise_model()
+    if req.guaranteed and not noise.turn.exact and noise.turn.kind == "normal":
+        raise LimitError(422, f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
+    run = NoisyRun(noise, req.payoff_model(), req.max_actions, False, req.guaranteed)
+    return run.document(run.plan(pb), inputs)
+
+
+def _exact_method(req: PlanRequest | SimulateRequest) -> None:
     if req.method != "exact":
         raise LimitError(
             422, "`method`: the noise-aware planner seeds from the exact planner; drop `method`"
         )
-    turn = TurnNoise() if req.turn_noise is None else parse_turn_noise(req.turn_noise)
-    noise = NoiseModel(turn, req.contact_noise or 0.0)
-    if req.guaranteed and not turn.exact and turn.kind == "normal":
-        raise LimitError(422, f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
-    payoff = None
-    if req.payoff is not None:
-        import numpy as np
-
-        from ..model.payoff import Payoff
-
-        degs, values = req.payoff.entries()
-        payoff = Payoff(np.radians(degs), np.array(values), req.payoff.default, "request")
-    run = NoisyRun(noise, payoff, req.max_actions, False, req.guaranteed)
-    return run.document(run.plan(pb), inputs)
 
 
 def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
-    """``bayesgrasp plan PART [--also PART ...] --sense ... --json``: the Bayes policy."""
+    """``bayesgrasp plan PART [--also PART ...] --sense ... --json``: the Bayes policy.
+
+    With the noise or payoff options, the policy under the noisy actions
+    (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`), as the command line plans it.
+    """
     from ..io.policies import policy_document
+    from ..planning.noisy_policy import plan_noisy_policy
     from ..planning.policy import plan_policy
 
     spec = problem_spec(req)
     parts = [service.part(p) for p in (req.part, *req.also)]
     problems = [build_problem(p, req, spec) for p in parts]
     prior = None if req.part_prior is None else ",".join(map(repr, req.part_prior))
-    pol = plan_policy(problems, sensor=req.sense, max_actions=req.max_actions, part_prior=prior)
+    if not req.noisy:
+        pol = plan_policy(problems, sensor=req.sense, max_actions=req.max_actions, part_prior=prior)
+        return policy_document(pol)
+    if req.payoff is not None and len(problems) > 1:
+        raise LimitError(422, "`payoff`: a payoff is for one part: drop `also`")
+    pol = plan_noisy_policy(
+        problems,
+        req.sense,
+        req.max_actions,
+        req.noise_model(),
+        payoff=req.payoff_model(),
+        part_prior=prior,
+    )
     return policy_document(pol)
 
 
 def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
     """``bayesgrasp simulate PART [options] --engine kinematic --json``."""
     from .. import report
-    from ..sim.kinematic import GripperNoise, simulate_kinematic
+    from ..model.noise import NoiseModel, TurnNoise
+    from ..model.payoff import as_vector
+    from ..sim.kinematic import simulate_kinematic
 
     if req.trials > service.limits.max_trials:
         raise LimitError(422, f"`trials` is {req.trials}; the limit is {service.limits.max_trials}")
     spec = problem_spec(req)
     p = service.part(req.part)
-    pb, option, _ = _chosen(req.plan, req, p, spec)
-    err = GripperNoise(req.noise_kind, math.radians(req.noise))
-    res = simulate_kinematic(pb, option, req.trials, err, rng=req.seed)
+    if req.turn_noise is not None and req.noise > 0:
+        raise LimitError(422, "`noise`: give `noise` or `turn_noise`, not both")
+    noise = req.noise_model()
+    deg, kind = req.noise, req.noise_kind
+    if req.turn_noise is None:
+        noise = NoiseModel(TurnNoise(req.noise_kind, math.radians(req.noise)), noise.contact)
+    else:
+        deg, kind = float(req.turn_noise.partition(":")[2]), noise.turn.kind
+    pay = req.payoff_model()
+    if (not noise.exact or noise.contact > 0 or pay is not None) and req.plan != "guaranteed":
+        _exact_method(req)
+        from ..planning.noisy import plan_noisy
+
+        pb = spec.build(p)
+        res_n = plan_noisy(pb, noise, pay, spec.max_actions)
+        option = res_n.options[res_n.bayes if req.plan == "bayes" else res_n.most_certain].option
+    else:
+        pb, option, _ = _chosen(req.plan, req, p, spec)
+    u = None if pay is None else as_vector(pay, pb.states)
+    res = simulate_kinematic(pb, option, req.trials, noise, rng=req.seed, payoff=u)
     from ..cli.common import simulate_inputs
     from ..cli.specs import run_inputs
     from ..io.plans import provenance
 
     doc = report.simulate_json(res, p)  # with the provenance the command line writes
-    how = simulate_inputs("kinematic", req.plan, req.seed, req.trials, req.noise, req.noise_kind)
+    how = simulate_inputs("kinematic", req.plan, req.seed, req.trials, deg, kind)
+    how["contact_noise"] = req.contact_noise
+    how["payoff"] = None if req.payoff is None else "request"
     doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec))
     return doc
 

@@ -169,14 +169,9 @@ class PayoffIn(_Strict):
         return degs, [float(e["value"]) for e in self.payoff]
 
 
-class PlanRequest(ProblemOptions):
-    """The body of ``plan``.
+class NoiseOptions(ProblemOptions):
+    """The action noise and payoff options (``--turn-noise``, ``--contact-noise``, ``--payoff``)."""
 
-    With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
-    (``plan --turn-noise ... --contact-noise ... --payoff FILE``).
-    """
-
-    guaranteed: bool = Field(False, description="Also the shortest guaranteed plan.")
     turn_noise: str | None = Field(
         None,
         max_length=64,
@@ -214,12 +209,45 @@ class PlanRequest(ProblemOptions):
 
     @property
     def noisy(self) -> bool:
-        """Whether the noise-aware planner is asked for."""
+        """Whether the noise or payoff options are given (the noise-aware planners)."""
         return not (self.turn_noise is None and self.contact_noise is None and self.payoff is None)
 
+    def noise_model(self) -> Any:
+        """The :class:`~bayesgrasp.model.noise.NoiseModel` of the options."""
+        from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
 
-class SimulateRequest(ProblemOptions):
-    """The body of ``simulate`` (kinematic engine)."""
+        turn = TurnNoise() if self.turn_noise is None else parse_turn_noise(self.turn_noise)
+        return NoiseModel(turn, self.contact_noise or 0.0)
+
+    def payoff_model(self) -> Any:
+        """The :class:`~bayesgrasp.model.payoff.Payoff` given inline, or ``None``."""
+        if self.payoff is None:
+            return None
+        import numpy as np
+
+        from ..model.payoff import Payoff
+
+        degs, values = self.payoff.entries()
+        return Payoff(np.radians(degs), np.array(values), self.payoff.default, "request")
+
+
+class PlanRequest(NoiseOptions):
+    """The body of ``plan``.
+
+    With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
+    (``plan --turn-noise ... --contact-noise ... --payoff FILE``).
+    """
+
+    guaranteed: bool = Field(False, description="Also the shortest guaranteed plan.")
+
+
+class SimulateRequest(NoiseOptions):
+    """The body of ``simulate`` (kinematic engine).
+
+    ``noise`` and ``noise_kind`` are the older spelling of ``turn_noise``
+    (``noise_kind:noise``); with the noise or payoff options the plan run is the one ``plan``
+    gives under them, as ``bayesgrasp simulate`` runs it.
+    """
 
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
     trials: int = Field(100_000, ge=1, description="Executions (bounded by the server's limit).")
@@ -234,8 +262,12 @@ class FigureRequest(ProblemOptions):
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
 
 
-class PolicyRequest(ProblemOptions):
-    """The body of ``policy``: ``bayesgrasp plan PART [--also PART ...] --sense ...``."""
+class PolicyRequest(NoiseOptions):
+    """The body of ``policy``: ``bayesgrasp plan PART [--also PART ...] --sense ...``.
+
+    With ``turn_noise`` or ``contact_noise`` (or ``payoff``, one part): the Bayes policy
+    under the noisy actions (``--sense ... --turn-noise ...``).
+    """
 
     sense: str = Field(
         "width",
