@@ -177,7 +177,7 @@ def test_density_prior_accepts_unnormalised_and_scalar_densities() -> None:
         (lambda t: np.zeros_like(t), 360, "not all zero"),
         (lambda t: np.ones(3), 360, "could not be evaluated"),
         (lambda t: 1 / 0, 360, "could not be evaluated: division by zero"),
-        (lambda t: 1.0, 0, "`bins` must be at least 1; got 0"),
+        (lambda t: 1.0, 0, "`bins` must be an integer >= 1; got 0"),
     ],
 )
 def test_density_prior_rejects_bad_densities(density: object, bins: int, match: str) -> None:
@@ -368,7 +368,7 @@ def test_parse_prior_good(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("spec", "match"),
     [
-        ("", "unknown prior ''"),
+        ("", "the prior is empty"),
         ("gauss:1,2", "unknown prior 'gauss:1,2'; expected uniform"),
         ("uniform:3", "unknown prior"),
         ("vonmises:30", "needs two numbers; got '30'"),

@@ -636,7 +636,7 @@ def test_max_actions() -> None:
     rep = plan_exact(pb, max_actions=2)
     assert len(rep.options) == 2
     assert rep.most_certain == 1
-    with pytest.raises(PlanningError, match="`max_actions` must be at least 1; got 0"):
+    with pytest.raises(PlanningError, match="`max_actions` must be an integer >= 1; got 0"):
         plan_exact(pb, max_actions=0)
 
 

@@ -37,7 +37,7 @@ def _check(name: str, value: object) -> float:
     if (
         isinstance(value, bool)
         or not isinstance(value, int | float)
-        or not math.isfinite(value)
+        or (isinstance(value, float) and not math.isfinite(value))
         or value < 0
     ):
         raise CostError(f"cost `{name}` must be a finite number >= 0; got {value!r}")

@@ -216,8 +216,8 @@ def DensityPrior(
     >>> round(float(p.mass(-np.pi / 2, np.pi / 2)), 6)
     0.81831
     """
-    if bins < 1:
-        raise PriorError(f"`bins` must be at least 1; got {bins}")
+    if isinstance(bins, bool) or not isinstance(bins, int | np.integer) or bins < 1:
+        raise PriorError(f"`bins` must be an integer >= 1; got {bins!r}")
     edges = np.linspace(0.0, TWO_PI, bins + 1)
     mids = 0.5 * (edges[:-1] + edges[1:])
     try:
@@ -242,6 +242,9 @@ def von_mises(mean: float, kappa: float, bins: int = 3600) -> HistogramPrior:
     >>> float(p.mass(-0.5, 0.5)) > 0.6
     True
     """
+    for name, v in (("mean", mean), ("kappa", kappa)):
+        if isinstance(v, bool) or not isinstance(v, int | float | np.floating | np.integer):
+            raise PriorError(f"von Mises `{name}` must be a number; got {v!r}")
     if not (math.isfinite(mean) and math.isfinite(kappa)) or kappa < 0:
         raise PriorError(f"von Mises needs a finite mean and kappa >= 0; got {mean}, {kappa}")
     name = f"von-mises({math.degrees(mean):g}deg,{kappa:g})"  # people read degrees
@@ -335,6 +338,13 @@ def parse_prior(spec: str) -> Prior:
     >>> parse_prior("vonmises:30,4").name
     'von-mises(30deg,4)'
     """
+    if not isinstance(spec, str):
+        raise PriorError(f"a prior is written as text (uniform, vonmises:...); got {spec!r}")
+    if not spec.strip():
+        raise PriorError(
+            "the prior is empty; expected uniform, vonmises:MEAN_DEG,KAPPA, histogram:FILE or "
+            "sample:FILE"
+        )
     kind, _, arg = spec.partition(":")
     kind = kind.strip().lower()
     if kind == "uniform" and not arg:

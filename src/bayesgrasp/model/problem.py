@@ -287,8 +287,8 @@ class Problem:
         if not (type(accuracy) is float and 0.0 <= accuracy < math.inf) and (
             isinstance(accuracy, bool)
             or not isinstance(accuracy, int | float)
-            or not math.isfinite(accuracy)
-            or accuracy < 0
+            or not math.isfinite(accuracy if isinstance(accuracy, float) else 0.0)
+            or not 0 <= accuracy <= 1e300  # an int beyond a float is no angle either
         ):
             raise PlanningError(
                 f"`accuracy` must be a finite number of radians >= 0; got {accuracy!r}"

@@ -128,8 +128,10 @@ def plan_exact(
     >>> [o.n_actions for o in rep.options], rep.bayes, rep.most_certain
     ([2], 0, 0)
     """
-    if max_actions is not None and max_actions < 1:
-        raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    if max_actions is not None and (
+        isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1
+    ):
+        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
     if report not in ("all", "best"):
         raise PlanningError(f"`report` must be 'all' or 'best'; got {report!r}")
     if len(problem.actions) == 1 and arcs.FUSED and arcs.few_states(problem.transfers.values()):
