@@ -273,9 +273,12 @@ def more_cases() -> list[dict[str, Any]]:
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?|inf|nan")
 
 
+SECONDS = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)? s\b")
+
+
 def numbers(text: str) -> list[float]:
     """The numbers of a text, in order (what a table's snapshot keeps; wall times dropped)."""
-    lines = (x for x in text.splitlines() if not x.startswith("wall time"))
+    lines = (SECONDS.sub("", x) for x in text.splitlines() if not x.startswith("wall time"))
     return [float(x) for line in lines for x in NUMBER.findall(line)]
 
 
