@@ -16,6 +16,7 @@ from .specs import Engine, PartSpec, ProblemSpec, SenseSpec
 
 if TYPE_CHECKING:
     from ..io.export import Stroke
+    from .outputs import PartOutputs
 
 
 def plan_policy_command(
@@ -24,26 +25,31 @@ def plan_policy_command(
     sensing: SenseSpec,
     as_json: bool,
     fold_below: float = 0.0,
-    export: Path | None = None,
+    outputs: PartOutputs | None = None,
     stroke: Stroke | None = None,
+    fold_figure: float | None = None,
 ) -> None:
     """Plan and print a sensing policy over PART and the candidate parts.
 
     The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
-    ``export``: also write the policy's robot state machine there (the caller has checked
-    the name); ``stroke``: refuse a policy with a state outside the gripper's stroke.
+    ``outputs``: also draw the policy (``--plot``, folded at ``fold_figure`` when given) and
+    write its robot state machine (``--export``); ``stroke``: refuse a policy with a state
+    outside the gripper's stroke.
     """
-    from ..io.export import check_stroke, write_robot
+    from ..io.export import check_stroke
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
 
     parts = sensing.parts(part)
+    if outputs is not None:
+        outputs.check(parts[0].name, 1)
     problems, pol = sensing.policy(parts, spec)
     if stroke is not None:
         check_stroke(problems, pol, stroke)
-    if export is not None:
-        write_robot(export, problems, pol)
-        typer.echo(f"bayesgrasp: wrote {export}", err=True)
+    if outputs is not None:
+        from .batch import write_policy_outputs
+
+        write_policy_outputs(outputs, 1, problems, pol, fold_figure)
     if as_json:
         emit_json(policy_document(pol))
         return

@@ -23,7 +23,6 @@ from .options import (
     AlsoOpt,
     ContactNoiseOpt,
     JsonOpt,
-    MaxActionsOpt,
     PartPriorOpt,
     PayoffOpt,
     PlanChoiceOpt,
@@ -32,8 +31,9 @@ from .options import (
     command_app,
     part_options,
     problem_options,
+    sense_spec,
 )
-from .specs import Engine, PartSpec, ProblemSpec, SenseSpec, run_inputs
+from .specs import Engine, PartSpec, ProblemSpec, run_inputs
 
 app = command_app()
 
@@ -138,7 +138,6 @@ def simulate(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
-    max_actions: MaxActionsOpt = 3,
     sensor_error: SensorErrorOpt = False,
     jaw_lag: JawLagOpt = 0.0,
 ) -> None:
@@ -202,7 +201,7 @@ def simulate(
             if given is not None:
                 raise typer.BadParameter("does not apply to --sense yet", param_hint=hint)
         err = GripperNoise(noise_kind.value, math.radians(noise))
-        sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
+        sensing = sense_spec(sense, also or (), part_prior, spec)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, err, seed, units,
             sensor_error, as_json,
