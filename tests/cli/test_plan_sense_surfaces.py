@@ -346,3 +346,41 @@ def test_help_names_one_length_option(capsys: pytest.CaptureFixture[str], comman
     assert code == 0 and "--max-actions" in text and "--max-squeezes" not in text
     assert "with --sense, the deepest policy (default 3, at most 8)" in text
     assert "--sense" in text  # every command that says --sense has it
+
+
+def sweep_options(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path, *args: str
+) -> Any:
+    """The options ``sweep`` runs with (the sweep itself not run)."""
+    import typer
+
+    import bayesgrasp.sweep as sweeps
+
+    seen = []
+
+    def capture(paths: Any, out: Any, options: Any, **kwargs: Any) -> Any:
+        seen.append(options)
+        raise typer.Exit(0)
+
+    monkeypatch.setattr(sweeps, "run_sweep", capture)
+    argv = ["sweep", str(tmp_path), "--out", str(tmp_path / "rows.csv"), *args]
+    assert run(capsys, *argv)[0] == 0
+    return seen[0]
+
+
+def test_sweep_takes_the_one_option(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    default = sweep_options(capsys, monkeypatch, tmp_path, "--sense", "width")
+    assert (default.max_actions, default.sense_max_actions) == (None, 3)
+    given = sweep_options(capsys, monkeypatch, tmp_path, "--sense", "width", "--max-actions", "2")
+    assert (given.max_actions, given.sense_max_actions) == (2, 2)
+    assert (
+        sweep_options(capsys, monkeypatch, tmp_path, "--sense", "width", "--max-squeezes", "2")
+        == given
+    )
+    plain = sweep_options(capsys, monkeypatch, tmp_path, "--max-squeezes", "12")
+    assert (plain.max_actions, plain.sense) == (12, None)
+    err = refused(capsys, "sweep", str(tmp_path), "--out", str(tmp_path / "r.csv"), "--sense",
+                  "width", "--max-actions", "9")  # fmt: skip
+    assert "at most 8 actions deep" in err
