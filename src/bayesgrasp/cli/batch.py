@@ -98,14 +98,7 @@ def run_batch(
     out = sys.stdout
     if noisy is not None or outputs is not None or stroke is not None:
         stage = _one_at_a_time(spec, inputs, guaranteed, best_only, noisy, outputs, encode, stroke)
-        code = 0
-        for index, (label, load) in enumerate(_batch_parts(part, more, batch), start=1):
-            try:
-                found: Any = (index, label, load())
-            except BayesGraspError as exc:
-                found = exc
-            code = _finish([(label, found)], (stage,), encode, out, code)
-        return code
+        return _each_alone(_batch_parts(part, more, batch), stage, encode, out)
     build, plan = _builder(spec), spec.planner(best_only)
     memo: dict[str, Any] = {}  # what the documents share (the provenance)
 
@@ -183,6 +176,27 @@ def _finish(
         code = max(code, line[1])
     out.write("".join(text))  # a group at a time (a line at a time from stdin)
     out.flush()
+    return code
+
+
+def _each_alone(
+    parts: Iterator[tuple[str, Any]],
+    stage: Callable[[tuple[int, str, Part]], _Line],
+    encode: Callable[[Any], str],
+    out: TextIO,
+) -> int:
+    """Each part's line, one part at a time: ``stage((index, label, part))`` or its error.
+
+    ``parts``: (label, loader) pairs (:func:`_batch_parts`); the index counts from 1.
+    Returns the largest exit code of the lines.
+    """
+    code = 0
+    for index, (label, load) in enumerate(parts, start=1):
+        try:
+            found: Any = (index, label, load())
+        except BayesGraspError as exc:
+            found = exc
+        code = _finish([(label, found)], (stage,), encode, out, code)
     return code
 
 
@@ -300,14 +314,7 @@ def run_policy_batch(
             return _refused(label, exc, encode)
         return text, 0
 
-    code = 0
-    for index, (label, load) in enumerate(_batch_parts(part, [], batch), start=1):
-        try:
-            found: Any = (index, label, load())
-        except BayesGraspError as exc:
-            found = exc
-        code = _finish([(label, found)], (stage,), encode, sys.stdout, code)
-    return code
+    return _each_alone(_batch_parts(part, [], batch), stage, encode, sys.stdout)
 
 
 def write_policy_outputs(
