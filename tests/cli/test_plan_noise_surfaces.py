@@ -288,13 +288,9 @@ def test_two_parts_of_one_name_do_not_share_a_file(
         (["key", "--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
         # an option of the other mode, given (even at its default value)
         (["key", "--sense", "width", "--guaranteed"], "takes no --guaranteed"),
-        (["key", "--sense", "width", "--plot", "p.png"], "takes no --plot"),
         (["key", "--sense", "width", "--only", "best"], "takes no --only best"),
         (["key", "--sense", "width", "--method", "bfs"], "takes no --method"),
-        (["key", "--sense", "width", "--max-squeezes", "2"], "the policy's depth is --max-actions"),
-        (["key", "--max-actions", "3"], "--max-actions needs --sense"),
         (["key", "--fold-below", "0.01"], "--fold-below needs --sense"),
-        (["key", "--turn-noise", "normal:1", "--max-actions", "2"], "--max-actions needs --sense"),
     ],
 )
 def test_refused_with_the_reason(

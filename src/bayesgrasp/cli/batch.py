@@ -1,7 +1,8 @@
 """``plan`` of many parts in one process: one JSON document a line, errors in their line.
 
 :func:`run_batch` plans PART, the more PARTs and each line of ``--batch FILE.jsonl`` in
-turn; ``plan`` calls it for several parts.
+turn; ``plan`` calls it for several parts. :func:`run_policy_batch` plans each line's
+sensing policy (``plan --batch FILE.jsonl --sense S``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from ..errors import BayesGraspError
 from .specs import (
     PartSpec,
     ProblemSpec,
+    SenseSpec,
     guaranteed_plan,
     run_inputs,
 )
@@ -27,11 +29,13 @@ if TYPE_CHECKING:
     from ..io.export import Stroke
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
+    from ..planning.policy import Policy
     from ..planning.result import PlanReport
     from .noisy import NoisyRun
     from .outputs import PartOutputs
+    from .sensing import ActionModel
 
-__all__ = ["BatchFileError", "run_batch"]
+__all__ = ["BatchFileError", "run_batch", "run_policy_batch"]
 
 
 class BatchFileError(Exception):
@@ -95,14 +99,7 @@ def run_batch(
     out = sys.stdout
     if noisy is not None or outputs is not None or stroke is not None:
         stage = _one_at_a_time(spec, inputs, guaranteed, best_only, noisy, outputs, encode, stroke)
-        code = 0
-        for index, (label, load) in enumerate(_batch_parts(part, more, batch), start=1):
-            try:
-                found: Any = (index, label, load())
-            except BayesGraspError as exc:
-                found = exc
-            code = _finish([(label, found)], (stage,), encode, out, code)
-        return code
+        return _each_alone(_batch_parts(part, more, batch), stage, encode, out)
     build, plan = _builder(spec), spec.planner(best_only)
     memo: dict[str, Any] = {}  # what the documents share (the provenance)
 
@@ -183,6 +180,27 @@ def _finish(
     return code
 
 
+def _each_alone(
+    parts: Iterator[tuple[str, Any]],
+    stage: Callable[[tuple[int, str, Part]], _Line],
+    encode: Callable[[Any], str],
+    out: TextIO,
+) -> int:
+    """Each part's line, one part at a time: ``stage((index, label, part))`` or its error.
+
+    ``parts``: (label, loader) pairs (:func:`_batch_parts`); the index counts from 1.
+    Returns the largest exit code of the lines.
+    """
+    code = 0
+    for index, (label, load) in enumerate(parts, start=1):
+        try:
+            found: Any = (index, label, load())
+        except BayesGraspError as exc:
+            found = exc
+        code = _finish([(label, found)], (stage,), encode, out, code)
+    return code
+
+
 def _one_at_a_time(
     spec: ProblemSpec,
     inputs: dict[str, Any],
@@ -234,12 +252,100 @@ def _one_at_a_time(
                 if outputs is not None:
                     write_plain_outputs(outputs, index, pb, result)
         except typer.BadParameter as exc:  # a file refused: this part's error
-            hint = f"{exc.param_hint}: " if isinstance(exc.param_hint, str) else ""
-            text = encode({"part": label, "error": hint + exc.message, "exit_code": 2})
-            return text, 2
+            return _refused(label, exc, encode)
         return text, 1 if missing else 0
 
     return stage
+
+
+def _refused(label: str, exc: Any, encode: Callable[[Any], str]) -> _Line:
+    """The error line of a part whose file was refused (a ``typer.BadParameter``)."""
+    hint = f"{exc.param_hint}: " if isinstance(exc.param_hint, str) else ""
+    return encode({"part": label, "error": hint + exc.message, "exit_code": 2}), 2
+
+
+def run_policy_batch(
+    part: PartSpec,
+    batch: Path,
+    spec: ProblemSpec,
+    sensing: SenseSpec,
+    *,
+    outputs: PartOutputs | None = None,
+    stroke: Stroke | None = None,
+    fold: float | None = None,
+    noise: ActionModel | None = None,
+) -> int:
+    """Plan each line's sensing policy, one policy document a line; the largest exit code.
+
+    Each line is what ``plan PART --sense S --json`` prints for the line's part (with the
+    same --also parts, part prior and depth), as ``json.dumps`` writes it on one line; a part
+    that fails gets ``{"part": ..., "error": ..., "exit_code": 2}`` and the others go on.
+    The --also parts are read and the sensor checked once, before the first line (a bad one
+    is the run's error, exit 2). ``part`` gives the part-file options (its PART is
+    ``None``); ``outputs``, ``stroke``: as :func:`run_batch`; ``fold``: the figures' folding
+    (:func:`write_policy_outputs`); ``noise``: the action noise and payoff each policy is
+    planned under (:class:`~.sensing.ActionModel`). The parts are planned one at a time.
+
+    Raises
+    ------
+    BatchFileError
+        The batch file cannot be opened.
+    """
+    import typer
+
+    from ..io.export import check_stroke
+    from ..io.policies import policy_document
+    from ..model.sensing import parse_sensor
+    from .common import input_files
+    from .sensing import plan_sensing_policy
+
+    parse_sensor(sensing.sense)  # a malformed sensor: the run's one error line
+    others = [dataclasses.replace(part, part=p).load() for p in sensing.also]
+    encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
+
+    def stage(item: tuple[int, str, Part]) -> _Line:
+        index, label, found = item
+        try:
+            if outputs is not None:
+                outputs.check(found.name, index, input_files(label))
+            problems, pol = plan_sensing_policy(sensing, [found, *others], spec, noise)
+            if stroke is not None:
+                check_stroke(problems, pol, stroke)
+            text = encode(policy_document(pol))
+            if outputs is not None:
+                write_policy_outputs(outputs, index, problems, pol, fold)
+        except typer.BadParameter as exc:  # a file refused: this part's error
+            return _refused(label, exc, encode)
+        return text, 0
+
+    return _each_alone(_batch_parts(part, [], batch), stage, encode, sys.stdout)
+
+
+def write_policy_outputs(
+    outputs: PartOutputs,
+    index: int,
+    problems: list[Problem],
+    policy: Policy,
+    fold: float | None = None,
+) -> None:
+    """Write a policy's ``--plot`` and ``--export`` files (its tree, its state machine).
+
+    The figure is :func:`~bayesgrasp.figures.policy.policy_figure`, as ``plot --sense``
+    draws it; ``fold``: its ``min_probability`` (default: the figure's own).
+    """
+    from ..figures.policy import policy_figure
+    from ..io.export import write_robot
+
+    def figure() -> Any:
+        if fold is None:
+            return policy_figure(problems, policy)
+        return policy_figure(problems, policy, min_probability=fold)
+
+    def robot(path: Path) -> None:
+        meta = {} if policy.noise is None else {"noise": policy.noise.to_json()}
+        write_robot(path, problems, policy, meta)
+
+    outputs.write(problems[0].part.name, index, figure, robot)
 
 
 def write_plain_outputs(outputs: PartOutputs, index: int, pb: Problem, result: PlanReport) -> None:

@@ -13,14 +13,14 @@ from __future__ import annotations
 
 import functools
 import inspect
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
 import typer
 
 from .common import accuracy_value, cost_value
-from .specs import GoalKind, Method, PartFormat, PartSpec, problem_spec
+from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec, SenseSpec, problem_spec
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -74,6 +74,10 @@ ACTIONS_HELP = (
     "-x side)."
 )
 MAX_HELP = "Longest plan to consider, counting actions of every kind (push-grasps too)."
+MAX_SENSE_HELP = (
+    "Longest plan to consider, counting actions of every kind (push-grasps too; default: "
+    "the planner's own bound); with --sense, the deepest policy (default {}, at most {})."
+)
 ACCURACY_HELP = (
     "Gripper accuracy: each turn between actions may err by up to DEG degrees; only plans "
     "whose tolerance is at least DEG are returned (exact planner)."
@@ -136,9 +140,6 @@ PartPriorOpt = Annotated[
         "--part-prior", metavar="W1,W2,...", help="With --sense: weights of PART and each --also."
     ),
 ]
-MaxActionsOpt = Annotated[
-    int, typer.Option("--max-actions", min=1, max=8, help="With --sense: deepest policy.")
-]
 MaxOpeningOpt = Annotated[
     float | None,
     typer.Option(
@@ -159,8 +160,12 @@ MinOpeningOpt = Annotated[
         "step that may close the jaws on a width narrower than this.",
     ),
 ]
-# SenseOpt, AlsoOpt, PartPriorOpt and MaxActionsOpt: the options of a sensing policy (plan,
-# simulate and plot --sense), gathered into a SenseSpec.
+# SenseOpt, AlsoOpt, PartPriorOpt and the problem option --max-actions: the options of a
+# sensing policy (plan, simulate and plot --sense), gathered into a SenseSpec (sense_spec).
+POLICY_DEPTH = 3
+"""The depth of a policy when ``--max-actions`` is not given (a plan has no such default)."""
+DEEPEST_POLICY = 8
+"""The deepest policy ``--max-actions`` asks for (the policy's tree grows with each level)."""
 FoldOpt = Annotated[
     float,
     typer.Option(
@@ -170,7 +175,8 @@ FoldOpt = Annotated[
         metavar="P",
         help="With --sense: the printed tree leaves out the branches whose probability at "
         "their node is below P, counted on one line (0 prints every branch; --json keeps "
-        "every branch).",
+        "every branch); given, the --plot figure too draws them as one edge (its default: "
+        "0.05).",
     ),
 ]
 
@@ -202,7 +208,7 @@ def _part_params(optional: bool = False) -> list[inspect.Parameter]:
 
 
 def _problem_params(
-    names: list[str], push_grasp_alias: bool, plan_file: bool = True
+    names: list[str], push_grasp_alias: bool, plan_file: bool = True, sense: bool = False
 ) -> list[inspect.Parameter]:
     money = {"callback": cost_value}
     cost = [
@@ -223,6 +229,8 @@ def _problem_params(
     ]
     kinds = ACTIONS_HELP.format(", ".join(names))
     from_file = " (default: {}; with --plan FILE: the file's)" if plan_file else " (default: {})"
+    longest = MAX_SENSE_HELP.format(POLICY_DEPTH, DEEPEST_POLICY) if sense else MAX_HELP
+    old_longest = "The old name of --max-actions."
     params = [
         _opt("prior", str | None, None, help=PRIOR_HELP + from_file.format("uniform")),
         cost[0],
@@ -234,7 +242,8 @@ def _problem_params(
         _opt("actions", str, "squeeze", metavar="KINDS", help=kinds),
         _opt("accuracy", float, 0.0, callback=accuracy_value, metavar="DEG", help=ACCURACY_HELP),
         _opt("method", Method, Method.exact, help="exact planner or the seed's search."),
-        _opt("max_squeezes", int | None, None, min=1, help=MAX_HELP),
+        _opt("max_actions", int | None, None, "--max-actions", min=1, help=longest),
+        _opt("max_squeezes", int | None, None, min=1, hidden=True, help=old_longest),
     ]
     if push_grasp_alias:  # the old spelling of simulate and plot, kept working
         alias = "Same as --actions squeeze,push-grasp."
@@ -279,10 +288,60 @@ def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:
         from ..model.actions import ACTIONS
 
         names = list(ACTIONS)  # the kinds registered now: one cost option each
-        # the help names --plan FILE only where the command has --plan
+        # the help names --plan FILE and --sense only where the command has them
         hints = inspect.signature(func, eval_str=True).parameters.values()
         plan_file = any(p.annotation == PlanChoiceOpt for p in hints)
-        params = _problem_params(names, push_grasp_alias, plan_file)
-        return _replace(func, "spec", params, functools.partial(problem_spec, names))
+        sense = any(p.name == "sense" for p in hints)
+        params = _problem_params(names, push_grasp_alias, plan_file, sense)
+
+        def make(values: dict[str, Any]) -> ProblemSpec:
+            values["max_squeezes"] = longest(values.pop("max_actions"), values["max_squeezes"])
+            return problem_spec(names, values)
+
+        return _replace(func, "spec", params, make)
 
     return decorate
+
+
+def longest(max_actions: int | None, max_squeezes: int | None) -> int | None:
+    """The value of ``--max-actions``, or of its old name ``--max-squeezes``.
+
+    Both given with different values: exit 2 (one option cannot say two lengths).
+
+    Examples
+    --------
+    >>> longest(None, 2), longest(3, None), longest(2, 2), longest(None, None)
+    (2, 3, 2, None)
+    """
+    if max_actions is not None and max_squeezes is not None and max_actions != max_squeezes:
+        raise typer.BadParameter(
+            f"is the old name of --max-actions; give one of them (got --max-actions "
+            f"{max_actions} and --max-squeezes {max_squeezes})",
+            param_hint="--max-squeezes",
+        )
+    return max_squeezes if max_actions is None else max_actions
+
+
+def sense_spec(
+    sense: str, also: Iterable[str], part_prior: str | None, spec: ProblemSpec
+) -> SenseSpec:
+    """The :class:`SenseSpec` of the --sense options, its depth ``spec``'s --max-actions.
+
+    Without --max-actions a policy is :data:`POLICY_DEPTH` deep; deeper than
+    :data:`DEEPEST_POLICY` is refused (exit 2).
+
+    Examples
+    --------
+    >>> sense_spec("width", ["key"], None, ProblemSpec()).max_actions
+    3
+    >>> sense_spec("width", [], None, ProblemSpec(max_actions=2)).max_actions
+    2
+    """
+    depth = POLICY_DEPTH if spec.max_actions is None else spec.max_actions
+    if depth > DEEPEST_POLICY:
+        raise typer.BadParameter(
+            f"a policy is at most {DEEPEST_POLICY} actions deep (its tree grows with each "
+            f"level); got {depth}",
+            param_hint="--max-actions",
+        )
+    return SenseSpec(sense, tuple(also), part_prior, depth)

@@ -6,18 +6,17 @@ import enum
 import functools
 import math
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from .common import check_export, emit_json, input_files
+from .common import emit_json, input_files
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
     FoldOpt,
     ForceOpt,
     JsonOpt,
-    MaxActionsOpt,
     MaxOpeningOpt,
     MinOpeningOpt,
     PartPriorOpt,
@@ -27,8 +26,13 @@ from .options import (
     command_app,
     part_options,
     problem_options,
+    sense_spec,
 )
 from .specs import PartSpec, ProblemSpec, SenseSpec, guaranteed_plan, run_inputs
+
+if TYPE_CHECKING:
+    from ..io.export import Stroke
+    from .sensing import ActionModel
 
 app = command_app()
 
@@ -66,8 +70,9 @@ PlotOpt = Annotated[
         "--plot",
         metavar="FILE",
         help="Also draw the part, its diameter function and the Bayes plan's distributions "
-        "(under the noise, with noise options) into FILE (.png, .svg, .pdf). Several parts: "
-        "FILE must hold {name}, the part's name (and may hold {index}, its place in the run).",
+        "(under the noise, with noise options) into FILE (.png, .svg, .pdf); with --sense, the "
+        "policy's tree as plot --sense draws it. Several parts: FILE must hold {name}, the "
+        "part's name (and may hold {index}, its place in the run).",
     ),
 ]
 
@@ -110,7 +115,8 @@ BatchOpt = Annotated[
         metavar="FILE.jsonl",
         help='Plan one part a line ({"name": ..., "vertices": [...]} as a .json part file, or '
         "a catalogue name or path as a JSON string; '-' reads stdin); one JSON document a "
-        "line, an error in its line.",
+        "line, an error in its line. With --sense: each part's policy (with the --also "
+        "parts as its candidates).",
     ),
 ]
 
@@ -129,7 +135,6 @@ def plan(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
-    max_actions: MaxActionsOpt = 3,
     fold_below: FoldOpt = 0.01,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
@@ -144,7 +149,9 @@ def plan(
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
     With --sense: the policy of least expected cost that branches on the jaw widths read
-    after each action (and tells the candidate parts apart), beside the sensorless Bayes plan.
+    after each action (and tells the candidate parts apart), beside the sensorless Bayes plan;
+    --max-actions is then the policy's depth (default 3). With --sense and --batch: each
+    line's part gets its policy (the --also parts its other candidates), one document a line.
 
     With --turn-noise, --contact-noise or --payoff: the noise-aware Bayes plan, through
     every other option (--only, --guaranteed, --plot, --export, several parts, --batch).
@@ -166,34 +173,35 @@ def plan(
         stroke = Stroke(min_opening or 0.0, math.inf if max_opening is None else max_opening)
     if sense is None and (also or part_prior is not None):
         raise typer.BadParameter("--also and --part-prior need --sense")
-    if sense is None and (given := _given(ctx, "max_actions", "fold_below")):
-        need = "needs" if len(given) == 1 else "need"
-        raise typer.BadParameter(f"{' and '.join(given)} {need} --sense")
+    if sense is None and _given(ctx, "fold_below"):
+        raise typer.BadParameter("--fold-below needs --sense")
     noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
     if sense is not None:
-        if part.part is None or batch is not None:
-            raise typer.BadParameter("--sense needs PART and takes no --batch")
         refused = [
             name
             for name, on in (
                 ("--guaranteed", guaranteed),
-                ("--plot", plot_file is not None),
                 ("--only best", only is Only.best),
                 ("--method", spec.method.value != "exact"),
-                ("--max-squeezes (the policy's depth is --max-actions)", spec.max_actions),
             )
             if on
         ]
         if refused:
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
+        more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
+        sensing = sense_spec(sense, more, part_prior, spec)
+        fold = fold_below if _given(ctx, "fold_below") else None  # the figure's, when given
         from .sensing import plan_policy_command, sense_noise
 
-        more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
-        if export is not None:
-            check_export(export, input_files(part.part, spec.prior, *more), force)
-        sensing = SenseSpec(sense, more, part_prior, max_actions)
         noise = sense_noise(turn_noise, contact_noise, payoff)
-        plan_policy_command(part, spec, sensing, as_json, fold_below, export, stroke, noise)
+        if batch is not None:
+            _policy_batch(part, batch, spec, sensing, plot_file, export, force, stroke, fold, noise)
+            return
+        if part.part is None:
+            raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
+        files = input_files(part.part, spec.prior, payoff, *more)
+        outputs = PartOutputs.of(plot_file, export, force, files, several=False)
+        plan_policy_command(part, spec, sensing, as_json, fold_below, outputs, stroke, fold, noise)
         return
     several = batch is not None or bool(more_parts)
     if part.part is None and not several:
@@ -256,3 +264,43 @@ def plan(
         write_plain_outputs(outputs, 1, pb, result)
     if missing is not None:  # no plan reached the goal asked for
         raise typer.Exit(1)
+
+
+def _policy_batch(
+    part: PartSpec,
+    batch: Path,
+    spec: ProblemSpec,
+    sensing: SenseSpec,
+    plot_file: Path | None,
+    export: Path | None,
+    force: bool,
+    stroke: Stroke | None,
+    fold: float | None,
+    noise: ActionModel | None = None,
+) -> None:
+    """``plan --batch FILE.jsonl --sense S``: each line's part's policy, one document a line.
+
+    PART beside the batch has no place: with --sense, more parts are candidates of one
+    policy, and each line already names the part its policy is for.
+    """
+    from .batch import BatchFileError, run_policy_batch
+    from .outputs import PartOutputs
+
+    if part.part is not None:
+        raise typer.BadParameter(
+            "with --sense each line's part gets its policy (its other candidates: --also); "
+            "give PART in the batch file, not beside it",
+            param_hint="--batch",
+        )
+    files = input_files(None, spec.prior, batch, *sensing.also)
+    if noise is not None and noise.payoff is not None:
+        files = input_files(None, spec.prior, batch, noise.payoff, *sensing.also)
+    outputs = PartOutputs.of(plot_file, export, force, files, several=True)
+    try:
+        code = run_policy_batch(
+            part, batch, spec, sensing, outputs=outputs, stroke=stroke, fold=fold, noise=noise
+        )
+    except BatchFileError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--batch") from None
+    if code:
+        raise typer.Exit(code)

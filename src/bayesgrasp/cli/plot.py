@@ -18,15 +18,15 @@ from .common import (
 from .options import (
     AlsoOpt,
     JsonOpt,
-    MaxActionsOpt,
     PartPriorOpt,
     PlanChoiceOpt,
     SenseOpt,
     command_app,
     part_options,
     problem_options,
+    sense_spec,
 )
-from .specs import PartSpec, ProblemSpec, SenseSpec
+from .specs import PartSpec, ProblemSpec
 
 app = command_app()
 
@@ -76,7 +76,6 @@ def plot(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
-    max_actions: MaxActionsOpt = 3,
 ) -> None:
     """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif.
 
@@ -100,7 +99,7 @@ def plot(
         from .sensing import plot_policy_command
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
-        sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
+        sensing = sense_spec(sense, also or (), part_prior, spec)
         plot_policy_command(part, spec, sensing, out, formats, as_json)
         return
     if also or part_prior is not None:

@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     from ..model.problem import Problem
     from ..model.sensing import WidthSensor
     from ..planning.policy import Policy
+    from .outputs import PartOutputs
 
 
 @dataclass(frozen=True)
@@ -32,7 +33,7 @@ class ActionModel:
     payoff: Path | None = None
 
 
-def _policy(
+def plan_sensing_policy(
     sensing: SenseSpec,
     parts: list[Part],
     spec: ProblemSpec,
@@ -76,30 +77,34 @@ def plan_policy_command(
     sensing: SenseSpec,
     as_json: bool,
     fold_below: float = 0.0,
-    export: Path | None = None,
+    outputs: PartOutputs | None = None,
     stroke: Stroke | None = None,
+    fold_figure: float | None = None,
     noise: ActionModel | None = None,
 ) -> None:
     """Plan and print a sensing policy over PART and the candidate parts.
 
     The text leaves out the branches below ``fold_below`` at their node (the JSON keeps all).
-    ``export``: also write the policy's robot state machine there (the caller has checked
-    the name); ``stroke``: refuse a policy with a state outside the gripper's stroke.
+    ``outputs``: also draw the policy (``--plot``, folded at ``fold_figure`` when given) and
+    write its robot state machine (``--export``); ``stroke``: refuse a policy with a state
+    outside the gripper's stroke.
     With ``noise`` the policy is planned, and its figures computed, under that action noise
     (and payoff).
     """
-    from ..io.export import check_stroke, write_robot
+    from ..io.export import check_stroke
     from ..io.policies import policy_document
     from ..planning.policy import policy_text
 
     parts = sensing.parts(part)
-    problems, pol = _policy(sensing, parts, spec, noise)
+    if outputs is not None:
+        outputs.check(parts[0].name, 1)
+    problems, pol = plan_sensing_policy(sensing, parts, spec, noise)
     if stroke is not None:
         check_stroke(problems, pol, stroke)
-    if export is not None:
-        meta = {} if pol.noise is None else {"noise": pol.noise.to_json()}
-        write_robot(export, problems, pol, meta)
-        typer.echo(f"bayesgrasp: wrote {export}", err=True)
+    if outputs is not None:
+        from .batch import write_policy_outputs
+
+        write_policy_outputs(outputs, 1, problems, pol, fold_figure)
     if as_json:
         emit_json(policy_document(pol))
         return
@@ -164,7 +169,7 @@ def simulate_policy_command(
 
     model = action
     noise = None if model is None else model.noise
-    problems, pol = _policy(sensing, parts, spec, model, sensor)
+    problems, pol = plan_sensing_policy(sensing, parts, spec, model, sensor)
     n = cycles or (200_000 if engine is Engine.kinematic else 200)
 
     def run(progress: Any) -> Any:

@@ -23,7 +23,6 @@ from .options import (
     AlsoOpt,
     ContactNoiseOpt,
     JsonOpt,
-    MaxActionsOpt,
     PartPriorOpt,
     PayoffOpt,
     PlanChoiceOpt,
@@ -32,8 +31,9 @@ from .options import (
     command_app,
     part_options,
     problem_options,
+    sense_spec,
 )
-from .specs import Engine, PartSpec, ProblemSpec, SenseSpec, run_inputs
+from .specs import Engine, PartSpec, ProblemSpec, run_inputs
 
 app = command_app()
 
@@ -138,7 +138,6 @@ def simulate(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
-    max_actions: MaxActionsOpt = 3,
     sensor_error: SensorErrorOpt = False,
     jaw_lag: JawLagOpt = 0.0,
 ) -> None:
@@ -200,7 +199,7 @@ def simulate(
         model, _, _ = _noise_model(noise, noise_kind, turn_noise, contact_noise)
         asked = not model.exact or model.contact > 0 or payoff is not None
         action = ActionModel(model, payoff) if asked else None
-        sensing = SenseSpec(sense, tuple(also or ()), part_prior, max_actions)
+        sensing = sense_spec(sense, also or (), part_prior, spec)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
             sensor_error, as_json, action,

@@ -12,11 +12,12 @@ import typer
 from .common import emit_json, with_progress
 from .options import (
     FLATTEN_HELP,
+    POLICY_DEPTH,
     SHAPE_HELP,
     JsonOpt,
-    MaxActionsOpt,
     command_app,
     problem_options,
+    sense_spec,
 )
 from .specs import Engine, ProblemSpec
 
@@ -91,7 +92,6 @@ def sweep(
             "(SIGMA and RES in each part's units): the policy_* columns.",
         ),
     ] = None,
-    max_actions: MaxActionsOpt = 3,
     turn_noise: Annotated[
         str | None,
         typer.Option(
@@ -174,6 +174,7 @@ def sweep(
     if report_file is not None:
         check_outputs([report_file], [*inputs, out], force, "--report")
 
+    depth = POLICY_DEPTH if sense is None else sense_spec(sense, (), None, spec).max_actions
     options = SweepOptions(
         prior=spec.prior,
         squeeze_cost=(spec.costs or {}).get("squeeze", 1.0),
@@ -195,7 +196,7 @@ def sweep(
         flatten_tol=flatten_tol,
         shape_tol=shape_tol,
         sense=sense,
-        sense_max_actions=max_actions,
+        sense_max_actions=depth,
         turn_noise=turn_noise,
         contact_noise=contact_noise,
         payoff=None if payoff is None else str(payoff),

@@ -245,8 +245,28 @@ async function post(path, body) {
     body: JSON.stringify(body),
   });
   const doc = await r.json();
-  if (!r.ok) throw new Error(doc.detail || `HTTP ${r.status}`);
+  if (!r.ok) {
+    const err = new Error(doc.detail || `HTTP ${r.status}`);
+    err.status = r.status;
+    throw err;
+  }
   return doc;
+}
+
+// A noise-aware plan is refused at once (503, "busy") while another is at work on the server;
+// the page asks again while its request is still the latest one (the previous plan finishes
+// within the server's time limit).
+async function postWhenFree(path, body, gen) {
+  for (let i = 0; ; i++) {
+    try {
+      return await post(path, body);
+    } catch (err) {
+      const busy = err.status === 503 && /busy/.test(String(err.message));
+      if (!busy || gen !== generation || i >= 80) throw err;
+      setStatus("planning... (waiting for the previous noise-aware plan)");
+      await new Promise((done) => setTimeout(done, 250));
+    }
+  }
 }
 
 let timer = null;
@@ -268,7 +288,7 @@ async function run() {
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
-      post("/plan", { part, ...o, ...noise() }),
+      postWhenFree("/plan", { part, ...o, ...noise() }, gen),
       post("/squeeze", { part, prior: o.prior }),
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
