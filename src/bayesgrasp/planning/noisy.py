@@ -301,6 +301,19 @@ class _Evaluator:
         )
         self.half = half if ok else None
 
+    def boundary_turns(self, kind: str, rows: NDArray[np.intp] | None = None) -> FloatArray:
+        """Turns that put a state of ``rows`` (default all) on a basin boundary of ``kind``.
+
+        ``S_i - B - o`` for every state ``S_i`` of ``rows``, every way the action may go
+        (offset ``o``) and every boundary ``B`` of its transfer function, unwrapped: the
+        unstable equilibria a turn must keep away from, whether or not both sides are worth
+        the same.
+        """
+        s = self.nt.stable if rows is None else self.nt.stable[np.asarray(rows, dtype=np.intp)]
+        return np.concatenate(
+            [(s[:, None] - c.offset - c.hi[None, :]).ravel() for c in self.nt.components(kind)]
+        )
+
     def targets(self, q: FloatArray, prefer: int | None = None) -> tuple[FloatArray, int]:
         """The payoff vector a final distribution is scored with, and the aimed state.
 
@@ -446,6 +459,72 @@ class _Planner:
         self.ev = _Evaluator(problem, noise, payoff)
         self.turn = noise.turn
         self.p_tol = problem.part.hull.tol.probability
+        self.a_tol = problem.states.angle_tol
+
+    # -- unstable equilibria ---------------------------------------------------------------
+    def margins(self, kinds: Sequence[str], angles: Sequence[float]) -> list[float]:
+        """Each turn's distance to the nearest boundary turn of a state it may meet.
+
+        Entry ``m - 1`` is turn ``alpha_m``'s (``m >= 2``): the states of positive
+        probability before it (under the noise), every way its action may go.
+        """
+        periods = _periods(self.problem, kinds)
+        qs = self.ev.forward(kinds, angles)
+        return [
+            _margin(
+                angles[m],
+                self.ev.boundary_turns(kinds[m], np.flatnonzero(qs[m - 1] > 0)),
+                periods[m],
+            )
+            for m in range(1, len(kinds))
+        ]
+
+    def off_edges(self, kinds: Sequence[str], angles: Sequence[float]) -> tuple[list[float], bool]:
+        """The turns, each moved off the unstable equilibria of the states it meets.
+
+        A turn (exact turns) within the angle tolerance of a boundary turn of a state of
+        positive probability is moved to the middle of one of the two arcs beside that
+        boundary, the one whose plan (the other turns as they are) earns more. Returns the
+        turns and whether any moved.
+        """
+        out = list(angles)
+        periods = _periods(self.problem, kinds)
+        q = self.ev.nt.initial(kinds[0], out[0])
+        moved = False
+        for m in range(1, len(kinds)):
+            bounds = self.ev.boundary_turns(kinds[m], np.flatnonzero(q > 0))
+            if _margin(out[m], bounds, periods[m]) <= self.a_tol:
+                starts, mids, _ = _free_intervals(bounds, periods[m], self.a_tol)
+                d = np.abs(np.mod(starts - out[m] + periods[m] / 2, periods[m]) - periods[m] / 2)
+                j = int(np.argmin(d))
+                best_v = -math.inf
+                for x in (float(mids[j - 1]), float(mids[j])):
+                    trial = [*out[:m], wrap_period(x, periods[m]), *out[m + 1 :]]
+                    v = float(self.ev.value(self.ev.forward(kinds, trial)[-1]))
+                    if v > best_v + self.p_tol:
+                        best_v, out = v, trial
+                moved = True
+            q = self.ev.step(q, kinds[m], np.array([out[m]]))[0]
+        return out, moved
+
+    def search_turns(self, kind: str, mids: FloatArray, period: float) -> FloatArray:
+        """The search's turns for ``kind``: each on a boundary turn of any state replaced.
+
+        The middles of the noise-free action classes keep away from the transfer's own
+        boundaries; under contact noise a push-grasp's boundary may fall on one. Such a turn
+        is replaced by the middles of the two arcs beside it (between all boundary turns).
+        """
+        bounds = self.ev.boundary_turns(kind)
+        starts, free, _ = _free_intervals(bounds, period, self.a_tol)
+        out: list[float] = []
+        for x in mids:
+            if _margin(float(x), bounds, period) > self.a_tol:
+                out.append(float(x))
+                continue
+            d = np.abs(np.mod(starts - x + period / 2, period) - period / 2)
+            j = int(np.argmin(d))
+            out += [wrap_period(float(free[j - 1]), period), wrap_period(float(free[j]), period)]
+        return np.array(list(dict.fromkeys(out)), dtype=np.float64)
 
     # -- refinement -----------------------------------------------------------------------
     def _right(
@@ -475,18 +554,22 @@ class _Planner:
         """The turn of largest ``f`` over ``(-g/2, g/2]`` and its value (``f0`` at ``current``)."""
         turn = self.turn
         if turn.exact:
-            # Exact turns (contact noise only): f is constant between critical turns, so
-            # the middles of those intervals are all there is; the widest of the best wins.
-            crit = self.ev.nt.critical(kind, left, right)
-            c = np.unique(np.mod(crit + period / 2, period) - period / 2)
-            if len(c) == 0:
-                return current, f0
-            widths = np.diff(np.append(c, c[0] + period))
-            mids = np.mod(c + widths / 2 + period / 2, period) - period / 2
+            # Exact turns (contact noise only): f is constant between the turns that put a
+            # state of positive probability on a basin boundary of any way the action may
+            # go. Between the critical turns alone (boundaries where the value changes) a
+            # middle may sit on a boundary where it does not: an unstable equilibrium, which
+            # the matrices send to one side and a squeeze to either or neither. So the
+            # middles of the arcs between *all* boundaries are tried: the widest of the best.
+            rows = np.flatnonzero(left > 0)
+            bounds = self.ev.boundary_turns(kind, rows)
+            _, mids, half = _free_intervals(bounds, period, self.a_tol)
             vals = self._line(kind, left, right, mids)
             top = np.flatnonzero(vals >= vals.max() - self.p_tol)
-            i = int(top[np.argmax(widths[top])])
+            i = int(top[np.argmax(half[top])])
             best, fb = float(mids[i]), float(vals[i])
+            if _margin(current, bounds, period) <= self.a_tol:
+                # The current turn's value is one side's, not what a squeeze does: move.
+                return wrap_period(best, period), fb
         elif turn.kind == "uniform":
             crit = self.ev.nt.critical(kind, left, right)
             pts = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
@@ -577,6 +660,32 @@ def _best(cands: list[_Cand], p_tol: float) -> _Cand:
     tied = [c for c in cands if _cost(c) <= m * (1.0 + TIE_RTOL)] if math.isfinite(m) else cands
     top = max(c.ev.expected_payoff for c in tied)  # type: ignore[union-attr]
     return next(c for c in tied if c.ev.expected_payoff >= top - p_tol)  # type: ignore[union-attr]
+
+
+def _free_intervals(
+    turns: FloatArray, period: float, tol: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The arcs between boundary turns on the circle of turns ``(-g/2, g/2]``.
+
+    Returns their starts (the sorted boundary turns, those closer than ``tol`` merged),
+    middles (wrapped) and half-widths: the middle of an arc is its point farthest from every
+    boundary turn, by its half-width.
+    """
+    c = np.unique(np.mod(turns + period / 2, period) - period / 2)
+    if len(c) > 1:
+        keep = np.append(True, np.diff(c) > tol)
+        if c[0] + period - c[-1] <= tol:
+            keep[0] = False
+        c = c[keep]
+    widths = np.diff(np.append(c, c[0] + period))
+    mids = np.mod(c + widths / 2 + period / 2, period) - period / 2
+    return c, mids, widths / 2
+
+
+def _margin(alpha: float, turns: FloatArray, period: float) -> float:
+    """Distance of the turn ``alpha`` to the nearest boundary turn (modulo ``period``)."""
+    d = np.mod(turns - alpha + period / 2, period) - period / 2
+    return float(np.min(np.abs(d))) if len(d) else math.inf
 
 
 def _turn_grid(crit: FloatArray, period: float, h: float, reach: float) -> FloatArray:
@@ -722,6 +831,9 @@ def plan_noisy(
         t: np.array([wrap_period(float(x), a.gripper_period) for x in problem.classes(t).mid])
         for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True)
     }
+    if noise.turn.exact:  # no turn may put a state on an unstable equilibrium
+        for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True):
+            mids[t] = pl.search_turns(t, mids[t], a.gripper_period)
     # Without noise the exact planner's plans are the best of each length (it is exact):
     # the search is needed only for a payoff, which it does not know.
     search = not noise.exact or u is not None
@@ -757,6 +869,10 @@ def plan_noisy(
         for c in cands:
             if c.source == "search":  # seeds are in their short form already
                 c.angles = _short(problem, c.kinds, c.angles)
+            if noise.turn.exact:
+                c.angles, moved = pl.off_edges(c.kinds, c.angles)
+                if moved:
+                    c.source += "+refined"
             c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
         cands = _ranked(cands)
         refined: list[_Cand] = []
@@ -770,7 +886,10 @@ def plan_noisy(
             if len(refined) >= refine:
                 break
         best = _best(cands + refined, pl.p_tol)
-        options.append(_noisy_option(problem, exact, best))
+        margin = None
+        if noise.turn.exact and k > 1:
+            margin = min(pl.margins(best.kinds, best.angles))
+        options.append(_noisy_option(problem, exact, best, margin))
         best_cost = min(best_cost, best.ev.expected_cost)  # type: ignore[union-attr]
         cheapest_next = cost.expected_cost((first_kind,) + (next_kind,) * k, bound)
         if not all_lengths and k >= reach and cheapest_next >= best_cost * (1.0 - 1e-12):
@@ -818,8 +937,13 @@ def _noise_free(
     )
 
 
-def _noisy_option(problem: Problem, exact: _Evaluator, c: _Cand) -> NoisyOption:
-    """The reported plan of a candidate (``exact``: an evaluator without noise)."""
+def _noisy_option(
+    problem: Problem, exact: _Evaluator, c: _Cand, tolerance: float | None = None
+) -> NoisyOption:
+    """The reported plan of a candidate (``exact``: an evaluator without noise).
+
+    ``tolerance``: with exact turns, the plan's least margin (:meth:`_Planner.margins`).
+    """
     e = c.ev
     if e is None:  # pragma: no cover - every candidate is evaluated before it is chosen
         raise PlanningError("internal error: a plan was chosen before it was evaluated")
@@ -828,7 +952,7 @@ def _noisy_option(problem: Problem, exact: _Evaluator, c: _Cand) -> NoisyOption:
     p0 = float(q0 @ e.target)
     final = float(problem.states.stable[e.final_state])
     arc = _success_arc(problem, steps, e.target)
-    opt = PlanOption(steps, final, e.success_probability, e.expected_cost, None, arc)
+    opt = PlanOption(steps, final, e.success_probability, e.expected_cost, tolerance, arc)
     return NoisyOption(opt, e, p0, c.source)
 
 
