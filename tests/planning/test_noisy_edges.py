@@ -194,19 +194,20 @@ def test_a_turn_on_an_equilibrium_is_moved_to_its_better_side() -> None:
     kinds = ("squeeze", "squeeze")
     on_edge = [0.0, -45 * DEG]
     assert min(margins(pb, (PlanStep("squeeze", 0.0), PlanStep("squeeze", -45 * DEG)), 0.3)) < 1e-9
-    angles, moved = pl.off_edges(kinds, on_edge)
+    angles, moved, q_end = pl.off_edges(kinds, on_edge)
     assert moved and angles[0] == 0.0
     steps = tuple(PlanStep(t, a) for t, a in zip(kinds, angles, strict=True))
     assert min(margins(pb, steps, 0.3)) > 1e-6
     # Its value is the better side's: a turn just beside -45 deg either way (same target).
     got = evaluate_plan(pb, noise, steps)
+    np.testing.assert_allclose(q_end, got.distribution, atol=1e-15)
     sides = [
         evaluate_plan(pb, noise, [PlanStep("squeeze", 0.0), PlanStep("squeeze", -45 * DEG + e)])
         for e in (-1e-6, 1e-6)
     ]
     assert got.expected_payoff == pytest.approx(max(s.expected_payoff for s in sides), abs=1e-12)
     # A turn already off every equilibrium is left alone.
-    again, moved = pl.off_edges(kinds, angles)
+    again, moved, _ = pl.off_edges(kinds, angles)
     assert not moved and again == angles
     # And the refinement does not put it back.
     cand = _Cand(kinds, angles, "test")

@@ -479,13 +479,15 @@ class _Planner:
             for m in range(1, len(kinds))
         ]
 
-    def off_edges(self, kinds: Sequence[str], angles: Sequence[float]) -> tuple[list[float], bool]:
+    def off_edges(
+        self, kinds: Sequence[str], angles: Sequence[float]
+    ) -> tuple[list[float], bool, FloatArray]:
         """The turns, each moved off the unstable equilibria of the states it meets.
 
         A turn (exact turns) within the angle tolerance of a boundary turn of a state of
         positive probability is moved to the middle of one of the two arcs beside that
         boundary, the one whose plan (the other turns as they are) earns more. Returns the
-        turns and whether any moved.
+        turns, whether any moved, and the final distribution of the plan they make.
         """
         out = list(angles)
         periods = _periods(self.problem, kinds)
@@ -505,7 +507,7 @@ class _Planner:
                         best_v, out = v, trial
                 moved = True
             q = self.ev.step(q, kinds[m], np.array([out[m]]))[0]
-        return out, moved
+        return out, moved, q
 
     def search_turns(self, kind: str, mids: FloatArray, period: float) -> FloatArray:
         """The search's turns for ``kind``: each on a boundary turn of any state replaced.
@@ -870,10 +872,12 @@ def plan_noisy(
             if c.source == "search":  # seeds are in their short form already
                 c.angles = _short(problem, c.kinds, c.angles)
             if noise.turn.exact:
-                c.angles, moved = pl.off_edges(c.kinds, c.angles)
+                c.angles, moved, q_end = pl.off_edges(c.kinds, c.angles)
                 if moved:
                     c.source += "+refined"
-            c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
+                c.ev = ev.finish(c.kinds, q_end, c.prefer)
+            else:
+                c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
         cands = _ranked(cands)
         refined: list[_Cand] = []
         done: set[tuple[tuple[str, ...], tuple[float, ...]]] = set()
