@@ -32,7 +32,10 @@ How the plan is found, for each length ``k``:
    piecewise linear with kinks at ``S_i - B - o +- A`` (state ``S_i``, basin boundary ``B``,
    contact offset ``o``), so its maximum over the kinks is exact (the middle of a flat top
    is kept). Exact turns (contact noise alone): ``f`` is constant between the critical
-   turns ``S_i - B - o``, whose interval middles are tried (exact). Normal error: ``f`` on a
+   turns ``S_i - B - o``; the middles of the arcs between *all* of them (every boundary of
+   every way the action may go, for every state of positive probability, whether or not
+   its two sides are worth the same) are tried, and the widest arc of the best value wins
+   (exact). Normal error: ``f`` on a
    grid of step ``h = sigma / 6`` within ``8 sigma`` of the critical turns (farther, ``f`` is
    flat to 1e-15: one point a gap) then a grid of step ``h / 32`` around the best point;
    since ``|f''| <= 2 phi(1) / sigma^2``
@@ -43,6 +46,20 @@ How the plan is found, for each length ``k``:
 4. *Exact evaluation*: every candidate's distribution, payoff and cost are matrix products
    (:func:`evaluate_plan`), nothing is sampled.
 
+Unstable equilibria (exact turns). A turn that puts a state of positive probability exactly
+on a basin boundary (a maximum of the diameter function, or of the radius function for a
+push-grasp from one jaw) leaves it on an unstable equilibrium: the matrices send it to one
+side (their intervals are half-open), a squeeze to either side or nowhere (it jams), so a
+plan built on one claims what no gripper does. With exact turns no candidate keeps such a
+turn: the search's class middles that fall on a boundary (under contact noise, a
+push-grasp's boundary may fall inside a squeeze's action class) are replaced by the middles
+of the arcs beside it, a seed's turn on a boundary is moved to the middle of the arc beside
+it whose plan earns more, and the refinement chooses among the arcs between all boundaries.
+Each plan reports its margin as its ``tolerance``: the least distance of a turn
+``alpha_2..alpha_k`` to a boundary turn of a state of positive probability before it, so
+that turn errors below it, on every turn at once, change no state's outcome. (With a turn
+error a boundary is met with probability 0, and the tolerance is ``None``.)
+
 The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
 
 - every reported probability, payoff and cost is exact for the noise model (to rounding;
@@ -50,7 +67,8 @@ The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
   composite 512-node Gauss-Legendre rule);
 - the plan of each length is the best of its candidate set, and each refined plan is
   coordinate-wise optimal: changing any one turn ``alpha_2..alpha_k`` gains at most ``eps``
-  in ``E[payoff]`` (0 for the uniform error, whose one-turn maxima are exact). The first
+  in ``E[payoff]`` (0 for the uniform error, whose one-turn maxima are exact; 0 for exact
+  turns, among the turns that keep every state off an unstable equilibrium). The first
   angle is not refined: under a non-uniform prior it is one of the exact planner's
   placements of the arc on the prior (with the error, those are seeds, not optima);
 - the lengths searched are enough: the search stops at the first length ``k`` where the
@@ -157,14 +175,18 @@ class NoisyOption:
     ----------
     option : PlanOption
         Its steps and final orientation; ``success_probability`` and ``expected_cost``
-        (per unit payoff) under the noise; ``tolerance`` ``None`` (the noise is in the
-        probability already); ``success_arc`` the noise-free one of its steps.
+        (per unit payoff) under the noise; ``tolerance``: with exact turns (contact noise
+        alone) the plan's margin, the least distance of a turn to a basin boundary of a
+        state of positive probability before it (see the module notes; ``None`` for one
+        action), ``None`` under a turn error (the noise is in the probability already);
+        ``success_arc`` the noise-free one of its steps.
     evaluation : NoisyEvaluation
     noise_free_probability : float
         The same steps' success probability with exact actions (same target).
     source : str
         Where the plan came from: ``"exact"``, ``"accuracy"`` (a robust exact plan),
-        ``"search"`` (hyperstate search), with ``"+refined"`` if refinement moved it.
+        ``"search"`` (hyperstate search), with ``"+refined"`` if refinement moved it
+        (or a turn was moved off an unstable equilibrium).
     """
 
     option: PlanOption
