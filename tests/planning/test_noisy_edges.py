@@ -41,6 +41,7 @@ from bayesgrasp.model.states import nearest_state
 from bayesgrasp.paper.study import random_polygon
 from bayesgrasp.planning import PlanStep, plan_exact
 from bayesgrasp.planning.noisy import _Cand, _Planner, evaluate_plan, plan_noisy
+from bayesgrasp.planning.robust import plan_guaranteed_noisy
 from bayesgrasp.sim.kinematic import simulate_kinematic
 
 DEG = math.pi / 180
@@ -246,3 +247,17 @@ def test_two_actions_under_contact_noise_beat_every_turn_of_a_grid(name: str) ->
     best = float(qs[~near].max(axis=1).max())
     assert o.expected_payoff >= best - 1e-12
     assert min(margins(pb, o.option.steps, q)) > pb.states.angle_tol
+
+
+@pytest.mark.parametrize("name", shapes.names())
+def test_guaranteed_plans_under_contact_noise_keep_off_the_equilibria(name: str) -> None:
+    """The set search's turns are middles between every boundary of every state it may meet."""
+    pb = Problem.build(shapes.load(name))
+    g = plan_guaranteed_noisy(pb, NoiseModel(contact=0.3), max_actions=6)
+    if g.status != "ok":
+        pytest.skip(g.reason or "no plan")
+    assert g.option is not None
+    m = margins(pb, g.option.steps, 0.3)
+    assert all(x > pb.states.angle_tol for x in m), np.degrees(m)
+    if m:
+        assert g.option.tolerance is not None and g.option.tolerance <= min(m) + 1e-12
