@@ -171,22 +171,11 @@ def _cli_noise(noise: NoiseModel) -> list[str]:
     return out + (["--contact-noise", f"{noise.contact:g}"] if noise.contact else [])
 
 
-KNIFE_EDGE = pytest.mark.xfail(
-    strict=True,
-    reason="the noise-aware planner's contact-only Bayes plan for the house turns by exactly "
-    "-45 deg, which puts four of its states on the squeeze's unstable equilibria (basin "
-    "boundaries where both sides are worth the same, so the planner's critical turns miss "
-    "them): the exact matrices send each to one side, the kinematic trials jam (half of them)",
-)
-
-
 @pytest.mark.parametrize("part", ["key", "triangle", "example", "house"])
 @pytest.mark.parametrize("name", list(NOISES))
 def test_simulated_success_agrees_with_the_exact_prediction(
-    capsys: pytest.CaptureFixture[str], part: str, name: str, request: pytest.FixtureRequest
+    capsys: pytest.CaptureFixture[str], part: str, name: str
 ) -> None:
-    if part == "house" and name == "contact":
-        request.applymarker(KNIFE_EDGE)
     noise = NOISES[name]
     n = 100_000
     sim = doc_of(capsys, "simulate", part, *_cli_noise(noise), "--trials", str(n), "--seed", "5")

@@ -32,7 +32,10 @@ How the plan is found, for each length ``k``:
    piecewise linear with kinks at ``S_i - B - o +- A`` (state ``S_i``, basin boundary ``B``,
    contact offset ``o``), so its maximum over the kinks is exact (the middle of a flat top
    is kept). Exact turns (contact noise alone): ``f`` is constant between the critical
-   turns ``S_i - B - o``, whose interval middles are tried (exact). Normal error: ``f`` on a
+   turns ``S_i - B - o``; the middles of the arcs between *all* of them (every boundary of
+   every way the action may go, for every state of positive probability, whether or not
+   its two sides are worth the same) are tried, and the widest arc of the best value wins
+   (exact). Normal error: ``f`` on a
    grid of step ``h = sigma / 6`` within ``8 sigma`` of the critical turns (farther, ``f`` is
    flat to 1e-15: one point a gap) then a grid of step ``h / 32`` around the best point;
    since ``|f''| <= 2 phi(1) / sigma^2``
@@ -43,6 +46,20 @@ How the plan is found, for each length ``k``:
 4. *Exact evaluation*: every candidate's distribution, payoff and cost are matrix products
    (:func:`evaluate_plan`), nothing is sampled.
 
+Unstable equilibria (exact turns). A turn that puts a state of positive probability exactly
+on a basin boundary (a maximum of the diameter function, or of the radius function for a
+push-grasp from one jaw) leaves it on an unstable equilibrium: the matrices send it to one
+side (their intervals are half-open), a squeeze to either side or nowhere (it jams), so a
+plan built on one claims what no gripper does. With exact turns no candidate keeps such a
+turn: the search's class middles that fall on a boundary (under contact noise, a
+push-grasp's boundary may fall inside a squeeze's action class) are replaced by the middles
+of the arcs beside it, a seed's turn on a boundary is moved to the middle of the arc beside
+it whose plan earns more, and the refinement chooses among the arcs between all boundaries.
+Each plan reports its margin as its ``tolerance``: the least distance of a turn
+``alpha_2..alpha_k`` to a boundary turn of a state of positive probability before it, so
+that turn errors below it, on every turn at once, change no state's outcome. (With a turn
+error a boundary is met with probability 0, and the tolerance is ``None``.)
+
 The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
 
 - every reported probability, payoff and cost is exact for the noise model (to rounding;
@@ -50,7 +67,8 @@ The guarantee (:attr:`NoisyPlanResult.refinement_bound`):
   composite 512-node Gauss-Legendre rule);
 - the plan of each length is the best of its candidate set, and each refined plan is
   coordinate-wise optimal: changing any one turn ``alpha_2..alpha_k`` gains at most ``eps``
-  in ``E[payoff]`` (0 for the uniform error, whose one-turn maxima are exact). The first
+  in ``E[payoff]`` (0 for the uniform error, whose one-turn maxima are exact; 0 for exact
+  turns, among the turns that keep every state off an unstable equilibrium). The first
   angle is not refined: under a non-uniform prior it is one of the exact planner's
   placements of the arc on the prior (with the error, those are seeds, not optima);
 - the lengths searched are enough: the search stops at the first length ``k`` where the
@@ -157,14 +175,18 @@ class NoisyOption:
     ----------
     option : PlanOption
         Its steps and final orientation; ``success_probability`` and ``expected_cost``
-        (per unit payoff) under the noise; ``tolerance`` ``None`` (the noise is in the
-        probability already); ``success_arc`` the noise-free one of its steps.
+        (per unit payoff) under the noise; ``tolerance``: with exact turns (contact noise
+        alone) the plan's margin, the least distance of a turn to a basin boundary of a
+        state of positive probability before it (see the module notes; ``None`` for one
+        action), ``None`` under a turn error (the noise is in the probability already);
+        ``success_arc`` the noise-free one of its steps.
     evaluation : NoisyEvaluation
     noise_free_probability : float
         The same steps' success probability with exact actions (same target).
     source : str
         Where the plan came from: ``"exact"``, ``"accuracy"`` (a robust exact plan),
-        ``"search"`` (hyperstate search), with ``"+refined"`` if refinement moved it.
+        ``"search"`` (hyperstate search), with ``"+refined"`` if refinement moved it
+        (or a turn was moved off an unstable equilibrium).
     """
 
     option: PlanOption
@@ -300,6 +322,19 @@ class _Evaluator:
             atol=1e3 * problem.states.angle_tol,
         )
         self.half = half if ok else None
+
+    def boundary_turns(self, kind: str, rows: NDArray[np.intp] | None = None) -> FloatArray:
+        """Turns that put a state of ``rows`` (default all) on a basin boundary of ``kind``.
+
+        ``S_i - B - o`` for every state ``S_i`` of ``rows``, every way the action may go
+        (offset ``o``) and every boundary ``B`` of its transfer function, unwrapped: the
+        unstable equilibria a turn must keep away from, whether or not both sides are worth
+        the same.
+        """
+        s = self.nt.stable if rows is None else self.nt.stable[np.asarray(rows, dtype=np.intp)]
+        return np.concatenate(
+            [(s[:, None] - c.offset - c.hi[None, :]).ravel() for c in self.nt.components(kind)]
+        )
 
     def targets(self, q: FloatArray, prefer: int | None = None) -> tuple[FloatArray, int]:
         """The payoff vector a final distribution is scored with, and the aimed state.
@@ -446,6 +481,74 @@ class _Planner:
         self.ev = _Evaluator(problem, noise, payoff)
         self.turn = noise.turn
         self.p_tol = problem.part.hull.tol.probability
+        self.a_tol = problem.states.angle_tol
+
+    # -- unstable equilibria ---------------------------------------------------------------
+    def margins(self, kinds: Sequence[str], angles: Sequence[float]) -> list[float]:
+        """Each turn's distance to the nearest boundary turn of a state it may meet.
+
+        Entry ``m - 1`` is turn ``alpha_m``'s (``m >= 2``): the states of positive
+        probability before it (under the noise), every way its action may go.
+        """
+        periods = _periods(self.problem, kinds)
+        qs = self.ev.forward(kinds, angles)
+        return [
+            _margin(
+                angles[m],
+                self.ev.boundary_turns(kinds[m], np.flatnonzero(qs[m - 1] > 0)),
+                periods[m],
+            )
+            for m in range(1, len(kinds))
+        ]
+
+    def off_edges(
+        self, kinds: Sequence[str], angles: Sequence[float]
+    ) -> tuple[list[float], bool, FloatArray]:
+        """The turns, each moved off the unstable equilibria of the states it meets.
+
+        A turn (exact turns) within the angle tolerance of a boundary turn of a state of
+        positive probability is moved to the middle of one of the two arcs beside that
+        boundary, the one whose plan (the other turns as they are) earns more. Returns the
+        turns, whether any moved, and the final distribution of the plan they make.
+        """
+        out = list(angles)
+        periods = _periods(self.problem, kinds)
+        q = self.ev.nt.initial(kinds[0], out[0])
+        moved = False
+        for m in range(1, len(kinds)):
+            bounds = self.ev.boundary_turns(kinds[m], np.flatnonzero(q > 0))
+            if _margin(out[m], bounds, periods[m]) <= self.a_tol:
+                starts, mids, _ = _free_intervals(bounds, periods[m], self.a_tol)
+                d = np.abs(np.mod(starts - out[m] + periods[m] / 2, periods[m]) - periods[m] / 2)
+                j = int(np.argmin(d))
+                best_v = -math.inf
+                for x in (float(mids[j - 1]), float(mids[j])):
+                    trial = [*out[:m], wrap_period(x, periods[m]), *out[m + 1 :]]
+                    v = float(self.ev.value(self.ev.forward(kinds, trial)[-1]))
+                    if v > best_v + self.p_tol:
+                        best_v, out = v, trial
+                moved = True
+            q = self.ev.step(q, kinds[m], np.array([out[m]]))[0]
+        return out, moved, q
+
+    def search_turns(self, kind: str, mids: FloatArray, period: float) -> FloatArray:
+        """The search's turns for ``kind``: each on a boundary turn of any state replaced.
+
+        The middles of the noise-free action classes keep away from the transfer's own
+        boundaries; under contact noise a push-grasp's boundary may fall on one. Such a turn
+        is replaced by the middles of the two arcs beside it (between all boundary turns).
+        """
+        bounds = self.ev.boundary_turns(kind)
+        starts, free, _ = _free_intervals(bounds, period, self.a_tol)
+        out: list[float] = []
+        for x in mids:
+            if _margin(float(x), bounds, period) > self.a_tol:
+                out.append(float(x))
+                continue
+            d = np.abs(np.mod(starts - x + period / 2, period) - period / 2)
+            j = int(np.argmin(d))
+            out += [wrap_period(float(free[j - 1]), period), wrap_period(float(free[j]), period)]
+        return np.array(list(dict.fromkeys(out)), dtype=np.float64)
 
     # -- refinement -----------------------------------------------------------------------
     def _right(
@@ -475,18 +578,22 @@ class _Planner:
         """The turn of largest ``f`` over ``(-g/2, g/2]`` and its value (``f0`` at ``current``)."""
         turn = self.turn
         if turn.exact:
-            # Exact turns (contact noise only): f is constant between critical turns, so
-            # the middles of those intervals are all there is; the widest of the best wins.
-            crit = self.ev.nt.critical(kind, left, right)
-            c = np.unique(np.mod(crit + period / 2, period) - period / 2)
-            if len(c) == 0:
-                return current, f0
-            widths = np.diff(np.append(c, c[0] + period))
-            mids = np.mod(c + widths / 2 + period / 2, period) - period / 2
+            # Exact turns (contact noise only): f is constant between the turns that put a
+            # state of positive probability on a basin boundary of any way the action may
+            # go. Between the critical turns alone (boundaries where the value changes) a
+            # middle may sit on a boundary where it does not: an unstable equilibrium, which
+            # the matrices send to one side and a squeeze to either or neither. So the
+            # middles of the arcs between *all* boundaries are tried: the widest of the best.
+            rows = np.flatnonzero(left > 0)
+            bounds = self.ev.boundary_turns(kind, rows)
+            _, mids, half = _free_intervals(bounds, period, self.a_tol)
             vals = self._line(kind, left, right, mids)
             top = np.flatnonzero(vals >= vals.max() - self.p_tol)
-            i = int(top[np.argmax(widths[top])])
+            i = int(top[np.argmax(half[top])])
             best, fb = float(mids[i]), float(vals[i])
+            if _margin(current, bounds, period) <= self.a_tol:
+                # The current turn's value is one side's, not what a squeeze does: move.
+                return wrap_period(best, period), fb
         elif turn.kind == "uniform":
             crit = self.ev.nt.critical(kind, left, right)
             pts = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
@@ -577,6 +684,32 @@ def _best(cands: list[_Cand], p_tol: float) -> _Cand:
     tied = [c for c in cands if _cost(c) <= m * (1.0 + TIE_RTOL)] if math.isfinite(m) else cands
     top = max(c.ev.expected_payoff for c in tied)  # type: ignore[union-attr]
     return next(c for c in tied if c.ev.expected_payoff >= top - p_tol)  # type: ignore[union-attr]
+
+
+def _free_intervals(
+    turns: FloatArray, period: float, tol: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The arcs between boundary turns on the circle of turns ``(-g/2, g/2]``.
+
+    Returns their starts (the sorted boundary turns, those closer than ``tol`` merged),
+    middles (wrapped) and half-widths: the middle of an arc is its point farthest from every
+    boundary turn, by its half-width.
+    """
+    c = np.unique(np.mod(turns + period / 2, period) - period / 2)
+    if len(c) > 1:
+        keep = np.append(True, np.diff(c) > tol)
+        if c[0] + period - c[-1] <= tol:
+            keep[0] = False
+        c = c[keep]
+    widths = np.diff(np.append(c, c[0] + period))
+    mids = np.mod(c + widths / 2 + period / 2, period) - period / 2
+    return c, mids, widths / 2
+
+
+def _margin(alpha: float, turns: FloatArray, period: float) -> float:
+    """Distance of the turn ``alpha`` to the nearest boundary turn (modulo ``period``)."""
+    d = np.mod(turns - alpha + period / 2, period) - period / 2
+    return float(np.min(np.abs(d))) if len(d) else math.inf
 
 
 def _turn_grid(crit: FloatArray, period: float, h: float, reach: float) -> FloatArray:
@@ -722,6 +855,9 @@ def plan_noisy(
         t: np.array([wrap_period(float(x), a.gripper_period) for x in problem.classes(t).mid])
         for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True)
     }
+    if noise.turn.exact:  # no turn may put a state on an unstable equilibrium
+        for t, a in zip(kinds_all, plan_actions(problem, kinds_all), strict=True):
+            mids[t] = pl.search_turns(t, mids[t], a.gripper_period)
     # Without noise the exact planner's plans are the best of each length (it is exact):
     # the search is needed only for a payoff, which it does not know.
     search = not noise.exact or u is not None
@@ -757,7 +893,13 @@ def plan_noisy(
         for c in cands:
             if c.source == "search":  # seeds are in their short form already
                 c.angles = _short(problem, c.kinds, c.angles)
-            c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
+            if noise.turn.exact:
+                c.angles, moved, q_end = pl.off_edges(c.kinds, c.angles)
+                if moved:
+                    c.source += "+refined"
+                c.ev = ev.finish(c.kinds, q_end, c.prefer)
+            else:
+                c.ev = ev.evaluate(c.kinds, c.angles, c.prefer)
         cands = _ranked(cands)
         refined: list[_Cand] = []
         done: set[tuple[tuple[str, ...], tuple[float, ...]]] = set()
@@ -770,7 +912,10 @@ def plan_noisy(
             if len(refined) >= refine:
                 break
         best = _best(cands + refined, pl.p_tol)
-        options.append(_noisy_option(problem, exact, best))
+        margin = None
+        if noise.turn.exact and k > 1:
+            margin = min(pl.margins(best.kinds, best.angles))
+        options.append(_noisy_option(problem, exact, best, margin))
         best_cost = min(best_cost, best.ev.expected_cost)  # type: ignore[union-attr]
         cheapest_next = cost.expected_cost((first_kind,) + (next_kind,) * k, bound)
         if not all_lengths and k >= reach and cheapest_next >= best_cost * (1.0 - 1e-12):
@@ -818,8 +963,13 @@ def _noise_free(
     )
 
 
-def _noisy_option(problem: Problem, exact: _Evaluator, c: _Cand) -> NoisyOption:
-    """The reported plan of a candidate (``exact``: an evaluator without noise)."""
+def _noisy_option(
+    problem: Problem, exact: _Evaluator, c: _Cand, tolerance: float | None = None
+) -> NoisyOption:
+    """The reported plan of a candidate (``exact``: an evaluator without noise).
+
+    ``tolerance``: with exact turns, the plan's least margin (:meth:`_Planner.margins`).
+    """
     e = c.ev
     if e is None:  # pragma: no cover - every candidate is evaluated before it is chosen
         raise PlanningError("internal error: a plan was chosen before it was evaluated")
@@ -828,7 +978,7 @@ def _noisy_option(problem: Problem, exact: _Evaluator, c: _Cand) -> NoisyOption:
     p0 = float(q0 @ e.target)
     final = float(problem.states.stable[e.final_state])
     arc = _success_arc(problem, steps, e.target)
-    opt = PlanOption(steps, final, e.success_probability, e.expected_cost, None, arc)
+    opt = PlanOption(steps, final, e.success_probability, e.expected_cost, tolerance, arc)
     return NoisyOption(opt, e, p0, c.source)
 
 
