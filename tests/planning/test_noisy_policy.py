@@ -412,3 +412,20 @@ def test_invariants_on_random_polygons(
     free = evaluate_policy(pb, plan_policy(pb, sensor, 2), nm)
     assert pol.expected_cost <= free.expected_cost + 1e-9
     assert pol.sensorless_cost is not None and pol.expected_cost <= pol.sensorless_cost + 1e-9
+
+
+@pytest.mark.parametrize("name", ["house", "triangle", "rectangle", "key", "example"])
+def test_policies_under_contact_noise_keep_off_unstable_equilibria(name: str) -> None:
+    """With exact turns a turn is chosen in the middle of the arcs between every boundary of
+    every state the node may hold: no squeeze of the policy starts at an unstable equilibrium,
+    so the kinematic replay jams nowhere and agrees with the claim."""
+    from bayesgrasp import shapes
+    from bayesgrasp.sim.policy import simulate_policy
+
+    pb = Problem.build(shapes.load(name))
+    noise = NoiseModel(contact=0.3)
+    pol = plan_noisy_policy(pb, "width", 2, noise)
+    sim = simulate_policy(pb, pol, 20_000, noise, rng=7)
+    assert sim.jams == 0
+    lo, hi = sim.success_interval
+    assert lo <= pol.success_probability <= hi

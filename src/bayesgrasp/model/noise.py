@@ -450,6 +450,19 @@ class NoisyTransitions:
             pts.append((self.stable[rows][:, None] - c.offset - c.hi[None, :])[keep])
         return np.concatenate(pts)
 
+    def boundary_turns(self, kind: str, rows: ArrayLike | None = None) -> FloatArray:
+        """Turns that put a state of ``rows`` (default all) on a basin boundary of ``kind``.
+
+        ``S_i - B - o`` for every state ``S_i`` of ``rows``, every way the action may go
+        (offset ``o``) and every boundary ``B`` of its transfer function, unwrapped: the
+        unstable equilibria a turn must keep away from, whether or not both sides are worth
+        the same.
+        """
+        s = self.stable if rows is None else self.stable[np.asarray(rows, dtype=np.intp)]
+        return np.concatenate(
+            [(s[:, None] - c.offset - c.hi[None, :]).ravel() for c in self.components(kind)]
+        )
+
     def matrix(self, kind: str, alpha: float) -> FloatArray:
         """The (K, K) transition matrix of one turn."""
         return np.asarray(self.matrices(kind, [alpha])[0], dtype=np.float64)

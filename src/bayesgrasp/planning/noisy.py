@@ -324,17 +324,8 @@ class _Evaluator:
         self.half = half if ok else None
 
     def boundary_turns(self, kind: str, rows: NDArray[np.intp] | None = None) -> FloatArray:
-        """Turns that put a state of ``rows`` (default all) on a basin boundary of ``kind``.
-
-        ``S_i - B - o`` for every state ``S_i`` of ``rows``, every way the action may go
-        (offset ``o``) and every boundary ``B`` of its transfer function, unwrapped: the
-        unstable equilibria a turn must keep away from, whether or not both sides are worth
-        the same.
-        """
-        s = self.nt.stable if rows is None else self.nt.stable[np.asarray(rows, dtype=np.intp)]
-        return np.concatenate(
-            [(s[:, None] - c.offset - c.hi[None, :]).ravel() for c in self.nt.components(kind)]
-        )
+        """:meth:`NoisyTransitions.boundary_turns` of this problem."""
+        return self.nt.boundary_turns(kind, rows)
 
     def targets(self, q: FloatArray, prefer: int | None = None) -> tuple[FloatArray, int]:
         """The payoff vector a final distribution is scored with, and the aimed state.

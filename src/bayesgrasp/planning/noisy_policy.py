@@ -121,7 +121,14 @@ from ..model.payoff import Payoff, as_vector
 from ..model.problem import Problem
 from ..model.sensing import StateSpace, WidthSensor, parse_sensor
 from ..model.states import nearest_state
-from .noisy import FLAT_SIGMAS, GRID_PER_SIGMA, _turn_grid, plan_noisy
+from .noisy import (
+    FLAT_SIGMAS,
+    GRID_PER_SIGMA,
+    _free_intervals,
+    _margin,
+    _turn_grid,
+    plan_noisy,
+)
 from .policy import (
     _DEFAULT_MAX_ACTIONS,
     _PRUNE,
@@ -235,6 +242,19 @@ class _Model:
             if np.any(left[lo:hi] > 0):
                 out += nt.line(kind, left[lo:hi], right[lo:hi], alphas)
         return out
+
+    def boundaries(self, kind: str, left: FloatArray) -> FloatArray:
+        """Turns that put a state of positive ``left`` mass on a basin boundary of ``kind``.
+
+        Every way the action may go counts, whether or not both sides of the boundary are
+        worth the same: a squeeze at an unstable equilibrium goes either way, or jams.
+        """
+        pts = [
+            nt.boundary_turns(kind, np.flatnonzero(left[lo:hi] > 0))
+            for (lo, hi), nt in zip(self.blocks, self.nts, strict=True)
+            if np.any(left[lo:hi] > 0)
+        ]
+        return np.concatenate(pts) if pts else np.zeros(0)
 
     def critical(self, kind: str, left: FloatArray, right: FloatArray) -> FloatArray:
         """Turns where ``left M(alpha) right`` may change with exact turns."""
@@ -363,16 +383,20 @@ def _best_turn(
     if len(crit) == 0:
         return current, -f0, 0.0
     eps = 0.0
+    on_edge = False
     if turn.exact:
-        # f is constant between critical turns: the middle of each interval, the widest of
-        # the best (intervals of a rounding's width are not turns a gripper can make).
-        c = np.unique(np.mod(crit + period / 2, period) - period / 2)
-        widths = np.diff(np.append(c, c[0] + period))
-        pts = np.mod(c + widths / 2 + period / 2, period) - period / 2
-        vals = np.where(widths > 1e-9, model.line(kind, left, neg, pts), -np.inf)
+        # f is constant between critical turns, so between every boundary of every state the
+        # node may hold (a refinement of them): the middle of each such arc, the widest of the
+        # best, keeps the turn farthest from the unstable equilibria (arcs of a rounding's
+        # width are not turns a gripper can make). A turn now on a boundary must move: its
+        # value is one side's, not what the squeeze does there.
+        edges = model.boundaries(kind, left)
+        _, pts, half = _free_intervals(edges, period, 1e-9)
+        vals = np.where(half > 5e-10, model.line(kind, left, neg, pts), -np.inf)
         top = np.flatnonzero(vals >= vals.max() - _GAIN_TOL * max(1.0, abs(float(vals.max()))))
-        i = int(top[np.argmax(widths[top])])
+        i = int(top[np.argmax(half[top])])
         best, fb = float(pts[i]), float(vals[i])
+        on_edge = _margin(current, edges, period) < 1e-9
     elif turn.kind == "uniform":
         raw = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
         kinks = np.unique(np.mod(raw + period / 2, period)) - period / 2
@@ -392,6 +416,9 @@ def _best_turn(
             best, fb = float(fine[j]), float(fv[j])
         span = float(right.max() - right.min())
         eps = turn.curvature_bound * h * h / 8.0 * float(left.sum()) * span
+    if on_edge:
+        best = float(math.remainder(best, TWO_PI))
+        return best, float(left @ model.matrix(kind, best) @ right), eps
     if fb > f0 + _GAIN_TOL * max(1.0, abs(f0)):
         # Checked with the matrix the evaluation uses (the line's sums are arranged
         # differently, and may round differently right at a critical turn).
