@@ -203,8 +203,12 @@ def policy_figure(
     for b in boxes:
         for edge, c in b.children:
             ax.plot([b.x, c.x], [y(b) - 0.45, y(c) + 0.45], color="#999999", lw=0.8, zorder=0)
+            # Nearer the child than the parent: a node's edges fan out, and their labels
+            # must sit where the edges are as far apart as the children.
+            t = 0.7
             ax.text(
-                0.5 * (b.x + c.x), 0.5 * (y(b) + y(c)), edge, ha="center", va="center",
+                b.x + t * (c.x - b.x), y(b) - 0.45 + t * (y(c) - y(b) + 0.9), edge,
+                ha="center", va="center",
                 fontsize=6.5, bbox={"fc": "white", "ec": "none", "pad": 0.5}, gid="policy-edge",
             )  # fmt: skip
         if isinstance(b.item, PolicyNode):
@@ -240,9 +244,10 @@ def policy_figure(
     ax.set_ylim(-1.6 * depth - 1.3, 1.0)
     ax.set_aspect("equal")
     sensor = policy.sensor.spec
+    noise = "" if policy.noise is None else f"\nunder {policy.noise.describe()} (exact figures)"
     ax.set_title(
         f"{' or '.join(policy.parts)}: Bayes policy, {sensor}, expected cost "
-        f"{policy.expected_cost:.3f} (success {policy.success_probability:.3f} a cycle)",
+        f"{policy.expected_cost:.3f} (success {policy.success_probability:.3f} a cycle){noise}",
         fontsize=9,
     )
     return fig
