@@ -91,7 +91,7 @@ class SweepOptions:
         Gripper accuracy in degrees (``--accuracy``).
     method : {"exact", "bfs"}
     max_actions : int, optional
-        Longest plan to consider (``--max-squeezes``).
+        Longest plan to consider (``--max-actions``).
     guaranteed : bool
         Also plan the shortest guaranteed plan (``--guaranteed``); on by default, since a
         row reports its length.
@@ -301,7 +301,7 @@ class SweepOptions:
             ("push_grasp_cost", "--push-grasp-cost"),
             ("goal", "--goal"),
             ("method", "--method"),
-            ("max_actions", "--max-squeezes"),
+            ("max_actions", "--max-actions"),
             ("layer", "--layer"),
             ("flatten_tol", "--flatten-tol"),
             ("shape_tol", "--shape-tol"),

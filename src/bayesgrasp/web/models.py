@@ -110,7 +110,7 @@ class ProblemOptions(_Strict):
     accuracy: float = Field(0.0, ge=0, le=180, description="Gripper accuracy, deg (--accuracy).")
     method: Literal["exact", "bfs"] = "exact"
     max_actions: int | None = Field(
-        None, ge=1, le=1000, description="Longest plan to consider (--max-squeezes)."
+        None, ge=1, le=1000, description="Longest plan to consider (--max-actions)."
     )
 
 
