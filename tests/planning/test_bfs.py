@@ -330,7 +330,7 @@ def test_report_fields() -> None:
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"max_actions": 0}, "`max_actions` must be at least 1; got 0"),
+        ({"max_actions": 0}, "`max_actions` must be an integer >= 1; got 0"),
         ({"node_limit": 0}, "`node_limit` and `fallback_limit` must be at least 1"),
         ({"first_angles": []}, "`first_angles` must be a non-empty list"),
         ({"first_angles": [math.nan]}, "`first_angles` must be a non-empty list"),

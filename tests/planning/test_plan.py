@@ -109,7 +109,7 @@ def test_plan_rejects_unknown_method_and_bad_length() -> None:
     with pytest.raises(PlanningError, match="`method` must be one of 'exact', 'bfs', 'guaranteed'"):
         plan(pb, "greedy")  # type: ignore[arg-type]
     for method in METHODS:
-        with pytest.raises(PlanningError, match="`max_actions` must be at least 1; got 0"):
+        with pytest.raises(PlanningError, match="`max_actions` must be an integer >= 1; got 0"):
             plan(pb, method, max_actions=0)
 
 

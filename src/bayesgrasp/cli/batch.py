@@ -342,7 +342,9 @@ def write_policy_outputs(
         return policy_figure(problems, policy, min_probability=fold)
 
     def robot(path: Path) -> None:
-        meta = {} if policy.noise is None else {"noise": policy.noise.to_json()}
+        meta: dict[str, Any] = {} if policy.noise is None else {"noise": policy.noise.to_json()}
+        if policy.payoff is not None:
+            meta["payoff"] = list(policy.payoff)
         write_robot(path, problems, policy, meta)
 
     outputs.write(problems[0].part.name, index, figure, robot)

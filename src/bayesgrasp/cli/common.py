@@ -176,19 +176,6 @@ def check_figure_path(path: Path, hint: str = "--plot") -> None:
         raise typer.BadParameter(f"no folder {str(path.parent)!r} to write into", param_hint=hint)
 
 
-def check_export(path: Path, inputs: Iterable[Path], force: bool = False) -> None:
-    """Refuse a robot file name that cannot be written, before any work is done."""
-    if path.suffix.lstrip(".").lower() not in ("csv", "json"):
-        raise typer.BadParameter(
-            f"the robot file must end in .csv or .json; got {path.name!r}", param_hint="--export"
-        )
-    if not path.parent.is_dir():
-        raise typer.BadParameter(
-            f"no folder {str(path.parent)!r} to write into", param_hint="--export"
-        )
-    check_outputs([path], inputs, force, "--export")
-
-
 def save_figure(fig: Any, path: Path) -> None:
     """Write a figure; a bad file name is a usage error (exit 2), not a traceback."""
     check_figure_path(path)

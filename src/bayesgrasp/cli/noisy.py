@@ -17,7 +17,10 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from ..io.plans import noisy_plan_document
 from .common import emit_json
+
+noisy_document = noisy_plan_document  # the document is written by io.plans
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
@@ -136,29 +139,6 @@ class NoisyRun:
             write_robot(path, pb, res.bayes_plan.option, self.robot_metadata(res))
 
         outputs.write(pb.part.name, index, lambda: noisy_plan_figure(res), robot)
-
-
-def noisy_document(
-    res: NoisyPlanResult,
-    *,
-    guaranteed: GuaranteedPlan | None = None,
-    guaranteed_missing: str | None = None,
-    inputs: dict[str, Any] | None = None,
-) -> dict[str, Any]:
-    """The plan document of a noisy result: the usual fields plus the noise and payoff."""
-    from ..io.plans import json_float, plan_document
-
-    doc = plan_document(
-        res.plan_result(),
-        guaranteed=guaranteed,
-        guaranteed_missing=guaranteed_missing,
-        inputs=inputs,
-    )
-    bayes = res.bayes_plan
-    doc["expected_payoff"] = bayes.expected_payoff
-    doc["expected_cost_per_unit_payoff"] = json_float(bayes.evaluation.expected_cost)
-    doc.update(res.to_json())
-    return doc
 
 
 def noisy_text(res: NoisyPlanResult) -> str:

@@ -167,9 +167,8 @@ def simulate_policy_command(
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))
     from ..sim.noise import GripperNoise
 
-    model = action
-    noise = None if model is None else model.noise
-    problems, pol = plan_sensing_policy(sensing, parts, spec, model, sensor)
+    noise = None if action is None else action.noise
+    problems, pol = plan_sensing_policy(sensing, parts, spec, action, sensor)
     n = cycles or (200_000 if engine is Engine.kinematic else 200)
 
     def run(progress: Any) -> Any:
@@ -195,7 +194,7 @@ def simulate_policy_command(
     names = " or ".join(pol.parts)
     most = sensing.max_actions
     title = f"{names}: Bayes policy of at most {most} actions; "
-    if noise is not None and not (noise.exact and noise.contact == 0):
+    if noise is not None and not noise.exact:
         title += f"planned and predicted under {noise.describe()}; "
     typer.echo(policy_simulation_text(res, title))
 

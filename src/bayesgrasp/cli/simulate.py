@@ -60,8 +60,9 @@ TrialsOpt = Annotated[
     int | None,
     typer.Option(
         min=1,
-        help="Executions (default: 1,000,000 kinematic, 200 mujoco; at most 1e9, run in "
-        "blocks of 2^20 so memory stays bounded).",
+        help="Executions (default: 1,000,000 kinematic, 200 mujoco; with --sense, cycles: "
+        "200,000 kinematic, 200 mujoco; at most 1e9, run in blocks of 2^20 so memory stays "
+        "bounded).",
     ),
 ]
 WorkersOpt = Annotated[
@@ -194,10 +195,16 @@ def simulate(
     if sense is not None:
         if jaw_lag:
             raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
+        if which != "bayes" or force:
+            raise typer.BadParameter(
+                "with --sense the Bayes policy is planned and run; --plan and --force choose or "
+                "admit a linear plan",
+                param_hint="--plan" if which != "bayes" else "--force",
+            )
         from .sensing import ActionModel, simulate_policy_command
 
         model, _, _ = _noise_model(noise, noise_kind, turn_noise, contact_noise)
-        asked = not model.exact or model.contact > 0 or payoff is not None
+        asked = not model.exact or payoff is not None
         action = ActionModel(model, payoff) if asked else None
         sensing = sense_spec(sense, also or (), part_prior, spec)
         simulate_policy_command(
@@ -220,7 +227,7 @@ def simulate(
         )
     params = _lagged(jaw_lag, p, units) if jaw_lag else None
     pay = _read_payoff(payoff)
-    if (not model.exact or pay is not None) and which in ("bayes", "most-certain"):
+    if (not model.exact or pay is not None) and which in ("bayes", "most-certain", "guaranteed"):
         pb, option, label = noise_aware_plan(which, spec, p, model, pay)
     else:
         pb, option, label = chosen_plan(which, spec, p, force)
@@ -316,6 +323,9 @@ def noise_aware_plan(
 
     ``which`` is ``bayes`` or ``most-certain`` (the highest expected payoff); the planner
     is :func:`~bayesgrasp.planning.noisy.plan_noisy` with the options ``plan`` passes it.
+    ``guaranteed``: the plan ``plan --guaranteed`` gives under the noise
+    (:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`; none under a normal turn error,
+    which is unbounded).
     """
     from ..planning.noisy import plan_noisy
     from .common import PLAN_NAMES
@@ -326,6 +336,17 @@ def noise_aware_plan(
             param_hint="--method",
         )
     pb = spec.build(part)
+    if which == "guaranteed":
+        from ..planning.robust import UNBOUNDED_GUARANTEE, plan_guaranteed_noisy
+
+        if not noise.turn.exact and noise.turn.kind == "normal":
+            raise typer.BadParameter(UNBOUNDED_GUARANTEE, param_hint="--plan")
+        found = plan_guaranteed_noisy(pb, noise)
+        if found.status != "ok":
+            raise typer.BadParameter(
+                f"no guaranteed plan under {noise.describe()}: {found.reason}", param_hint="--plan"
+            )
+        return pb, found.options[0], "noise-aware guaranteed"
     res = plan_noisy(pb, noise, payoff, spec.max_actions)
     chosen = res.bayes if which == "bayes" else res.most_certain
     what = "noise-aware " if not noise.exact else "payoff "
@@ -340,6 +361,7 @@ def _note_plan_file(which: str, noise: Any, payoff: Any) -> None:
     """
     import json
 
+    from ..errors import BayesGraspError
     from ..model.noise import NoiseModel, TurnNoise
 
     path = Path(which)
@@ -352,8 +374,8 @@ def _note_plan_file(which: str, noise: Any, payoff: Any) -> None:
             TurnNoise(made["turn"]["kind"], made["turn"]["scale_rad"]), made["contact"]
         ) if isinstance(made, dict) else NoiseModel()  # fmt: skip
         paid = isinstance(doc, dict) and doc.get("payoff") is not None
-    except (OSError, ValueError, KeyError, TypeError):  # the plan reader has checked the file
-        return
+    except (OSError, ValueError, KeyError, TypeError, BayesGraspError):
+        return  # the plan reader has checked the file; a note is never an error
     missing = []
     if theirs != noise and not theirs.exact:
         t, q = theirs.turn, theirs.contact

@@ -93,6 +93,7 @@ from ..sizes import SMALL
 if TYPE_CHECKING:  # the planners are imported by what reads plans, not by every document
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
+    from ..planning.noisy import NoisyPlanResult
     from ..planning.result import PlanOption, PlanReport, PlanStep
 
 __all__ = [
@@ -104,6 +105,7 @@ __all__ = [
     "PlanSource",
     "guaranteed_document",
     "json_float",
+    "noisy_plan_document",
     "option_document",
     "part_document",
     "part_id",
@@ -326,6 +328,32 @@ def json_float(x: float | None) -> float | None:
     if x is None or not math.isfinite(x):
         return None
     return float(x)
+
+
+def noisy_plan_document(
+    res: NoisyPlanResult,
+    *,
+    guaranteed: GuaranteedPlan | None = None,
+    guaranteed_missing: str | None = None,
+    inputs: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The plan document of a noise-aware result.
+
+    :func:`plan_document`'s fields, then the Bayes plan's expected payoff and cost per unit
+    payoff, the noise and payoff, and each option's figures under the noise
+    (:meth:`NoisyPlanResult.to_json`).
+    """
+    doc = plan_document(
+        res.plan_result(),
+        guaranteed=guaranteed,
+        guaranteed_missing=guaranteed_missing,
+        inputs=inputs,
+    )
+    bayes = res.bayes_plan
+    doc["expected_payoff"] = bayes.expected_payoff
+    doc["expected_cost_per_unit_payoff"] = json_float(bayes.evaluation.expected_cost)
+    doc.update(res.to_json())
+    return doc
 
 
 # json.dumps(doc, allow_nan=False) without its argument checks (documents are trees).

@@ -67,7 +67,14 @@ from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
 from ..model.prior import UniformPrior
 from ..model.problem import Problem, critical_angles, nearest_state
-from .result import PlanOption, PlanResult, choose_indices, plan_actions, short_turns
+from .result import (
+    PlanOption,
+    PlanResult,
+    check_max_actions,
+    choose_indices,
+    plan_actions,
+    short_turns,
+)
 
 __all__ = ["BfsResult", "SearchStats", "plan_bfs", "search_bfs"]
 
@@ -443,8 +450,7 @@ def search_bfs(
     >>> [round(o.expected_cost, 1) for o in res.report.options], res.stats.nodes
     ([6.3, 6.0], 2)
     """
-    if max_actions is not None and max_actions < 1:
-        raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    check_max_actions(max_actions)
     if problem.accuracy > 0:
         # Its action classes assume exact turns; a class margin is only a lower bound on a
         # plan's tolerance, so filtering on it would lose plans the exact planner finds.

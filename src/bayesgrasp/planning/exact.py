@@ -54,6 +54,7 @@ from .result import (
     PlanOption,
     PlanResult,
     PlanStep,
+    check_max_actions,
     choose_among,
     max_plan_length,
     new_result,
@@ -128,10 +129,7 @@ def plan_exact(
     >>> [o.n_actions for o in rep.options], rep.bayes, rep.most_certain
     ([2], 0, 0)
     """
-    if max_actions is not None and (
-        isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1
-    ):
-        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
+    check_max_actions(max_actions)
     if report not in ("all", "best"):
         raise PlanningError(f"`report` must be 'all' or 'best'; got {report!r}")
     if len(problem.actions) == 1 and arcs.FUSED and arcs.few_states(problem.transfers.values()):

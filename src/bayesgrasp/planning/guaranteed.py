@@ -50,10 +50,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..errors import PlanningError
 from ..model.problem import Problem
 from .arcs import Arc, ArcPlanner, chain_option, widest_arc
-from .result import PlanOption, PlanResult, max_plan_length
+from .result import PlanOption, PlanResult, check_max_actions, max_plan_length
 
 __all__ = ["GuaranteedPlan", "plan_guaranteed", "widest_arc"]
 
@@ -141,8 +140,7 @@ def plan_guaranteed(problem: Problem, max_actions: int | None = None) -> Guarant
     >>> g.status, g.reason.split(":")[0]
     ('no-plan', "no guaranteed plan for part 'part' with gripper accuracy 30 deg")
     """
-    if max_actions is not None and max_actions < 1:
-        raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    check_max_actions(max_actions)
     planner = ArcPlanner.for_problem(problem)
     tol, period = planner.tol, planner.period
     # An arc reaches the period to the angle tolerance only. (The symmetry tolerance is a

@@ -110,6 +110,7 @@ from .result import (
     PlanOption,
     PlanResult,
     PlanStep,
+    check_max_actions,
     choose_indices,
     max_plan_length,
     plan_actions,
@@ -815,8 +816,7 @@ def plan_noisy(
     >>> [round(o.option.success_probability, 4) for o in res.options]
     [0.3176, 0.4964]
     """
-    if max_actions is not None and max_actions < 1:
-        raise PlanningError(f"`max_actions` must be at least 1; got {max_actions}")
+    check_max_actions(max_actions)
     if all_lengths and max_actions is None:
         raise PlanningError("`all_lengths` needs `max_actions`")
     if beam < 1 or refine < 1:

@@ -40,6 +40,7 @@ __all__ = [
     "PlanResult",
     "PlanStep",
     "Status",
+    "check_max_actions",
     "choose_among",
     "choose_indices",
     "execute_plan",
@@ -278,6 +279,24 @@ class PlanResult:
 
 PlanReport = PlanResult
 """The former name of :class:`PlanResult`."""
+
+
+def check_max_actions(max_actions: object) -> None:
+    """Refuse a bound on plan lengths that is not an integer >= 1 (``None``: no bound).
+
+    Examples
+    --------
+    >>> check_max_actions(2), check_max_actions(None)
+    (None, None)
+    >>> check_max_actions(0)
+    Traceback (most recent call last):
+    ...
+    bayesgrasp.errors.PlanningError: `max_actions` must be an integer >= 1; got 0
+    """
+    if max_actions is not None and (
+        isinstance(max_actions, bool) or not isinstance(max_actions, int) or max_actions < 1
+    ):
+        raise PlanningError(f"`max_actions` must be an integer >= 1; got {max_actions!r}")
 
 
 def max_plan_length(problem: Problem) -> int:

@@ -217,7 +217,7 @@ class NoisyJointTransitions:
 
 def transitions(space: StateSpace, noise: NoiseModel | None = None) -> Transitions:
     """The action model of a state space: exact, or under ``noise``."""
-    if noise is None or (noise.exact and noise.contact == 0):
+    if noise is None or noise.exact:
         return ExactTransitions(space)
     return NoisyJointTransitions(space, noise)
 

@@ -522,8 +522,10 @@ def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
         raise LimitError(422, f"`trials` is {req.trials}; the limit is {service.limits.max_trials}")
     spec = problem_spec(req)
     p = service.part(req.part)
-    if req.turn_noise is not None and req.noise > 0:
-        raise LimitError(422, "`noise`: give `noise` or `turn_noise`, not both")
+    if req.turn_noise is not None and (req.noise > 0 or req.noise_kind != "normal"):
+        raise LimitError(
+            422, "`noise`, `noise_kind`: the older spelling of `turn_noise`; give one of them"
+        )
     noise = req.noise_model()
     deg, kind = req.noise, req.noise_kind
     if req.turn_noise is None:
@@ -531,7 +533,7 @@ def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
     else:
         deg, kind = float(req.turn_noise.partition(":")[2]), noise.turn.kind
     pay = req.payoff_model()
-    if (not noise.exact or noise.contact > 0 or pay is not None) and req.plan != "guaranteed":
+    if (not noise.exact or pay is not None) and req.plan != "guaranteed":
         _exact_method(req)
         from ..planning.noisy import plan_noisy
 
@@ -692,12 +694,12 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     @app.post(f"{API}/policy", tags=["plans"])
     async def policy(req: PolicyRequest) -> JSONResponse:
         """The Bayes policy that branches on jaw widths (``plan --sense ... --json``)."""
-        return await answer(lambda: policy_document_of(service, req))
+        return await answer(lambda: policy_document_of(service, req), req.noisy)
 
     @app.post(f"{API}/simulate", tags=["plans"])
     async def simulate(req: SimulateRequest) -> JSONResponse:
         """Kinematic executions of a plan (``bayesgrasp simulate --engine kinematic --json``)."""
-        return await answer(lambda: simulate_document(service, req))
+        return await answer(lambda: simulate_document(service, req), req.noisy)
 
     @app.post(
         f"{API}/figures/{{name}}.{{fmt}}",
@@ -751,7 +753,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "policy": lambda: policy_document_of(service, req),
             "simulate": lambda: simulate_document(service, req),
         }
-        return await answer(work[command], isinstance(req, PlanRequest) and req.noisy)
+        return await answer(work[command], bool(getattr(req, "noisy", False)))
 
     @app.get(f"{API}/gallery", tags=["server"])
     async def gallery_rows(limit: int = Query(50, ge=1, le=10_000)) -> dict[str, Any]:
