@@ -123,11 +123,15 @@ def test_noise_keys_and_arguments() -> None:
             "`contact_noise` applies to simulate='kinematic' only",
         ),
         (
-            {"turn_noise": "normal:1", "guaranteed": False, "simulate": "kinematic",
-             "noise_deg": 1.0},
+            {
+                "turn_noise": "normal:1",
+                "guaranteed": False,
+                "simulate": "kinematic",
+                "noise_deg": 1.0,
+            },
             SweepError,
             "simulated under its own turn_noise",
-        ),  # fmt: skip
+        ),
     ],
 )
 def test_bad_noise_options_are_refused(kwargs: dict[str, Any], error: type, match: str) -> None:

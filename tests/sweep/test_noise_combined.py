@@ -151,7 +151,9 @@ def test_policy_with_a_payoff_equals_the_cli(
     options = SweepOptions(guaranteed=False, sense="width", payoff=payoff_file)
     row = plan_part(parts[1], options)
     assert row["status"] == "ok", row["error_message"]
-    want = cli_doc(cli_run, ["plan", parts[1], "--sense", "width", "--payoff", payoff_file, "--json"])
+    want = cli_doc(
+        cli_run, ["plan", parts[1], "--sense", "width", "--payoff", payoff_file, "--json"]
+    )
     assert json.loads(row["policy_json"]) == want
     # the noise-free policy and the payoff-free one differ: the payoff is used
     plain = plan_part(parts[1], SweepOptions(guaranteed=False, sense="width"))
@@ -179,9 +181,7 @@ def same_simulation(row: dict[str, Any], want: dict[str, Any]) -> None:
 def test_kinematic_simulation_under_noise_equals_the_cli(
     parts: list[str], cli_run: CliRun, kwargs: dict[str, Any]
 ) -> None:
-    options = SweepOptions(
-        guaranteed=False, simulate="kinematic", trials=20_000, seed=7, **kwargs
-    )
+    options = SweepOptions(guaranteed=False, simulate="kinematic", trials=20_000, seed=7, **kwargs)
     for r in run_chunk([PartSource(p) for p in parts], options).rows:
         assert r["status"] == "ok", r["error_message"]
         argv = ["simulate", r["path"], *noise_args(options), "--seed", "7", "--trials", "20000"]
@@ -189,7 +189,9 @@ def test_kinematic_simulation_under_noise_equals_the_cli(
         same_simulation(r, want)
         # the row simulates its own noise-aware Bayes plan, predicted exactly under the noise
         doc = json.loads(r["plan_json"])
-        assert r["sim_predicted"] == pytest.approx(doc["options"][doc["bayes"]]["success_probability"])
+        assert r["sim_predicted"] == pytest.approx(
+            doc["options"][doc["bayes"]]["success_probability"]
+        )
         assert abs(r["sim_observed"] - r["sim_predicted"]) < 4 * 0.5 / 20_000**0.5
 
 

@@ -675,9 +675,7 @@ def _policy(
     else:
         from ..planning.policy import plan_policy
 
-        pol = plan_policy(
-            problem, sensor=str(options.sense), max_actions=options.sense_max_actions
-        )
+        pol = plan_policy(problem, sensor=str(options.sense), max_actions=options.sense_max_actions)
     doc = policy_document(pol)
     row.update(
         policy_cost=doc["expected_cost"],
