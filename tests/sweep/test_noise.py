@@ -11,7 +11,6 @@ from typing import Any
 
 import pytest
 
-from bayesgrasp import shapes
 from bayesgrasp.errors import PlanningError
 from bayesgrasp.sweep import SweepError, SweepOptions, plan_part, read_results
 from bayesgrasp.sweep.results import open_results
@@ -19,27 +18,12 @@ from bayesgrasp.sweep.tasks import ROW_COLUMNS, run_chunk
 
 Check = Callable[[list[dict[str, Any]], list[str], SweepOptions], None]
 CliRun = Callable[[list[str]], tuple[int, str, str]]
-PARTS = ("triangle", "rectangle", "key", "hand")
 NOISY = [
     {"turn_noise": "normal:2"},
     {"turn_noise": "uniform:3", "contact_noise": 0.1},
     {"contact_noise": 0.2, "max_actions": 3},
     {"turn_noise": "normal:1", "prior": "vonmises:30,2", "retry_cost": 0.5},
 ]
-
-
-@pytest.fixture(scope="module")
-def parts(tmp_path_factory: pytest.TempPathFactory) -> list[str]:
-    """Catalogue parts as JSON part files."""
-    folder = tmp_path_factory.mktemp("noisy-parts")
-    files = []
-    for name in PARTS:
-        e = shapes.entry(name)
-        doc = {"name": name, "units": e.units, "vertices": [list(v) for v in e.vertices]}
-        f = folder / f"{name}.json"
-        f.write_text(json.dumps(doc))
-        files.append(str(f))
-    return files
 
 
 def noisy(**kwargs: Any) -> SweepOptions:
