@@ -258,3 +258,19 @@ def test_sweep_command_with_noise_guaranteed_sense_and_simulate(
         assert json.loads(r["policy_json"]) == policy
         sim = ["simulate", r["path"], *noise, "--seed", "0", "--trials", "3000", "--json"]
         same_simulation(r, cli_doc(cli_run, sim))
+
+
+def test_report_of_noisy_rows_with_policies_and_simulations(three: list[str]) -> None:
+    from bayesgrasp.sweep.report import report_html
+
+    options = SweepOptions(
+        turn_noise="uniform:3", contact_noise=0.1, sense="width", simulate="kinematic",
+        trials=2000, seed=1,
+    )  # fmt: skip
+    rows = run_chunk([PartSource(p) for p in three], options).rows
+    assert [r["status"] for r in rows] == ["no-plan", "ok", "ok"]
+    page = report_html(rows)
+    assert "<td>noise: turn_noise uniform:3, contact_noise 0.1</td><td>3</td>" in page
+    assert "<td>no guaranteed plan</td><td>1</td>" in page
+    assert "<td>simulated parts</td><td>3</td>" in page
+    assert "sensing policy cost: mean" in page
