@@ -139,3 +139,21 @@ def make_catalogue() -> Callable[[Path, np.random.Generator, int], list[str]]:
 @pytest.fixture
 def cli_run() -> Callable[[list[str]], tuple[int, str, str]]:
     return run_cli
+
+
+#: Catalogue parts of the noise tests (``parts``), in this order.
+NAMED_PARTS = ("triangle", "rectangle", "key", "hand")
+
+
+@pytest.fixture(scope="module")
+def parts(tmp_path_factory: pytest.TempPathFactory) -> list[str]:
+    """Catalogue parts as JSON part files (:data:`NAMED_PARTS`, in order)."""
+    folder = tmp_path_factory.mktemp("named-parts")
+    files = []
+    for name in NAMED_PARTS:
+        e = shapes.entry(name)
+        doc = {"name": name, "units": e.units, "vertices": [list(v) for v in e.vertices]}
+        f = folder / f"{name}.json"
+        f.write_text(json.dumps(doc))
+        files.append(str(f))
+    return files

@@ -11,7 +11,6 @@ from typing import Any
 
 import pytest
 
-from bayesgrasp import shapes
 from bayesgrasp.errors import PlanningError
 from bayesgrasp.sweep import SweepError, SweepOptions, plan_part, read_results
 from bayesgrasp.sweep.results import open_results
@@ -19,27 +18,12 @@ from bayesgrasp.sweep.tasks import ROW_COLUMNS, run_chunk
 
 Check = Callable[[list[dict[str, Any]], list[str], SweepOptions], None]
 CliRun = Callable[[list[str]], tuple[int, str, str]]
-PARTS = ("triangle", "rectangle", "key", "hand")
 NOISY = [
     {"turn_noise": "normal:2"},
     {"turn_noise": "uniform:3", "contact_noise": 0.1},
     {"contact_noise": 0.2, "max_actions": 3},
     {"turn_noise": "normal:1", "prior": "vonmises:30,2", "retry_cost": 0.5},
 ]
-
-
-@pytest.fixture(scope="module")
-def parts(tmp_path_factory: pytest.TempPathFactory) -> list[str]:
-    """Catalogue parts as JSON part files."""
-    folder = tmp_path_factory.mktemp("noisy-parts")
-    files = []
-    for name in PARTS:
-        e = shapes.entry(name)
-        doc = {"name": name, "units": e.units, "vertices": [list(v) for v in e.vertices]}
-        f = folder / f"{name}.json"
-        f.write_text(json.dumps(doc))
-        files.append(str(f))
-    return files
 
 
 def noisy(**kwargs: Any) -> SweepOptions:
@@ -111,18 +95,27 @@ def test_noise_keys_and_arguments() -> None:
         ({"turn_noise": "gauss:1", "guaranteed": False}, PlanningError, "normal:SIGMA_DEG"),
         ({"contact_noise": 1.5, "guaranteed": False}, SweepError, "contact_noise"),
         ({"contact_noise": math.nan, "guaranteed": False}, SweepError, "contact_noise"),
-        ({"turn_noise": "normal:1"}, SweepError, "takes no guaranteed"),
+        ({"turn_noise": "normal:1"}, SweepError, "`guaranteed`: no plan of two or more"),
         (
             {"turn_noise": "normal:1", "guaranteed": False, "method": "bfs"},
             SweepError,
-            "method='bfs'",
+            "seeds from the exact planner; drop method='bfs'",
         ),
         (
-            {"contact_noise": 0.1, "guaranteed": False, "simulate": "kinematic"},
+            {"contact_noise": 0.1, "guaranteed": False, "simulate": "mujoco"},
             SweepError,
-            "takes no simulate",
+            "`contact_noise` applies to simulate='kinematic' only",
         ),
-        ({"payoff": "u.json", "guaranteed": False, "sense": "width"}, SweepError, "sense"),
+        (
+            {
+                "turn_noise": "normal:1",
+                "guaranteed": False,
+                "simulate": "kinematic",
+                "noise_deg": 1.0,
+            },
+            SweepError,
+            "simulated under its own turn_noise",
+        ),
     ],
 )
 def test_bad_noise_options_are_refused(kwargs: dict[str, Any], error: type, match: str) -> None:
@@ -222,10 +215,9 @@ def test_local_cluster_sweep_with_a_payoff_equals_plan(
     [
         (["--turn-noise", "gauss:1"], "normal:SIGMA_DEG or uniform:A_DEG"),
         (["--contact-noise", "2"], "--contact-noise"),
-        (["--turn-noise", "normal:1", "--guaranteed"], "--guaranteed: not with --turn-noise"),
-        (["--payoff", "u.json", "--sense", "width"], "--sense: not with"),
-        (["--contact-noise", "0.1", "--method", "bfs"], "--method bfs: not with"),
-        (["--contact-noise", "0.1", "--simulate", "kinematic"], "--simulate: not with"),
+        (["--turn-noise", "normal:1", "--guaranteed"], "no plan of two or more actions can"),
+        (["--contact-noise", "0.1", "--method", "bfs"], "seeds from the exact planner"),
+        (["--contact-noise", "0.1", "--simulate", "mujoco"], "the physics' own"),
         (["--payoff", "missing.json"], "missing.json: no such file"),
         (["--output-format", "csv", "--format", "parquet"], "give --output-format only"),
     ],

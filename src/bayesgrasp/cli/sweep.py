@@ -136,7 +136,11 @@ def sweep(
     (`dask scheduler` / `dask worker`).
 
     With --turn-noise, --contact-noise or --payoff each row is the noise-aware Bayes plan
-    (as plan PATH --turn-noise ...), without a guaranteed plan, --sense or --simulate.
+    (as plan PATH --turn-noise ...); --guaranteed adds the plan guaranteed under a uniform
+    turn error (normal noise has no bound to guarantee under), --sense the policy under the
+    noisy actions (as plan PATH --sense S --turn-noise ...), and --simulate executes the
+    noise-aware plan under the noise (as simulate PATH --turn-noise ...; MuJoCo takes no
+    --contact-noise, its contacts are the physics' own).
     --resume continues a RESULTS planned with the same options only.
     """
     from ..sweep import SweepInterrupted, SweepOptions, run_sweep, write_report
@@ -149,25 +153,25 @@ def sweep(
         csv = out.suffix.lower() == ".csv" and not out.is_dir()
         fmt = ResultFormat.csv if csv else ResultFormat.parquet
     noisy = not (turn_noise is None and contact_noise is None and payoff is None)
-    if noisy:
-        given = [
-            flag
-            for flag, on in (
-                ("--guaranteed", guaranteed),
-                ("--sense", sense is not None),
-                ("--simulate", simulate is not None),
-                ("--method bfs", spec.method.value != "exact"),
-            )
-            if on
-        ]
-        if given:
-            raise typer.BadParameter(
-                f"{', '.join(given)}: not with --turn-noise, --contact-noise or --payoff yet"
-            )
+    if noisy and spec.method.value != "exact":
+        raise typer.BadParameter(
+            "the noise-aware planner seeds from the exact planner; drop --method",
+            param_hint="--method",
+        )
+    if contact_noise is not None and simulate is Engine.mujoco:
+        raise typer.BadParameter(
+            "applies to the kinematic engine only: in MuJoCo the jaws' contacts are the "
+            "physics' own",
+            param_hint="--contact-noise",
+        )
     if turn_noise is not None:
         from .noisy import turn_noise as parse_turn
 
-        parse_turn(turn_noise)  # a malformed spec: one line, exit 2
+        turn = parse_turn(turn_noise)  # a malformed spec: one line, exit 2
+        if guaranteed and not turn.exact and turn.kind == "normal":
+            from ..planning.robust import UNBOUNDED_GUARANTEE
+
+            raise typer.BadParameter(UNBOUNDED_GUARANTEE, param_hint="--guaranteed")
     extra = () if payoff is None else (str(payoff),)
     inputs = input_files(None, spec.prior, *paths, *extra)  # RESULTS: its own --resume/--force
     check_outputs([out], inputs, force=True, hint="--out", folders=True)

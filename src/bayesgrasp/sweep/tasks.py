@@ -31,6 +31,7 @@ from ..errors import BayesGraspError
 from ..model.prior import Prior, parse_prior
 
 if TYPE_CHECKING:
+    from ..model.noise import NoiseModel
     from ..model.payoff import Payoff
 
 __all__ = [
@@ -133,9 +134,17 @@ class SweepOptions:
 
         With any of these three, each part's plan is the noise-aware Bayes plan
         (:func:`~bayesgrasp.planning.noisy.plan_noisy`), its row ``plan_json`` the document
-        ``plan PATH --turn-noise ... --json`` prints; they take the exact method and no
-        guaranteed plan, sensing policy or simulation. Left out of :meth:`to_json` when not
-        given, so the keys of sweeps run before them still resume.
+        ``plan PATH --turn-noise ... --json`` prints. That planner seeds from the exact
+        planner, so ``method`` must be ``"exact"``. ``guaranteed`` asks for the plan that
+        succeeds under every turn error within the bound
+        (:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`), refused under a normal
+        turn error, which has no bound; turn it off for those. ``sense`` plans the policy
+        under the noisy actions (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`,
+        ``plan PATH --sense S --turn-noise ... --json``); ``simulate`` executes the
+        noise-aware Bayes plan under the noise and predicts it exactly (``simulate PATH
+        --turn-noise ... --json``; ``noise_deg`` stays 0, and MuJoCo takes no
+        ``contact_noise``: its contacts are the physics' own). Left out of :meth:`to_json`
+        when not given, so the keys of sweeps run before them still resume.
 
     Examples
     --------
@@ -231,20 +240,27 @@ class SweepOptions:
             raise SweepError(f"`payoff` must be the path of a payoff file; got {self.payoff!r}")
         if not self.noisy:
             return
-        refused = [
-            name
-            for name, given in (
-                ("method='bfs'", self.method != "exact"),
-                ("guaranteed", self.guaranteed),
-                ("sense", self.sense is not None),
-                ("simulate", self.simulate is not None),
-            )
-            if given
-        ]
-        if refused:
+        if self.method != "exact":
             raise SweepError(
-                "turn_noise, contact_noise and payoff plan with the noise-aware planner, which "
-                f"takes no {', '.join(refused)} yet"
+                "the noise-aware planner (turn_noise, contact_noise, payoff) seeds from the "
+                "exact planner; drop method='bfs'"
+            )
+        if self.guaranteed and self.turn_noise is not None:
+            from ..model.noise import parse_turn_noise
+            from ..planning.robust import UNBOUNDED_GUARANTEE
+
+            turn = parse_turn_noise(self.turn_noise)
+            if not turn.exact and turn.kind == "normal":
+                raise SweepError(f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
+        if self.noise_deg or self.noise_kind != "normal":
+            raise SweepError(
+                "`noise_deg` and `noise_kind` are the turn error of a simulation of the exact "
+                "plan; the noise-aware plan is simulated under its own turn_noise"
+            )
+        if self.simulate == "mujoco" and self.contact_noise is not None:
+            raise SweepError(
+                "`contact_noise` applies to simulate='kinematic' only: in MuJoCo the jaws' "
+                "contacts are the physics' own"
             )
 
     @property
@@ -548,33 +564,61 @@ def _plan(
     return rep, doc, "ok" if missing is None else "no-plan"
 
 
-def _plan_noisy(
-    pb: Any, options: SweepOptions, payoff: Payoff | None, given: dict[str, Any]
-) -> tuple[Any, dict[str, Any], str]:
-    """The noise-aware Bayes plan and ``plan --turn-noise ... --json``'s document."""
-    from ..cli.noisy import noisy_document
+def _noise(options: SweepOptions) -> NoiseModel:
+    """The noise model of ``turn_noise`` and ``contact_noise`` (none when not given)."""
     from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
-    from ..planning.noisy import plan_noisy
 
+    turn = TurnNoise() if options.turn_noise is None else parse_turn_noise(options.turn_noise)
+    return NoiseModel(turn, options.contact_noise or 0.0)
+
+
+def _read_payoff(options: SweepOptions, payoff: Payoff | None) -> Payoff | None:
+    """``options.payoff``, read here unless the client has read it."""
     if payoff is None and options.payoff is not None:
         from ..model.payoff import read_payoff
 
-        payoff = read_payoff(options.payoff)
-    turn = TurnNoise() if options.turn_noise is None else parse_turn_noise(options.turn_noise)
-    noise = NoiseModel(turn, options.contact_noise or 0.0)
-    res = plan_noisy(pb, noise, payoff, options.max_actions)
-    return res, noisy_document(res, inputs=given), "ok"
+        return read_payoff(options.payoff)
+    return payoff
+
+
+def _plan_noisy(
+    pb: Any, options: SweepOptions, payoff: Payoff | None, given: dict[str, Any]
+) -> tuple[Any, dict[str, Any], str]:
+    """The noise-aware Bayes plan and ``plan --turn-noise ... --json``'s document.
+
+    With ``guaranteed``, also the plan guaranteed under the (bounded) noise, as ``plan
+    --turn-noise uniform:A --guaranteed`` (status ``no-plan`` when there is none).
+    """
+    from ..cli.noisy import NoisyRun
+
+    run = NoisyRun(_noise(options), payoff, options.max_actions, False, options.guaranteed)
+    done = run.plan(pb)
+    return done[0], run.document(done, given), "no-plan" if isinstance(done[1], str) else "ok"
 
 
 def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
-    """The ``bayesgrasp.simulate/1`` document of the Bayes plan's execution."""
+    """The ``bayesgrasp.simulate/1`` document of the Bayes plan's execution.
+
+    Under noise or a payoff ``rep`` is the noise-aware result: its Bayes plan runs under the
+    noise and is predicted exactly under it (and judged by the payoff), as ``bayesgrasp
+    simulate PATH --turn-noise ... --json`` does.
+    """
     from .. import report
     from ..sim.kinematic import GripperNoise, simulate_kinematic
 
     pb, option = rep.problem, rep.bayes_plan
-    noise = GripperNoise(options.noise_kind, math.radians(options.noise_deg))  # type: ignore[arg-type]
+    noise: Any = GripperNoise(options.noise_kind, math.radians(options.noise_deg))  # type: ignore[arg-type]
+    deg, kind, u, model = options.noise_deg, options.noise_kind, None, None
+    if options.noisy:
+        model, u, option = _noise(options), rep.payoff, rep.bayes_plan.option
+        noise = GripperNoise.of(model.turn)
+        kind = model.turn.kind
+        deg = 0.0 if options.turn_noise is None else float(options.turn_noise.partition(":")[2])
     if options.simulate == "kinematic":
-        res = simulate_kinematic(pb, option, options.n_trials, noise, rng=options.seed)
+        res = simulate_kinematic(
+            pb, option, options.n_trials, noise if model is None else model, rng=options.seed,
+            payoff=u,
+        )  # fmt: skip
     else:
         from ..sim import simulate_mujoco
 
@@ -587,25 +631,51 @@ def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
             rng=options.seed,
             workers=1,
         )
+        if model is not None and (not model.exact or u is not None):
+            from ..sim.result import with_prediction
+
+            res = with_prediction(res, pb, model, u)  # MuJoCo drew the turn error
     from ..cli.common import simulate_inputs
     from ..io.plans import provenance
 
     doc = report.simulate_json(res, pb.part)  # with the provenance `bayesgrasp simulate` writes
     how = simulate_inputs(
-        str(options.simulate), "bayes", options.seed, options.n_trials, options.noise_deg,
-        options.noise_kind, options.offset_mm, None, 1 if options.simulate == "mujoco" else None,
+        str(options.simulate), "bayes", options.seed, options.n_trials, deg, kind,
+        options.offset_mm, None, 1 if options.simulate == "mujoco" else None,
     )  # fmt: skip
+    if options.noisy:
+        how |= {"contact_noise": options.contact_noise, "payoff": options.payoff}
     given = {"max_actions": options.max_actions, "layer": options.layer}
     doc["provenance"] = provenance(pb, None, **how, **given, flatten_tolerance=options.flatten_tol)
     return doc
 
 
-def _policy(row: dict[str, Any], problem: Any, options: SweepOptions) -> None:
-    """The ``policy_*`` columns: the part's Bayes sensing policy (``plan --sense --json``)."""
-    from ..io.policies import policy_document
-    from ..planning.policy import plan_policy
+def _policy(
+    row: dict[str, Any], problem: Any, options: SweepOptions, payoff: Payoff | None = None
+) -> None:
+    """The ``policy_*`` columns: the part's Bayes sensing policy (``plan --sense --json``).
 
-    pol = plan_policy(problem, sensor=str(options.sense), max_actions=options.sense_max_actions)
+    Under noise or a payoff the policy is planned under the noisy actions (and judged by
+    the payoff), as ``plan PATH --sense S --turn-noise ... --json``.
+    """
+    from ..io.policies import policy_document
+
+    if options.noisy:
+        from ..planning.noisy_policy import plan_noisy_policy
+
+        noisy = options.turn_noise is not None or options.contact_noise is not None
+        pol = plan_noisy_policy(
+            [problem],
+            str(options.sense),
+            options.sense_max_actions,
+            _noise(options) if noisy else None,
+            payoff=payoff,
+            part_prior=None,
+        )
+    else:
+        from ..planning.policy import plan_policy
+
+        pol = plan_policy(problem, sensor=str(options.sense), max_actions=options.sense_max_actions)
     doc = policy_document(pol)
     row.update(
         policy_cost=doc["expected_cost"],
@@ -691,6 +761,7 @@ def plan_part(
         part, digest = _read_part(source, options)
         if digest:
             row.update(sha256=digest, part_id=part_id(source.path, digest))
+        payoff = _read_payoff(options, payoff)
         rep, doc, status = _plan(part, options, prior or parse_prior(options.prior), payoff)
         _fill(row, part, doc)
         row["status"] = status
@@ -699,7 +770,7 @@ def plan_part(
         return _error(row, exc)
     if options.sense is not None:
         try:
-            _policy(row, rep.problem, options)
+            _policy(row, rep.problem, options, payoff)
         except Exception as exc:  # the plan columns stay; the message says which step failed
             _error(row, exc)
             row["error_message"] = f"sensing policy: {row['error_message']}"
