@@ -309,6 +309,26 @@ class NoiseModel:
             raise PlanningError(f"`contact` noise must be a probability in [0, 1]; got {q!r}")
         object.__setattr__(self, "contact", float(q))
 
+    @classmethod
+    def of(cls, turn: str | None = None, contact: float | None = None) -> NoiseModel:
+        """The model of the options ``--turn-noise TURN`` and ``--contact-noise CONTACT``.
+
+        Either may be ``None`` (not given: exact turns, simultaneous contacts).
+
+        Raises
+        ------
+        PlanningError
+            A malformed turn error or a contact probability outside [0, 1].
+
+        Examples
+        --------
+        >>> NoiseModel.of("uniform:2", 0.1).describe()
+        'turn error uniform:2 deg, contact asynchrony q=0.1'
+        >>> NoiseModel.of().exact
+        True
+        """
+        return cls(TurnNoise() if turn is None else parse_turn_noise(turn), contact or 0.0)
+
     @property
     def exact(self) -> bool:
         """Whether the model adds no noise at all."""

@@ -566,10 +566,9 @@ def _plan(
 
 def _noise(options: SweepOptions) -> NoiseModel:
     """The noise model of ``turn_noise`` and ``contact_noise`` (none when not given)."""
-    from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
+    from ..model.noise import NoiseModel
 
-    turn = TurnNoise() if options.turn_noise is None else parse_turn_noise(options.turn_noise)
-    return NoiseModel(turn, options.contact_noise or 0.0)
+    return NoiseModel.of(options.turn_noise, options.contact_noise)
 
 
 def _read_payoff(options: SweepOptions, payoff: Payoff | None) -> Payoff | None:

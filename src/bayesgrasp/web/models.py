@@ -214,10 +214,9 @@ class NoiseOptions(ProblemOptions):
 
     def noise_model(self) -> Any:
         """The :class:`~bayesgrasp.model.noise.NoiseModel` of the options."""
-        from ..model.noise import NoiseModel, TurnNoise, parse_turn_noise
+        from ..model.noise import NoiseModel
 
-        turn = TurnNoise() if self.turn_noise is None else parse_turn_noise(self.turn_noise)
-        return NoiseModel(turn, self.contact_noise or 0.0)
+        return NoiseModel.of(self.turn_noise, self.contact_noise)
 
     def payoff_model(self) -> Any:
         """The :class:`~bayesgrasp.model.payoff.Payoff` given inline, or ``None``."""
