@@ -39,7 +39,6 @@ from bayesgrasp.io.machine import (
     ROBOT_POLICY_SCHEMA,
     machine_csv,
     machine_document,
-    plan_chain,
     plan_machine,
     policy_machine,
 )
@@ -49,6 +48,7 @@ from bayesgrasp.model.problem import nearest_state
 from bayesgrasp.model.sensing import parse_sensor
 from bayesgrasp.planning.policy import Declare, Policy, PolicyNode, Reject, plan_policy
 from bayesgrasp.planning.result import PlanOption, PlanStep
+from bayesgrasp.planning.strategy import plan_strategy
 from bayesgrasp.sim.kinematic import sample_prior
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
@@ -315,7 +315,7 @@ def test_a_plan_through_the_machine_has_the_plan_exports_angles(
     # the chain run as a policy on exact readings succeeds as the plan claims
     p = plan.success_probability
     sensor = parse_sensor("width")
-    chain = Policy(plan_chain(pb, plan), (pb.part.name,), (1.0,), sensor, 9, 1.0, p, 1, 0, 1, ())
+    chain = Policy(plan_strategy(pb, plan), (pb.part.name,), (1.0,), sensor, 9, 1.0, p, 1, 0, 1, ())
     ok, declared = run_file([pb], chain, table, 3000, seed=2)
     assert declared == 3000
     assert abs(ok / 3000 - p) <= 4.5 * math.sqrt(p * (1 - p) / 3000) + 1e-9

@@ -80,7 +80,7 @@ from scipy.special import ndtr
 from ..errors import ExportError
 from ..model.problem import Problem
 from ..model.sensing import WidthSensor
-from ..planning.policy import Branch, Declare, Policy, PolicyNode, Reject
+from ..planning.policy import Branch, Policy, PolicyNode, Reject
 from ..planning.result import PlanOption
 from .export import GripperAngles, wrap_angle
 from .plans import json_float
@@ -411,18 +411,6 @@ def policy_machine(problems: Problem | Iterable[Problem], policy: Policy) -> Rob
     return _build(pbs, policy.root, policy.part_prior, policy.sensor, figures)
 
 
-def plan_chain(problem: Problem, option: PlanOption) -> PolicyNode:
-    """A linear plan as a policy tree: one branch on every reading, then declare the goal."""
-    nxt: PolicyNode | Declare = Declare(
-        0, problem.part.name, option.final_orientation, option.success_probability
-    )
-    for st in reversed(option.steps):
-        nxt = PolicyNode(st, (Branch(-math.inf, math.inf, 1.0, nxt),))
-    if not isinstance(nxt, PolicyNode):  # pragma: no cover - a plan has an action
-        raise ExportError("a plan without actions has no robot program")
-    return nxt
-
-
 def plan_machine(problem: Problem, option: PlanOption) -> RobotMachine:
     """A linear plan as a state machine: one transition a state (every reading), then declare.
 
@@ -442,7 +430,9 @@ def plan_machine(problem: Problem, option: PlanOption) -> RobotMachine:
         "expected_cost": json_float(option.expected_cost),
         "success_probability": json_float(option.success_probability),
     }
-    root = plan_chain(problem, option)
+    from ..planning.strategy import plan_strategy
+
+    root = plan_strategy(problem, option)
     return _build((problem,), root, (1.0,), WidthSensor(), figures)
 
 
