@@ -363,6 +363,9 @@ def test_mujoco_results_are_predicted_under_the_noise(
         (["--engine", "mujoco", "--contact-noise", "0.2", "--sense", "width"], "physics' own"),
         (["--payoff", "missing.json", "--sense", "width"], "no such file"),
         (["--turn-noise", "normal:1", "--method", "bfs"], "drop --method"),
+        (["--units", "mm"], "mujoco only"),
+        (["--sense", "width", "--plan", "most-certain"], "Bayes policy is planned"),
+        (["--plan", "guaranteed", "--turn-noise", "normal:1"], "unbounded"),
     ],
 )
 def test_bad_options_exit_2(
@@ -430,3 +433,18 @@ def test_the_payoff_interval_holds_the_mean(values: list[float], seed: int) -> N
     if set(values) <= {0.0, 1.0}:
         assert_allclose(res.payoff_interval(), res.ci95, atol=1e-12)
         assert_allclose(res.payoff_interval(4.0), res.success_interval, atol=1e-12)
+
+
+def test_simulate_runs_the_guaranteed_plan_plan_gives_under_bounded_noise(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``simulate --plan guaranteed`` under a uniform turn error runs ``plan --guaranteed``'s
+    plan for that error: its prediction is the plan's, the trials agree, and none jams."""
+    assert main(["plan", "key", "--turn-noise", "uniform:1", "--guaranteed", "--json"]) == 0
+    sure = json.loads(capsys.readouterr().out)["guaranteed"]
+    args = ["simulate", "key", "--plan", "guaranteed", "--turn-noise", "uniform:1"]
+    assert main([*args, "--trials", "20000", "--seed", "2", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["plan"]["steps"] == sure["steps"]
+    assert doc["predicted_success"] == pytest.approx(sure["success_probability"], abs=1e-12)
+    assert doc["agrees"] and doc["jams"] == 0

@@ -163,6 +163,11 @@ def simulate(
     from ..sim.result import verdict_lines
     from ..sim.scene import units_scale
 
+    if engine is Engine.kinematic and units is not None:
+        raise typer.BadParameter(
+            "applies to --engine mujoco only (the kinematic model has no sizes)",
+            param_hint="--units",
+        )
     if engine is Engine.kinematic and offset > 0:
         raise typer.BadParameter(
             "applies to --engine mujoco only (the kinematic model has no positions)",

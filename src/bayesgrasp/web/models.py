@@ -250,7 +250,13 @@ class SimulateRequest(NoiseOptions):
 
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
     trials: int = Field(100_000, ge=1, description="Executions (bounded by the server's limit).")
-    noise: float = Field(0.0, ge=0, le=180, description="Gripper angle error, deg.")
+    noise: float = Field(
+        0.0,
+        ge=0,
+        lt=90,
+        description="Gripper angle error, deg (the older spelling of `turn_noise`: "
+        "`noise_kind:noise`; an error of 90 deg or more hides every orientation).",
+    )
     noise_kind: Literal["normal", "uniform"] = "normal"
     seed: int = Field(0, ge=0, le=2**63 - 1)
 
