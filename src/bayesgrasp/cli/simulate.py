@@ -192,8 +192,6 @@ def simulate(
             param_hint="--contact-noise",
         )
     if sense is not None:
-        if jaw_lag:
-            raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
         from .sensing import ActionModel, simulate_policy_command
 
         model, _, _ = _noise_model(noise, noise_kind, turn_noise, contact_noise)
@@ -202,7 +200,7 @@ def simulate(
         sensing = sense_spec(sense, also or (), part_prior, spec)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
-            sensor_error, as_json, action,
+            sensor_error, as_json, action, jaw_lag,
         )  # fmt: skip
         return
     if also or part_prior is not None or sensor_error:
