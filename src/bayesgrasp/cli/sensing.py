@@ -218,11 +218,12 @@ def plot_policy_command(
     out: Path,
     formats: list[str],
     as_json: bool,
+    noise: ActionModel | None = None,
 ) -> None:
-    """Plan the Bayes policy and draw its tree into ``out/policy.FORMAT``."""
+    """Plan the Bayes policy (under ``noise`` if given) and draw its tree into ``out/policy.*``."""
     from ..figures.policy import policy_figure
 
-    problems, pol = sensing.policy(sensing.parts(part), spec)
+    problems, pol = plan_sensing_policy(sensing, sensing.parts(part), spec, noise)
     fig = policy_figure(problems, pol)
     files = []
     try:
