@@ -351,6 +351,8 @@ def test_mujoco_policy_takes_the_jaw_lag(monkeypatch: pytest.MonkeyPatch) -> Non
     for side in (-1, 1):
         assert not any(at_push_grasp(acts, side))
     assert plain.cycles == one.cycles == 12
+    assert policy_simulation_json(one)["jaw_lag_s"] == lag
+    assert "jaw_lag_s" not in policy_simulation_json(plain)
 
 
 def test_cli_jaw_lag_reaches_the_policy_simulation(

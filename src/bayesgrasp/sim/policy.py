@@ -124,6 +124,9 @@ class PolicySimulation:
         nearest to where the part ended (MuJoCo: of the actions that did not jam).
     seconds : float
         Wall time.
+    jaw_lag : float
+        MuJoCo: seconds by which one jaw of each squeeze led
+        (:attr:`~bayesgrasp.sim.params.SimParams.jaw_lag`; 0: together).
     """
 
     engine: str
@@ -137,6 +140,7 @@ class PolicySimulation:
     success: BoolArray
     reading_errors: FloatArray
     seconds: float
+    jaw_lag: float = 0.0
 
     @property
     def observed_success(self) -> float:
@@ -633,6 +637,7 @@ def simulate_policy_mujoco(
         ok,
         np.array([e for o in outs for e in o.errors], dtype=np.float64),
         time.perf_counter() - t0,
+        params.jaw_lag,
     )
 
 
@@ -674,7 +679,8 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
     """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals.
 
     A policy planned under noisy actions adds ``noise`` (the model its figures are exact
-    under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`).
+    under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`); a MuJoCo run with a jaw lag
+    adds ``jaw_lag_s``.
     """
     e = sim.reading_errors if len(sim.reading_errors) else np.full(1, math.nan)
     keys = ["success_probability", "cycle_cost", "expected_actions", "expected_cost"]
@@ -688,6 +694,7 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
         "parts": list(sim.policy.parts),
         "sensor": sim.policy.sensor.to_json(),
         **({} if sim.policy.noise is None else {"noise": sim.policy.noise.to_json()}),
+        **({"jaw_lag_s": sim.jaw_lag} if sim.jaw_lag > 0 else {}),
         "cycles": sim.cycles,
         "successes": sim.successes,
         "rejects": sim.rejects,
