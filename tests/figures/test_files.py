@@ -181,3 +181,66 @@ def test_plan_plot_from_a_fresh_process(tmp_path: Path) -> None:
     assert run.returncode == 0, run.stderr
     assert "Bayes plan" in run.stdout
     assert is_png(tmp_path / "plan.png")
+
+
+def test_write_figures_under_noise(tmp_path: Path) -> None:
+    """Under a noise model: the plan figure's stems are the exact distributions under it,
+    its title and the animation's caption say the noise, the part's figures are unchanged.
+
+    The exact distributions are checked against 100,000 sampled executions drawing the turn
+    error (:func:`~bayesgrasp.sim.kinematic.simulate_kinematic`), within 4 standard errors.
+    """
+    import math
+
+    import numpy as np
+
+    from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    from bayesgrasp.planning.noisy import plan_noisy
+    from bayesgrasp.sim.kinematic import simulate_kinematic
+
+    pb = Problem.build(load("key"))
+    noise = NoiseModel(TurnNoise("normal", math.radians(3.0)), 0.05)
+    res = plan_noisy(pb, noise)
+    option = res.bayes_plan.option
+    figures: dict[str, Any] = {}
+    real = bayesgrasp.figures.files.evolution_figure
+
+    def kept(*args: Any, **kwargs: Any) -> Any:
+        fig = real(*args, **kwargs)
+        figures.setdefault("plan", fig)  # the first: the noisy run's
+        return fig
+
+    anims: list[Any] = []
+    real_anim = bayesgrasp.figures.files.plan_animation
+
+    def kept_anim(*args: Any, **kwargs: Any) -> Any:
+        anims.append(real_anim(*args, **kwargs))
+        return anims[-1]
+
+    patch = pytest.MonkeyPatch()
+    patch.setattr(bayesgrasp.figures.files, "evolution_figure", kept)
+    patch.setattr(bayesgrasp.figures.files, "plan_animation", kept_anim)
+    try:
+        files = write_figures(
+            pb, option, tmp_path / "noisy", "Bayes", ("png",), frames_per_step=4, noise=noise
+        )
+        plain = write_figures(pb, option, tmp_path / "plain", "Bayes", ("png",), animation=False)
+    finally:
+        patch.undo()
+    assert [f.name for f in files] == [*(p.name for p in plain), "plan.gif"]
+    for name in ("part.png", "diameter.png", "transfer.png"):
+        assert (tmp_path / "noisy" / name).read_bytes() == (tmp_path / "plain" / name).read_bytes()
+    fig = figures["plan"]
+    assert "exact under turn error normal:3 deg, contact asynchrony q=0.05" in fig.get_suptitle()
+    assert f"P(success) = {option.success_probability:.3f}" in fig.get_suptitle()
+    (caption,) = [t for t in anims[0].figure.texts if "P(success)" in t.get_text()]
+    assert "exact under turn error normal:3 deg" in caption.get_text()
+    last = fig.axes[-1]
+    (stems,) = [c for c in last.collections if c.get_gid() == "distribution"]
+    drawn = {round(float(s[0][0]), 6): float(s[1][1]) for s in stems.get_segments()}
+    n = 100_000
+    sim = simulate_kinematic(pb, option, n, noise, rng=5)
+    for deg, count in zip(np.degrees(pb.states.stable), sim.observed, strict=True):
+        exact = drawn.get(round(float(deg), 6), 0.0)
+        sd = math.sqrt(max(exact * (1 - exact), 1e-6) / n)
+        assert abs(count / n - exact) <= 4 * sd, (deg, count / n, exact)

@@ -143,3 +143,30 @@ class NoPlan:
 def test_plan_figure_of_a_result_without_a_plan(bracket_problem: Problem) -> None:
     with pytest.raises(PlanningError, match="no plan to draw: no plan reaches the goal within 2"):
         plan_figure(NoPlan(bracket_problem))  # type: ignore[arg-type]
+
+
+def test_evolution_figure_under_noise_is_the_bottom_of_the_noisy_plan_figure() -> None:
+    """The distributions and note given draw the panels ``noisy_plan_figure`` draws."""
+    from bayesgrasp.figures.plans import noise_note, noisy_plan_figure
+    from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    from bayesgrasp.planning.noisy import plan_noisy, step_distributions_noisy
+
+    pb = Problem.build(load("key"))
+    noise = NoiseModel(TurnNoise("uniform", math.radians(4.0)))
+    res = plan_noisy(pb, noise)
+    option = res.bayes_plan.option
+    qs = step_distributions_noisy(pb, noise, option.steps)
+    alone = evolution_figure(pb, option, "Bayes", qs, noise_note(noise))
+    below = noisy_plan_figure(res).subfigs[1]
+    assert alone.get_suptitle() == below.get_suptitle()
+    assert "exact under turn error uniform:4 deg" in alone.get_suptitle()
+    assert len(alone.axes) == len(below.axes) == option.n_actions + 1
+    for a, b in zip(alone.axes, below.axes, strict=True):
+        assert a.get_title() == b.get_title()
+        sa = [c.get_segments() for c in a.collections if c.get_gid() == "distribution"]
+        sb = [c.get_segments() for c in b.collections if c.get_gid() == "distribution"]
+        assert_allclose(np.asarray(sa, dtype=float), np.asarray(sb, dtype=float), atol=0)
+    (stems,) = [c for c in alone.axes[-1].collections if c.get_gid() == "distribution"]
+    tops = sorted(float(s[1][1]) for s in stems.get_segments())
+    q = res.bayes_plan.evaluation.distribution
+    assert_allclose(tops, np.sort(q[q > 0]), atol=1e-12)

@@ -77,3 +77,22 @@ def test_cli_plot_sense(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
     assert (out / "policy.png").stat().st_size > 1000
     assert main(["plot", "house", "--also", "key", "--out", str(out)]) == 2
     assert "need --sense" in capsys.readouterr().err
+
+
+def test_a_payoff_policy_says_its_cost_is_per_unit_payoff() -> None:
+    from bayesgrasp.figures.policy import policy_figure
+    from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    from bayesgrasp.planning.noisy_policy import plan_noisy_policy
+
+    pb = Problem.build(shapes.load("key"))
+    states = pb.states.stable
+    payoff = np.where(np.isclose(np.degrees(states), 80.63, atol=0.05), 1.0, 0.0)
+    payoff[np.isclose(np.degrees(states), 260.63, atol=0.05)] = 0.5
+    noise = NoiseModel(TurnNoise("normal", math.radians(2.0)))
+    pol = plan_noisy_policy(pb, "width:0.5,0.1", 2, noise, payoff=payoff)
+    title = policy_figure(pb, pol).axes[0].get_title()
+    assert f"expected cost {pol.expected_cost:.3f} per unit payoff" in title
+    assert f"(expected payoff {pol.success_probability:.3f} a cycle)" in title
+    assert "under turn error normal:2 deg (exact figures)" in title
+    plain = policy_figure(pb, plan_policy(pb, "width:0.5,0.1", 2)).axes[0].get_title()
+    assert "payoff" not in plain and "(success " in plain

@@ -279,3 +279,112 @@ def test_mujoco_runs_a_policy_planned_under_turn_noise() -> None:
     sim = simulate_policy_mujoco(pb, pol, 80, noise=GripperNoise.of(turn), rng=6, workers=2)
     lo, hi = sim.success_interval
     assert lo - sim.jams / sim.cycles <= pol.success_probability <= hi + 1e-9
+
+
+@pytest.mark.physics
+@pytest.mark.skipif(
+    not HAVE_MUJOCO, reason="MuJoCo is not installed: pip install 'bayesgrasp[sim]'"
+)
+def test_mujoco_policy_takes_the_jaw_lag(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A jaw lag of 4 s (a 20 mm push by the leading jaw) reaches every squeeze of a policy.
+
+    Each squeeze gets a leading jaw (-1 or +1) drawn from the seed with the other draws, so
+    one worker and two give the same cycles. The check of the physics is the push-grasp's
+    transfer function: where the pure squeeze and the push-grasp from the leading side
+    predict different orientations, the lagged squeezes end at the push-grasp's, and the
+    same cycles without the lag never do.
+    """
+    from bayesgrasp.angles import TWO_PI, circle_distance
+    from bayesgrasp.geometry.push import push_grasp_function
+    from bayesgrasp.geometry.transfer import squeeze_function
+    from bayesgrasp.sim import engine
+    from bayesgrasp.sim.params import SimParams
+    from bayesgrasp.sim.policy import simulate_policy_mujoco
+
+    part = shapes.load("house")
+    pb = Problem.build(part)
+    pol = plan_policy(pb, mujoco_sensor(part, 0.001), 2)
+    acts: list[tuple[float, bool, int | None, float]] = []
+    real = engine.Squeezer.act
+
+    def recorded(self: object, theta: float, offset: float = 0.0, push: bool = False,
+                 lead: int | None = None) -> object:  # fmt: skip
+        res = real(self, theta, offset, push, lead)  # type: ignore[arg-type]
+        acts.append((theta, push, lead, res.end))
+        return res
+
+    monkeypatch.setattr(engine.Squeezer, "act", recorded)
+    lag = 4.0
+    lagged = SimParams(jaw_lag=lag, clearance=SimParams().jaw_speed * lag / 2 + 0.001)
+    one = simulate_policy_mujoco(pb, pol, 12, params=lagged, rng=7)
+    lagged_acts = list(acts)
+    leads = [lead for _, push, lead, _ in lagged_acts if not push]
+    assert len(leads) >= 12 and set(leads) == {-1, 1}
+    acts.clear()
+    plain = simulate_policy_mujoco(pb, pol, 12, params=SimParams(clearance=lagged.clearance), rng=7)
+    assert {lead for _, _, lead, _ in acts} == {None}
+    two = simulate_policy_mujoco(pb, pol, 12, params=lagged, rng=7, workers=2)
+    np.testing.assert_array_equal(one.success, two.success)
+    np.testing.assert_array_equal(one.cycle_costs, two.cycle_costs)
+    np.testing.assert_allclose(one.reading_errors, two.reading_errors, rtol=0, atol=1e-9)
+
+    s = squeeze_function(part.hull)
+    g = push_grasp_function(part, s)
+
+    def at_push_grasp(
+        records: list[tuple[float, bool, int | None, float]], side: int
+    ) -> list[bool]:
+        """Per squeeze whose two predictions differ: did it end at the push-grasp's?"""
+        out = []
+        for theta, push, lead, end in records:
+            if push:
+                continue
+            shift = math.pi if (lead or side) > 0 else 0.0
+            sq = float(s(np.array([theta]))[0])
+            pg = float(np.mod(g(np.array([theta - shift])) + shift, TWO_PI)[0])
+            if circle_distance(sq, pg) > 1e-3:
+                out.append(bool(circle_distance(end, pg) < math.radians(3.0)))
+        return out
+
+    pushed = at_push_grasp(lagged_acts, 0)
+    assert len(pushed) >= 3 and sum(pushed) >= len(pushed) - 1, pushed
+    for side in (-1, 1):
+        assert not any(at_push_grasp(acts, side))
+    assert plain.cycles == one.cycles == 12
+    assert policy_simulation_json(one)["jaw_lag_s"] == lag
+    assert "jaw_lag_s" not in policy_simulation_json(plain)
+
+
+def test_cli_jaw_lag_reaches_the_policy_simulation(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``simulate --sense --engine mujoco --jaw-lag 2``: the lagged SimParams reach the run.
+
+    As a plan's: the lag, and the clearance raised to the push (10 mm) + 1 mm; a lag that
+    pushes a candidate more than twice its size is refused before any work (exit 2).
+    """
+    import bayesgrasp.sim.policy as sim_policy
+
+    seen: list[object] = []
+
+    def fake(problems: object, pol: object, n: int, **kw: object) -> object:
+        seen.append(kw.get("params"))
+        return simulate_policy(problems, pol, n, rng=0)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(sim_policy, "simulate_policy_mujoco", fake)
+    args = ["simulate", "house", "--sense", "width", "--engine", "mujoco", "--trials", "20"]
+    assert main([*args, "--jaw-lag", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "jaw lag 2 s; " in out.splitlines()[0]
+    (params,) = seen
+    assert params.jaw_lag == 2.0 and params.lead_jaw == "random"  # type: ignore[attr-defined]
+    assert params.clearance == pytest.approx(0.011)  # type: ignore[attr-defined]
+    assert main(args) == 0 and seen[-1] is None
+    assert "jaw lag" not in capsys.readouterr().out
+    n = len(seen)
+    assert main([*args, "--also", "triangle", "--jaw-lag", "100"]) == 2
+    err = capsys.readouterr().err
+    assert "more than twice its size" in err and len(err.strip().splitlines()) == 1
+    assert len(seen) == n
+    assert main([*args[:-4], "--trials", "20", "--jaw-lag", "1"]) == 2  # kinematic: no jaws
+    assert "--engine mujoco only" in capsys.readouterr().err

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -28,6 +28,12 @@ from .options import (
 )
 from .specs import PartSpec, ProblemSpec
 
+if TYPE_CHECKING:
+    from ..geometry.polygon import Part
+    from ..model.problem import Problem
+    from ..planning.result import PlanOption
+    from .noisy import NoisyRun
+
 app = command_app()
 
 OutOpt = Annotated[
@@ -47,6 +53,38 @@ ForceOpt = Annotated[
     ),
 ]
 FramesOpt = Annotated[int, typer.Option(min=4, max=240, help="Animation frames per plan step.")]
+# The noise and payoff options of plan (cli/options.py), with what plot does with them.
+TurnNoiseOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--turn-noise",
+        metavar="normal:SIGMA_DEG|uniform:A_DEG",
+        help="Gripper turns executed as alpha + e, e ~ Normal(0, SIGMA^2) or uniform on "
+        "[-A, A] degrees: draw the noise-aware plan (plan's with the same options) and the "
+        "distributions after each step exactly under the noise.",
+    ),
+]
+ContactNoiseOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--contact-noise",
+        metavar="Q",
+        min=0.0,
+        max=1.0,
+        help="Jaws touch one after the other with probability Q (either side first), such a "
+        "squeeze acting as a push-grasp from that side: draw the plan planned for it and "
+        "the distributions under it.",
+    ),
+]
+PayoffOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--payoff",
+        metavar="FILE",
+        help="Payoff in [0, 1] of final stable orientations (.json or .csv, orientation_deg,"
+        "value): draw the plan of least expected cost per unit payoff.",
+    ),
+]
 
 FIGURES = ("part", "diameter", "transfer", "plan")
 """The figure files, one per image format (:func:`bayesgrasp.figures.files.write_figures`)."""
@@ -76,15 +114,25 @@ def plot(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
+    turn_noise: TurnNoiseOpt = None,
+    contact_noise: ContactNoiseOpt = None,
+    payoff: PayoffOpt = None,
 ) -> None:
     """Figures of a part and a plan: part.*, diameter.*, transfer.*, plan.* and plan.gif.
 
     With --sense: the Bayes sensing policy's tree with the part at each node (policy.*).
     Files that exist in the folder are replaced only with --force; an input (the part, the
-    prior or the plan file) never is.
+    prior, the plan or the payoff file) never is.
+
+    With --turn-noise, --contact-noise or --payoff: --plan bayes, most-certain and
+    guaranteed are the plans plan gives with the same options (--guaranteed under a bounded
+    turn error), --plan FILE the plan it holds; plan.* draws the exact distributions after each step under the noise
+    and its title says the noise (as plan --plot draws them); the part's figures are the
+    same. With --sense: the policy planned under the noise, as plan --sense --plot draws it.
     """
     from ..figures.plots import write_figures
     from ..model.actions import PUSH_GRASP
+    from . import noisy
 
     formats = [f.strip().lower() for f in image_formats.split(",") if f.strip()]
     if not formats or any(f not in IMAGE_FORMATS for f in formats):
@@ -94,18 +142,27 @@ def plot(
         )
     if out.exists() and not out.is_dir():
         raise typer.BadParameter(f"{str(out)!r} is a file, not a folder", param_hint="--out")
-    inputs = input_files(part.part, spec.prior, which)
+    inputs = input_files(part.part, spec.prior, which, payoff)
     if sense is not None:
-        from .sensing import plot_policy_command
+        from .sensing import plot_policy_command, sense_noise
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
         sensing = sense_spec(sense, also or (), part_prior, spec)
-        plot_policy_command(part, spec, sensing, out, formats, as_json)
+        action = sense_noise(turn_noise, contact_noise, payoff)
+        plot_policy_command(part, spec, sensing, out, formats, as_json, action)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
+    run = (
+        noisy.NoisyRun.of(spec, turn_noise, contact_noise, payoff)
+        if noisy.asked(turn_noise, contact_noise, payoff)
+        else None
+    )
     check_outputs(figure_files(out, formats, animation), inputs, force, "--out")
-    pb, option, label = chosen_plan(which, spec, part.load(), force)
+    if run is None:
+        pb, option, label = chosen_plan(which, spec, part.load(), force)
+    else:
+        pb, option, label = _noisy_plan(which, spec, part.load(), force, run)
     try:
         files = write_figures(
             pb,
@@ -116,7 +173,51 @@ def plot(
             push_grasp=PUSH_GRASP.name in pb.action_kinds,
             animation=animation,
             frames_per_step=frames,
+            noise=None if run is None else run.noise,
+            per_payoff=run is not None and run.payoff is not None,
         )
     except OSError as exc:
         write_failed(out, exc)
     list_files(files, as_json)
+
+
+def _noisy_plan(
+    which: str, spec: ProblemSpec, part: Part, force: bool, run: NoisyRun
+) -> tuple[Problem, PlanOption, str]:
+    """The problem, the plan ``--plan`` names under the noise and payoff, and its title name.
+
+    ``bayes`` and ``most-certain``: the noise-aware planner's
+    (:func:`~bayesgrasp.planning.noisy.plan_noisy`, the plans ``plan`` gives with the same
+    options). ``guaranteed``: the plan ``plan --guaranteed`` gives under the noise; a plan
+    file: the plan as without the options. Either with its success probability and expected
+    cost exact under the noise with its own goal (the states of positive payoff with
+    ``--payoff``), as ``simulate`` predicts it.
+    """
+    import dataclasses
+
+    import numpy as np
+
+    from ..model.payoff import as_vector
+    from ..planning.noisy import step_distributions_noisy
+    from .common import PLAN_NAMES
+
+    if which in ("bayes", "most-certain"):
+        pb = spec.build(part)
+        res, _ = run.plan(pb)
+        chosen = res.bayes if which == "bayes" else res.most_certain
+        return pb, res.options[chosen].option, PLAN_NAMES[which]
+    if which == "guaranteed":  # the plan plan --guaranteed gives under the noise
+        from .simulate import noise_aware_plan
+
+        pb, option, label = noise_aware_plan(which, spec, part, run.noise, run.payoff)
+    else:
+        pb, option, label = chosen_plan(which, spec, part, force)
+    q = step_distributions_noisy(pb, run.noise, option.steps)[-1]
+    if run.payoff is None:
+        goal: Any = np.asarray(pb.success_states(option.final_orientation), dtype=np.float64)
+    else:
+        goal = as_vector(run.payoff, pb.states)
+    gain = float(q @ goal)
+    success = float(q[goal > 0].sum())
+    cost = pb.cost.expected_cost(tuple(s.kind for s in option.steps), gain)
+    return pb, dataclasses.replace(option, success_probability=success, expected_cost=cost), label

@@ -141,6 +141,7 @@ def simulate_policy_command(
     sensor_error: bool,
     as_json: bool,
     action: ActionModel | None = None,
+    jaw_lag: float = 0.0,
 ) -> None:
     """Plan the Bayes policy of PART (and the --also parts), run it, print the comparison.
 
@@ -148,7 +149,8 @@ def simulate_policy_command(
     for MuJoCo's default reading error (:func:`bayesgrasp.sim.policy.mujoco_sensor`).
     With ``action`` (the noise and payoff options) the policy is planned under that noise
     (and payoff) and the runs draw the noise: turn error and contact asynchrony in the
-    kinematic runs, the turn error in MuJoCo (whose contacts are its own).
+    kinematic runs, the turn error in MuJoCo (whose contacts are its own; ``jaw_lag``
+    seconds: one jaw of each MuJoCo squeeze leads, as ``simulate --jaw-lag`` does a plan's).
     """
     from ..model.sensing import parse_sensor
     from ..sim.policy import (
@@ -163,6 +165,12 @@ def simulate_policy_command(
     sensor = parse_sensor(sensing.sense)
     parts = sensing.parts(part)
     scale = units_scale(units) if units is not None else None
+    params = None  # --jaw-lag: checked for every candidate before any work
+    if jaw_lag:
+        from .simulate import _lagged
+
+        checked = [_lagged(jaw_lag, p, units) for p in parts]  # one SimParams for all
+        params = checked[0]
     if engine is Engine.mujoco and sensor.kind == "exact":
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))
     from ..sim.noise import GripperNoise
@@ -185,6 +193,7 @@ def simulate_policy_command(
             scale=scale,
             add_sensor_error=sensor_error,
             progress=progress,
+            params=params,
         )
 
     res = with_progress(f"{engine.value} cycles", n, run)
@@ -196,6 +205,8 @@ def simulate_policy_command(
     title = f"{names}: Bayes policy of at most {most} actions; "
     if noise is not None and not noise.exact:
         title += f"planned and predicted under {noise.describe()}; "
+    if jaw_lag:
+        title += f"jaw lag {jaw_lag:g} s; "
     typer.echo(policy_simulation_text(res, title))
 
 
@@ -206,11 +217,12 @@ def plot_policy_command(
     out: Path,
     formats: list[str],
     as_json: bool,
+    noise: ActionModel | None = None,
 ) -> None:
-    """Plan the Bayes policy and draw its tree into ``out/policy.FORMAT``."""
+    """Plan the Bayes policy (under ``noise`` if given) and draw its tree into ``out/policy.*``."""
     from ..figures.policy import policy_figure
 
-    problems, pol = sensing.policy(sensing.parts(part), spec)
+    problems, pol = plan_sensing_policy(sensing, sensing.parts(part), spec, noise)
     fig = policy_figure(problems, pol)
     files = []
     try:

@@ -198,8 +198,6 @@ def simulate(
             param_hint="--contact-noise",
         )
     if sense is not None:
-        if jaw_lag:
-            raise typer.BadParameter("does not apply to --sense yet", param_hint="--jaw-lag")
         if which != "bayes" or force:
             raise typer.BadParameter(
                 "with --sense the Bayes policy is planned and run; --plan and --force choose or "
@@ -214,7 +212,7 @@ def simulate(
         sensing = sense_spec(sense, also or (), part_prior, spec)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
-            sensor_error, as_json, action,
+            sensor_error, as_json, action, jaw_lag,
         )  # fmt: skip
         return
     if also or part_prior is not None or sensor_error:

@@ -161,6 +161,7 @@ def plan_animation(
     initial: ArrayLike | None = None,
     frames_per_step: int = 24,
     label: str = "chosen",
+    note: str | None = None,
 ) -> PlanAnimation:
     """(e) Animate a plan from several initial orientations: jaws closing, the part turning.
 
@@ -180,6 +181,9 @@ def plan_animation(
         Frames of each step (at least 4).
     label : str, optional
         How the title names the plan.
+    note : str, optional
+        A second line of the caption (below the goal and ``P(success)``), for example the
+        noise model the option's probability is exact under.
 
     Returns
     -------
@@ -252,7 +256,8 @@ def plan_animation(
     title = fig.suptitle("", fontsize=12)
     fig.supxlabel(
         f"goal {math.degrees(option.final_orientation):.1f}° in the last gripper frame; "
-        f"P(success) = {option.success_probability:.3f} over the prior",
+        f"P(success) = {option.success_probability:.3f} over the prior"
+        + ("" if note is None else f"\n{note}"),
         fontsize=10,
     )
 

@@ -26,6 +26,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure, SubFigure
 
+    from ..model.noise import NoiseModel
     from ..planning.noisy import NoisyPlanResult
 
 __all__ = [
@@ -34,6 +35,7 @@ __all__ = [
     "draw_probability_labels",
     "evolution_figure",
     "label_levels",
+    "noise_note",
     "noisy_plan_figure",
     "plan_figure",
     "step_distributions",
@@ -220,7 +222,13 @@ def draw_evolution(
     return list(axes)
 
 
-def evolution_figure(problem: Problem, option: PlanOption, label: str = "chosen") -> Figure:
+def evolution_figure(
+    problem: Problem,
+    option: PlanOption,
+    label: str = "chosen",
+    distributions: Sequence[FloatArray] | None = None,
+    note: str | None = None,
+) -> Figure:
     """(d) The distribution over orientations before and after each step of a plan (Fig. 1).
 
     One panel per step, below the prior: stems at the stable orientations (degrees, in the
@@ -234,6 +242,11 @@ def evolution_figure(problem: Problem, option: PlanOption, label: str = "chosen"
         The plan (for example ``report.bayes_plan``).
     label : str, optional
         How the title names the plan ("Bayes", "most certain", ...).
+    distributions, note : optional
+        The distributions after each step to draw instead of the noise-free ones, and what
+        they are, added to the title (see :func:`draw_evolution`); under a noise model
+        :func:`~bayesgrasp.planning.noisy.step_distributions_noisy` and
+        :func:`noise_note`, as the bottom half of :func:`noisy_plan_figure` draws them.
 
     Returns
     -------
@@ -250,8 +263,24 @@ def evolution_figure(problem: Problem, option: PlanOption, label: str = "chosen"
     True
     """
     fig = new_figure(8.0, 1.9 * (option.n_actions + 1) + 0.6)
-    draw_evolution(fig, problem, option, label)
+    draw_evolution(fig, problem, option, label, distributions, note)
     return fig
+
+
+def noise_note(noise: NoiseModel, payoff: bool = False) -> str:
+    """What the distributions of a plan drawn under ``noise`` are: the title's second line.
+
+    ``payoff``: the plan's expected cost is per unit payoff (a payoff was given).
+
+    Examples
+    --------
+    >>> import math
+    >>> from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    >>> noise_note(NoiseModel(TurnNoise("normal", math.radians(2))), payoff=True)
+    'the distributions below: exact under turn error normal:2 deg; E[cost] per unit payoff'
+    """
+    note = f"the distributions below: exact under {noise.describe()}"
+    return note + ("; E[cost] per unit payoff" if payoff else "")
 
 
 PLAN_LABELS = {"bayes": "Bayes", "most-certain": "most certain", "guaranteed": "guaranteed"}
@@ -355,7 +384,4 @@ def noisy_plan_figure(result: NoisyPlanResult, which: str = "bayes") -> Figure:
     report = result.plan_result()
     option = chosen_option(report, which)
     qs = step_distributions_noisy(result.problem, result.noise, option.steps)
-    note = f"the distributions below: exact under {result.noise.describe()}"
-    if result.payoff is not None:
-        note += "; E[cost] per unit payoff"
-    return plan_figure(report, which, qs, note)
+    return plan_figure(report, which, qs, noise_note(result.noise, result.payoff is not None))

@@ -245,9 +245,15 @@ def policy_figure(
     ax.set_aspect("equal")
     sensor = policy.sensor.spec
     noise = "" if policy.noise is None else f"\nunder {policy.noise.describe()} (exact figures)"
+    if policy.payoff is None:
+        figures = f"{policy.expected_cost:.3f} (success {policy.success_probability:.3f} a cycle)"
+    else:  # the cost is per unit payoff, the success the payoff a cycle earns
+        figures = (
+            f"{policy.expected_cost:.3f} per unit payoff (expected payoff "
+            f"{policy.success_probability:.3f} a cycle)"
+        )
     ax.set_title(
-        f"{' or '.join(policy.parts)}: Bayes policy, {sensor}, expected cost "
-        f"{policy.expected_cost:.3f} (success {policy.success_probability:.3f} a cycle){noise}",
+        f"{' or '.join(policy.parts)}: Bayes policy, {sensor}, expected cost {figures}{noise}",
         fontsize=9,
     )
     return fig

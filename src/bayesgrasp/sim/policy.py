@@ -47,7 +47,7 @@ import math
 import multiprocessing
 import time
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -124,6 +124,9 @@ class PolicySimulation:
         nearest to where the part ended (MuJoCo: of the actions that did not jam).
     seconds : float
         Wall time.
+    jaw_lag : float
+        MuJoCo: seconds by which one jaw of each squeeze led
+        (:attr:`~bayesgrasp.sim.params.SimParams.jaw_lag`; 0: together).
     """
 
     engine: str
@@ -137,6 +140,7 @@ class PolicySimulation:
     success: BoolArray
     reading_errors: FloatArray
     seconds: float
+    jaw_lag: float = 0.0
 
     @property
     def observed_success(self) -> float:
@@ -430,6 +434,7 @@ class _Cycle:
     angle_err: tuple[float, ...]  # gripper error of each action (radians)
     offsets: tuple[float, ...]  # signed offset of each action (metres)
     reading_err: tuple[float, ...]  # the model's sensor error of each reading (part units)
+    leads: tuple[int | None, ...] = ()  # leading jaw of each lagged squeeze (jaw_lag > 0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -476,10 +481,11 @@ def _run_cycle(c: _Cycle) -> _CycleOut:
     node: PolicyNode | Declare | Reject = policy.root
     total, acts, jammed, t_sim = 0.0, 0, False, 0.0
     errors: list[float] = []
+    leads = c.leads or (None,) * len(c.angle_err)
     while isinstance(node, PolicyNode):
         step = node.step
         start = float(np.mod(yaw - step.alpha - c.angle_err[acts], TWO_PI))
-        res = sq.act(start, c.offsets[acts], get_action(step.kind).pushes_first)
+        res = sq.act(start, c.offsets[acts], get_action(step.kind).pushes_first, leads[acts])
         t_sim += res.sim_time
         total += cost.action_cost(step.kind, first=acts == 0)
         yaw = res.end
@@ -545,6 +551,10 @@ def simulate_policy_mujoco(
     policy : Policy
     cycles : int
     params : SimParams, optional
+        The physics settings. With ``jaw_lag > 0`` one jaw of every squeeze starts that
+        many seconds early (contact asynchrony, :class:`~bayesgrasp.sim.params.SimParams`);
+        with ``lead_jaw="random"`` the leading jaw of each action is drawn from ``rng``
+        with the other draws, so a run does not depend on ``workers``.
     offset : float
         Distance (metres) of the part's centre from the gripper centre at each action, on a
         random side.
@@ -605,6 +615,9 @@ def simulate_policy_mujoco(
                tuple(signs[i].tolist()), tuple(read_err[i].tolist()))
         for i in range(cycles)
     ]  # fmt: skip
+    if params.jaw_lag > 0 and params.lead_jaw == "random":  # drawn last: the rest as unlagged
+        leads = np.where(gen.random((cycles, k)) < 0.5, -1, 1)
+        tasks = [replace(t, leads=tuple(leads[i].tolist())) for i, t in enumerate(tasks)]
     t0 = time.perf_counter()
     outs: list[_CycleOut] = []
     for o in _map_cycles((pbs, policy, scales, params), tasks, workers):
@@ -624,6 +637,7 @@ def simulate_policy_mujoco(
         ok,
         np.array([e for o in outs for e in o.errors], dtype=np.float64),
         time.perf_counter() - t0,
+        params.jaw_lag,
     )
 
 
@@ -665,7 +679,8 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
     """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals.
 
     A policy planned under noisy actions adds ``noise`` (the model its figures are exact
-    under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`).
+    under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`); a MuJoCo run with a jaw lag
+    adds ``jaw_lag_s``.
     """
     e = sim.reading_errors if len(sim.reading_errors) else np.full(1, math.nan)
     keys = ["success_probability", "cycle_cost", "expected_actions", "expected_cost"]
@@ -679,6 +694,7 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
         "parts": list(sim.policy.parts),
         "sensor": sim.policy.sensor.to_json(),
         **({} if sim.policy.noise is None else {"noise": sim.policy.noise.to_json()}),
+        **({"jaw_lag_s": sim.jaw_lag} if sim.jaw_lag > 0 else {}),
         "cycles": sim.cycles,
         "successes": sim.successes,
         "rejects": sim.rejects,
