@@ -126,9 +126,10 @@ def plot(
 
     With --turn-noise, --contact-noise or --payoff: --plan bayes, most-certain and
     guaranteed are the plans plan gives with the same options (--guaranteed under a bounded
-    turn error), --plan FILE the plan it holds; plan.* draws the exact distributions after each step under the noise
-    and its title says the noise (as plan --plot draws them); the part's figures are the
-    same. With --sense: the policy planned under the noise, as plan --sense --plot draws it.
+    turn error), --plan FILE the plan it holds; plan.* draws the exact distributions after
+    each step under the noise and its title says the noise (as plan --plot draws them); the
+    part's figures are the same. With --sense: the policy planned under the noise, as plan
+    --sense --plot draws it.
     """
     from ..figures.plots import write_figures
     from ..model.actions import PUSH_GRASP
