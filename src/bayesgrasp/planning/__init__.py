@@ -6,6 +6,13 @@ returns a :class:`~bayesgrasp.planning.result.PlanResult` with a ``status`` (``"
 importable one by one: :func:`plan_exact` (:mod:`.exact`), :func:`plan_bfs` (the seed's
 breadth-first baseline, :mod:`.bfs`) and :func:`plan_guaranteed` (:mod:`.guaranteed`).
 The arc machinery the exact and guaranteed planners share is :mod:`.arcs`.
+
+Noise and sensing: :func:`~.noisy.plan_noisy` (plans under noisy actions and a payoff),
+:func:`~.robust.plan_guaranteed_noisy` (guaranteed plans under a bounded error),
+:func:`~.policy.plan_policy` (policies that branch on jaw-width readings) and
+:func:`~.noisy_policy.plan_noisy_policy` (both together). Every plan and policy is a tree of
+:mod:`.strategy`, whose :func:`~.strategy.evaluate` gives its exact figures under any noise,
+sensor and payoff.
 """
 
 from __future__ import annotations

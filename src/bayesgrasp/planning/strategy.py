@@ -36,7 +36,9 @@ one succeeds (geometric, mean ``1 / P``), each failure paying the retry overhead
 the paper's ``C / p`` for a linear plan (:meth:`~bayesgrasp.model.cost.CostModel.expected_cost`)
 and the cost every planner minimises (:mod:`bayesgrasp.planning.policy`'s module notes). All of
 it is exact: sums of products of the matrices, nothing sampled (the tests hold it against
-Monte Carlo runs of the same strategies and against every planner's own figures).
+Monte Carlo runs of the same strategies and against every planner's own figures). The policy
+planner under noisy actions (:mod:`.noisy_policy`) computes its figures with it
+(:func:`evaluate_tree`, with its own cached matrices).
 
 Examples
 --------
@@ -58,7 +60,7 @@ import dataclasses
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -153,8 +155,7 @@ def plan_strategy(problem: Problem, option: PlanOption, part: int = 0) -> Policy
     )
     for step in reversed(option.steps):
         nxt = PolicyNode(step, (Branch(-math.inf, math.inf, 1.0, nxt),))
-    assert isinstance(nxt, PolicyNode)  # the loop ran at least once
-    return nxt
+    return cast(PolicyNode, nxt)  # the loop ran at least once
 
 
 class Transitions(Protocol):
