@@ -59,6 +59,7 @@ __all__ = [
     "run_trials",
     "sample_prior",
     "simulate_kinematic",
+    "with_contacts",
 ]
 
 #: A kinematic trial jams when an action ends farther than this many times the states'
@@ -242,6 +243,26 @@ def contact_push(problem: Problem, contact: float) -> TransferFunction | None:
     return push_grasp_function(problem.part, problem.states)
 
 
+def with_contacts(
+    out: FloatArray, x: FloatArray, push: TransferFunction, event: FloatArray, contact: float
+) -> FloatArray:
+    """Squeeze outcomes ``out`` of parts at ``x`` (gripper frame), with the contact events drawn.
+
+    With contact asynchrony ``q`` (``contact``) a squeeze is, with probability ``q / 2``
+    each, the push-grasp from the ``-x`` side, ``push(x)``, or from the ``+x`` side,
+    ``push(x - pi) + pi`` (:mod:`bayesgrasp.model.noise`); ``event`` holds one uniform draw a
+    part. Returns a new array.
+    """
+    left = event < contact / 2
+    right = (event >= contact / 2) & (event < contact)
+    out = np.array(out, dtype=np.float64)
+    if np.any(left):
+        out[left] = push(x[left])
+    if np.any(right):
+        out[right] = push(x[right] - math.pi) + math.pi
+    return out
+
+
 def run_trials(
     problem: Problem,
     steps: Sequence[PlanStep],
@@ -274,13 +295,7 @@ def run_trials(
             near |= boundary_distance(f.boundaries, theta) < boundary_margin
         out = f(theta)
         if push is not None and event is not None and steps[j].kind == SQUEEZE.name:
-            # One jaw first: a push-grasp from that side (model/noise.py, contact asynchrony).
-            left = event[j] < contact / 2
-            right = (event[j] >= contact / 2) & (event[j] < contact)
-            if np.any(left):
-                out[left] = push(theta[left])
-            if np.any(right):
-                out[right] = push(theta[right] - math.pi) + math.pi
+            out = with_contacts(out, theta, push, event[j], contact)
         theta = out
         if j < len(transfers) - 1:
             jam |= boundary_distance(f.boundaries, theta) <= f.angle_tol

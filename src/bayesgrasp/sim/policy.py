@@ -62,7 +62,7 @@ from ..model.noise import NoiseModel
 from ..model.problem import Problem, nearest_state
 from ..model.sensing import WidthSensor
 from ..planning.policy import Declare, Policy, PolicyNode, Reject
-from .kinematic import sample_prior
+from .kinematic import sample_prior, with_contacts
 from .noise import GripperNoise, as_generator
 from .params import SimParams
 from .result import Progress, check_trials
@@ -230,9 +230,8 @@ class _Run:
     def act(self, j: int, kind: str, x: FloatArray) -> FloatArray:
         """Part ``j`` at ``x`` in the gripper frame after action ``kind`` (contact events drawn).
 
-        With contact asynchrony ``q`` a squeeze is, with probability ``q / 2`` each, the
-        push-grasp from the ``-x`` side, ``g(x)``, or from the ``+x`` side,
-        ``g(x - pi) + pi`` (:mod:`bayesgrasp.model.noise`).
+        With contact asynchrony a squeeze may act as a push-grasp from either side
+        (:func:`~bayesgrasp.sim.kinematic.with_contacts`).
         """
         pb = self.problems[j]
         out = np.asarray(pb.transfer(kind)(x), dtype=np.float64)
@@ -240,12 +239,7 @@ class _Run:
             return out
         if j not in self.pushes:
             self.pushes[j] = push_grasp_function(pb.part, pb.states)
-        g = self.pushes[j]
-        event = self.gen.random(len(x))
-        left = event < self.contact / 2
-        right = (event >= self.contact / 2) & (event < self.contact)
-        out = np.where(left, g(x), out)
-        return np.asarray(np.where(right, g(x - math.pi) + math.pi, out), dtype=np.float64)
+        return with_contacts(out, x, self.pushes[j], self.gen.random(len(x)), self.contact)
 
     def node(self, node: PolicyNode, idx: IntArray, first: bool) -> None:
         """Run the cycles ``idx`` through ``node`` and what follows it."""
