@@ -334,9 +334,9 @@ def test_recognition_under_noise() -> None:
 def test_bad_input() -> None:
     pb = Problem.build(HOUSE)
     nm = NOISES["normal"]
-    with pytest.raises(PlanningError, match="the memory bound `max_memory_mb`"):
+    with pytest.raises(PlanningError, match="the memory bound: --max-memory MB"):
         plan_noisy_policy(pb, "width:0.05,0.025", 3, nm, max_memory_mb=0.001)
-    with pytest.raises(PlanningError, match="`max_memory_mb` must be a number > 0"):
+    with pytest.raises(PlanningError, match="`max_memory_mb` must be a number of MB > 0"):
         plan_noisy_policy(pb, "width", 2, nm, max_memory_mb=0)
     with pytest.raises(PlanningError, match="`noise` must be a NoiseModel"):
         plan_noisy_policy(pb, "width", 2, "normal:2")  # type: ignore[arg-type]

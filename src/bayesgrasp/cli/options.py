@@ -166,6 +166,16 @@ POLICY_DEPTH = 3
 """The depth of a policy when ``--max-actions`` is not given (a plan has no such default)."""
 DEEPEST_POLICY = 8
 """The deepest policy ``--max-actions`` asks for (the policy's tree grows with each level)."""
+MaxMemoryOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--max-memory",
+        metavar="MB",
+        min=1.0,
+        help="With --sense: the most memory (MB, about) the policy search may keep for the "
+        "beliefs it acts on; past it the search stops with a message (default 2048).",
+    ),
+]
 FoldOpt = Annotated[
     float,
     typer.Option(
@@ -323,7 +333,11 @@ def longest(max_actions: int | None, max_squeezes: int | None) -> int | None:
 
 
 def sense_spec(
-    sense: str, also: Iterable[str], part_prior: str | None, spec: ProblemSpec
+    sense: str,
+    also: Iterable[str],
+    part_prior: str | None,
+    spec: ProblemSpec,
+    max_memory_mb: float | None = None,
 ) -> SenseSpec:
     """The :class:`SenseSpec` of the --sense options, its depth ``spec``'s --max-actions.
 
@@ -344,4 +358,6 @@ def sense_spec(
             f"level); got {depth}",
             param_hint="--max-actions",
         )
-    return SenseSpec(sense, tuple(also), part_prior, depth)
+    if max_memory_mb is None:
+        return SenseSpec(sense, tuple(also), part_prior, depth)
+    return SenseSpec(sense, tuple(also), part_prior, depth, max_memory_mb)

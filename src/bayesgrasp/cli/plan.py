@@ -17,6 +17,7 @@ from .options import (
     FoldOpt,
     ForceOpt,
     JsonOpt,
+    MaxMemoryOpt,
     MaxOpeningOpt,
     MinOpeningOpt,
     PartPriorOpt,
@@ -135,6 +136,7 @@ def plan(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
+    max_memory: MaxMemoryOpt = None,
     fold_below: FoldOpt = 0.01,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
@@ -175,6 +177,8 @@ def plan(
         raise typer.BadParameter("--also and --part-prior need --sense")
     if sense is None and _given(ctx, "fold_below"):
         raise typer.BadParameter("--fold-below needs --sense")
+    if sense is None and max_memory is not None:
+        raise typer.BadParameter("--max-memory bounds a policy search: it needs --sense")
     noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
     if sense is not None:
         refused = [
@@ -189,7 +193,7 @@ def plan(
         if refused:
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
-        sensing = sense_spec(sense, more, part_prior, spec)
+        sensing = sense_spec(sense, more, part_prior, spec, max_memory)
         fold = fold_below if _given(ctx, "fold_below") else None  # the figure's, when given
         from .sensing import plan_policy_command, sense_noise
 

@@ -18,6 +18,7 @@ from .common import (
 from .options import (
     AlsoOpt,
     JsonOpt,
+    MaxMemoryOpt,
     PartPriorOpt,
     PlanChoiceOpt,
     SenseOpt,
@@ -114,6 +115,7 @@ def plot(
     sense: SenseOpt = None,
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
+    max_memory: MaxMemoryOpt = None,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
     payoff: PayoffOpt = None,
@@ -148,12 +150,14 @@ def plot(
         from .sensing import plot_policy_command, sense_noise
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
-        sensing = sense_spec(sense, also or (), part_prior, spec)
+        sensing = sense_spec(sense, also or (), part_prior, spec, max_memory)
         action = sense_noise(turn_noise, contact_noise, payoff)
         plot_policy_command(part, spec, sensing, out, formats, as_json, action)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
+    if max_memory is not None:
+        raise typer.BadParameter("--max-memory bounds a policy search: it needs --sense")
     run = (
         noisy.NoisyRun.of(spec, turn_noise, contact_noise, payoff)
         if noisy.asked(turn_noise, contact_noise, payoff)

@@ -57,6 +57,7 @@ def plan_sensing_policy(
         model.noise,
         payoff=payoff,
         part_prior=sensing.part_prior,
+        max_memory_mb=sensing.max_memory_mb,
     )
     return problems, pol
 

@@ -220,6 +220,8 @@ class SenseSpec:
     """The other candidate parts (``--also``; ``plan`` adds its further PARTs)."""
     part_prior: str | None = None
     max_actions: int = 3
+    max_memory_mb: float = 2048.0
+    """The policy search's memory bound (``--max-memory``)."""
 
     def parts(self, part: PartSpec) -> list[Part]:
         """PART, then each candidate part, read with the same part-file options."""
@@ -239,6 +241,7 @@ class SenseSpec:
             sensor=self.sense if sensor is None else sensor,
             max_actions=self.max_actions,
             part_prior=self.part_prior,
+            max_memory_mb=self.max_memory_mb,
         )
         return problems, pol
 

@@ -132,6 +132,7 @@ from .noisy import (
 from .policy import (
     _DEFAULT_MAX_ACTIONS,
     _PRUNE,
+    DEFAULT_MAX_MEMORY_MB,
     Branch,
     Declare,
     Policy,
@@ -143,6 +144,7 @@ from .policy import (
     _solver,
     _space,
     _start_ratio,
+    memory_bytes,
     plan_policy,
 )
 from .result import PlanStep
@@ -157,8 +159,6 @@ IntArray = NDArray[np.intp]
 
 MAX_SWEEPS = 4
 """Most refinement sweeps over the turns of a policy."""
-DEFAULT_MAX_MEMORY_MB = 2048.0
-"""Default bound on the memory of the beliefs the programme keeps (their images, readings)."""
 _GAIN_TOL = 1e-12
 
 
@@ -580,12 +580,7 @@ def plan_noisy_policy(
     True
     """
     sens = parse_sensor(sensor)
-    if (
-        isinstance(max_memory_mb, bool)
-        or not isinstance(max_memory_mb, int | float)
-        or not max_memory_mb > 0
-    ):
-        raise PlanningError(f"`max_memory_mb` must be a number > 0; got {max_memory_mb!r}")
+    memory_bytes(max_memory_mb)  # a bad bound: refused before any work
     if noise is not None and not isinstance(noise, NoiseModel):
         raise PlanningError(f"`noise` must be a NoiseModel; got {type(noise).__name__}")
     if payoff is None and (noise is None or (noise.exact and not _always)):
@@ -615,7 +610,7 @@ def plan_noisy_policy(
         solver.goal = cast(Any, u[None, :])
         solver.goal_is_identity = False
         solver.use_pairs = False
-    solver.max_bytes = max(1, int(max_memory_mb * 2**20))
+    solver.max_bytes = memory_bytes(max_memory_mb)
     for k in solver.kinds:
         mid, half = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
         if main.accuracy > 0:  # only turns that keep their class under the accuracy

@@ -740,7 +740,8 @@ class _Solver:
             if self.max_bytes and self.prep_bytes > self.max_bytes:
                 raise PlanningError(
                     f"the policy search's beliefs take more than {self.max_bytes / 2**20:,.0f} "
-                    "MB (the memory bound `max_memory_mb`): raise it, or plan fewer actions"
+                    "MB (the memory bound: --max-memory MB, `max_memory_mb` in the library): "
+                    "raise it, or plan fewer actions"
                 )
             imgs, rows = self.images(q, self.kinds[ti])
             hit = (self.prepare(imgs), rows)
@@ -1104,6 +1105,27 @@ def _pairs(space: StateSpace) -> tuple[IntArray, IntArray, NDArray[np.bool_], bo
     return a, b, np.asarray(both, dtype=bool), ok
 
 
+DEFAULT_MAX_MEMORY_MB = 2048.0
+"""Default bound on the memory of the beliefs a policy search keeps (their images, readings)."""
+
+
+def memory_bytes(max_memory_mb: float) -> int:
+    """The bound in bytes of ``max_memory_mb`` (a number > 0), or a PlanningError.
+
+    Examples
+    --------
+    >>> memory_bytes(1.5)
+    1572864
+    """
+    if (
+        isinstance(max_memory_mb, bool)
+        or not isinstance(max_memory_mb, int | float)
+        or not 0 < max_memory_mb < 2**40
+    ):
+        raise PlanningError(f"`max_memory_mb` must be a number of MB > 0; got {max_memory_mb!r}")
+    return max(1, int(max_memory_mb * 2**20))
+
+
 def _solver(space: StateSpace, sens: WidthSensor, prune: Collection[str] = _PRUNE) -> _Solver:
     """The programme of a state space and sensor (its kinds, bins, goal and bounds)."""
     main = space.problems[0]
@@ -1161,6 +1183,7 @@ def plan_policy(
     max_first_angles: int = 512,
     max_iterations: int = 50,
     sensorless: bool = True,
+    max_memory_mb: float = DEFAULT_MAX_MEMORY_MB,
     _prune: Collection[str] = _PRUNE,
 ) -> Policy:
     """The Bayes policy: least expected cost over all policies of at most ``max_actions``.
@@ -1185,6 +1208,9 @@ def plan_policy(
         Largest number of candidate first angles tried exhaustively.
     max_iterations : int
         Most parametric steps.
+    max_memory_mb : float
+        Most memory (about, MB) the search may keep for the beliefs it acts on; past it a
+        :class:`~bayesgrasp.errors.PlanningError` says so (default 2048).
     sensorless : bool
         Also plan the sensorless Bayes plan (one part; :func:`plan_exact` within
         ``max_actions``): its cost is reported (``Policy.sensorless_cost``) and starts the
@@ -1214,6 +1240,7 @@ def plan_policy(
     space = _space(problems, part_prior, max_actions)
     main = space.problems[0]
     solver = _solver(space, sens, _prune)
+    solver.max_bytes = memory_bytes(max_memory_mb)
     kinds = solver.kinds
     if first_angles is not None:
         angles = [float(a) for a in first_angles]
