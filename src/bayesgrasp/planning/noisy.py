@@ -116,6 +116,7 @@ from .result import (
     plan_actions,
     short_turns,
 )
+from .turns import FLAT_SIGMAS, GRID_PER_SIGMA, free_arcs, margin, turn_grid
 
 __all__ = [
     "NoisyEvaluation",
@@ -128,10 +129,6 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 
-GRID_PER_SIGMA = 6
-"""Grid points per standard deviation of a normal turn error in the refinement."""
-FLAT_SIGMAS = 8.0
-"""Farther than this many sigma from every critical turn, ``f`` is flat (to 1e-15)."""
 ACCURACY_SEEDS = (2.0,)
 """Seeds: the exact planner's plans with a gripper accuracy of these many error scales."""
 TIE_RTOL = 1e-9
@@ -485,7 +482,7 @@ class _Planner:
         periods = _periods(self.problem, kinds)
         qs = self.ev.forward(kinds, angles)
         return [
-            _margin(
+            margin(
                 angles[m],
                 self.ev.boundary_turns(kinds[m], np.flatnonzero(qs[m - 1] > 0)),
                 periods[m],
@@ -509,8 +506,8 @@ class _Planner:
         moved = False
         for m in range(1, len(kinds)):
             bounds = self.ev.boundary_turns(kinds[m], np.flatnonzero(q > 0))
-            if _margin(out[m], bounds, periods[m]) <= self.a_tol:
-                starts, mids, _ = _free_intervals(bounds, periods[m], self.a_tol)
+            if margin(out[m], bounds, periods[m]) <= self.a_tol:
+                starts, mids, _ = free_arcs(bounds, periods[m], self.a_tol)
                 d = np.abs(np.mod(starts - out[m] + periods[m] / 2, periods[m]) - periods[m] / 2)
                 j = int(np.argmin(d))
                 best_v = -math.inf
@@ -531,10 +528,10 @@ class _Planner:
         is replaced by the middles of the two arcs beside it (between all boundary turns).
         """
         bounds = self.ev.boundary_turns(kind)
-        starts, free, _ = _free_intervals(bounds, period, self.a_tol)
+        starts, free, _ = free_arcs(bounds, period, self.a_tol)
         out: list[float] = []
         for x in mids:
-            if _margin(float(x), bounds, period) > self.a_tol:
+            if margin(float(x), bounds, period) > self.a_tol:
                 out.append(float(x))
                 continue
             d = np.abs(np.mod(starts - x + period / 2, period) - period / 2)
@@ -578,12 +575,12 @@ class _Planner:
             # middles of the arcs between *all* boundaries are tried: the widest of the best.
             rows = np.flatnonzero(left > 0)
             bounds = self.ev.boundary_turns(kind, rows)
-            _, mids, half = _free_intervals(bounds, period, self.a_tol)
+            _, mids, half = free_arcs(bounds, period, self.a_tol)
             vals = self._line(kind, left, right, mids)
             top = np.flatnonzero(vals >= vals.max() - self.p_tol)
             i = int(top[np.argmax(half[top])])
             best, fb = float(mids[i]), float(vals[i])
-            if _margin(current, bounds, period) <= self.a_tol:
+            if margin(current, bounds, period) <= self.a_tol:
                 # The current turn's value is one side's, not what a squeeze does: move.
                 return wrap_period(best, period), fb
         elif turn.kind == "uniform":
@@ -603,7 +600,7 @@ class _Planner:
         else:
             h = turn.scale / GRID_PER_SIGMA
             crit = self.ev.nt.critical(kind, left, right)
-            grid = _turn_grid(crit, period, h, FLAT_SIGMAS * turn.scale)
+            grid = turn_grid(crit, period, h, FLAT_SIGMAS * turn.scale)
             vals = self._line(kind, left, right, grid)
             i = int(np.argmax(vals))
             best, fb = float(grid[i]), float(vals[i])
@@ -676,54 +673,6 @@ def _best(cands: list[_Cand], p_tol: float) -> _Cand:
     tied = [c for c in cands if _cost(c) <= m * (1.0 + TIE_RTOL)] if math.isfinite(m) else cands
     top = max(c.ev.expected_payoff for c in tied)  # type: ignore[union-attr]
     return next(c for c in tied if c.ev.expected_payoff >= top - p_tol)  # type: ignore[union-attr]
-
-
-def _free_intervals(
-    turns: FloatArray, period: float, tol: float
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """The arcs between boundary turns on the circle of turns ``(-g/2, g/2]``.
-
-    Returns their starts (the sorted boundary turns, those closer than ``tol`` merged),
-    middles (wrapped) and half-widths: the middle of an arc is its point farthest from every
-    boundary turn, by its half-width.
-    """
-    c = np.unique(np.mod(turns + period / 2, period) - period / 2)
-    if len(c) > 1:
-        keep = np.append(True, np.diff(c) > tol)
-        if c[0] + period - c[-1] <= tol:
-            keep[0] = False
-        c = c[keep]
-    widths = np.diff(np.append(c, c[0] + period))
-    mids = np.mod(c + widths / 2 + period / 2, period) - period / 2
-    return c, mids, widths / 2
-
-
-def _margin(alpha: float, turns: FloatArray, period: float) -> float:
-    """Distance of the turn ``alpha`` to the nearest boundary turn (modulo ``period``)."""
-    d = np.mod(turns - alpha + period / 2, period) - period / 2
-    return float(np.min(np.abs(d))) if len(d) else math.inf
-
-
-def _turn_grid(crit: FloatArray, period: float, h: float, reach: float) -> FloatArray:
-    """Turns to try: a grid of step ``h`` within ``reach`` of the critical turns, one per gap.
-
-    Farther than ``reach`` from every critical turn the line ``f`` is constant to rounding
-    (its CDF terms are 0 or 1), so one point of each gap stands for all of it. Where the
-    windows cover the period the grid is the whole period's, of step at most ``h``.
-    """
-    n = max(8, math.ceil(period / h))
-    if len(crit) == 0:
-        return np.zeros(1)
-    c = np.unique(np.mod(crit + period / 2, period) - period / 2)
-    per = 2 * math.ceil(reach / h) + 1
-    if len(c) * per >= n:
-        return -period / 2 + period * (np.arange(n) + 0.5) / n
-    offsets = h * (np.arange(per) - per // 2)
-    pts = (c[:, None] + offsets[None, :]).ravel()
-    gaps = np.diff(np.append(c, c[0] + period))
-    wide = gaps > 2.0 * reach
-    mids = c[wide] + gaps[wide] / 2
-    return np.mod(np.concatenate([pts, mids]) + period / 2, period) - period / 2
 
 
 def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list[_Cand]:
@@ -903,10 +852,10 @@ def plan_noisy(
             if len(refined) >= refine:
                 break
         best = _best(cands + refined, pl.p_tol)
-        margin = None
+        least = None
         if noise.turn.exact and k > 1:
-            margin = min(pl.margins(best.kinds, best.angles))
-        options.append(_noisy_option(problem, exact, best, margin))
+            least = min(pl.margins(best.kinds, best.angles))
+        options.append(_noisy_option(problem, exact, best, least))
         best_cost = min(best_cost, best.ev.expected_cost)  # type: ignore[union-attr]
         cheapest_next = cost.expected_cost((first_kind,) + (next_kind,) * k, bound)
         if not all_lengths and k >= reach and cheapest_next >= best_cost * (1.0 - 1e-12):

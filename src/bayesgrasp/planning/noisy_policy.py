@@ -121,14 +121,7 @@ from ..model.payoff import Payoff, as_vector
 from ..model.problem import Problem
 from ..model.sensing import StateSpace, WidthSensor, parse_sensor
 from ..model.states import nearest_state
-from .noisy import (
-    FLAT_SIGMAS,
-    GRID_PER_SIGMA,
-    _free_intervals,
-    _margin,
-    _turn_grid,
-    plan_noisy,
-)
+from .noisy import plan_noisy
 from .policy import (
     _DEFAULT_MAX_ACTIONS,
     _PRUNE,
@@ -149,6 +142,7 @@ from .policy import (
 )
 from .result import PlanStep
 from .strategy import Evaluation, evaluate_tree
+from .turns import FLAT_SIGMAS, GRID_PER_SIGMA, free_arcs, margin, turn_grid
 
 __all__ = ["MAX_SWEEPS", "evaluate_policy", "plan_noisy_policy"]
 
@@ -391,12 +385,12 @@ def _best_turn(
         # width are not turns a gripper can make). A turn now on a boundary must move: its
         # value is one side's, not what the squeeze does there.
         edges = model.boundaries(kind, left)
-        _, pts, half = _free_intervals(edges, period, 1e-9)
+        _, pts, half = free_arcs(edges, period, 1e-9)
         vals = np.where(half > 5e-10, model.line(kind, left, neg, pts), -np.inf)
         top = np.flatnonzero(vals >= vals.max() - _GAIN_TOL * max(1.0, abs(float(vals.max()))))
         i = int(top[np.argmax(half[top])])
         best, fb = float(pts[i]), float(vals[i])
-        on_edge = _margin(current, edges, period) < 1e-9
+        on_edge = margin(current, edges, period) < 1e-9
     elif turn.kind == "uniform":
         raw = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
         kinks = np.unique(np.mod(raw + period / 2, period)) - period / 2
@@ -405,7 +399,7 @@ def _best_turn(
         best, fb = float(kinks[i]), float(vals[i])
     else:
         h = turn.scale / GRID_PER_SIGMA
-        grid = _turn_grid(crit, period, h, FLAT_SIGMAS * turn.scale)
+        grid = turn_grid(crit, period, h, FLAT_SIGMAS * turn.scale)
         vals = model.line(kind, left, neg, grid)
         i = int(np.argmax(vals))
         best, fb = float(grid[i]), float(vals[i])
