@@ -83,7 +83,7 @@ ACCURACY_HELP = (
     "whose tolerance is at least DEG are returned (exact planner)."
 )
 
-# The noise and payoff options of plan (and --turn-noise of simulate), see cli/noisy.py.
+# The noise and payoff options of plan, simulate and plot, see cli/noisy.py.
 TurnNoiseOpt = Annotated[
     str | None,
     typer.Option(
@@ -91,7 +91,7 @@ TurnNoiseOpt = Annotated[
         metavar="normal:SIGMA_DEG|uniform:A_DEG",
         help="Gripper turns executed as alpha + e, e ~ Normal(0, SIGMA^2) or uniform on "
         "[-A, A] degrees: plan gives the noise-aware Bayes plan; simulate runs it, draws e "
-        "and predicts exactly under it.",
+        "and predicts exactly under it; plot draws it and its distributions under the noise.",
     ),
 ]
 ContactNoiseOpt = Annotated[
@@ -102,7 +102,8 @@ ContactNoiseOpt = Annotated[
         min=0.0,
         max=1.0,
         help="Jaws touch one after the other with probability Q (either side first): such a "
-        "squeeze acts as a push-grasp from that side (plan plans for it, simulate draws it).",
+        "squeeze acts as a push-grasp from that side (plan plans for it, simulate draws it, "
+        "plot draws the distributions under it).",
     ),
 ]
 PayoffOpt = Annotated[
@@ -111,7 +112,8 @@ PayoffOpt = Annotated[
         "--payoff",
         metavar="FILE",
         help="Payoff in [0, 1] of final stable orientations (.json or .csv, orientation_deg,"
-        "value): minimise the expected cost per unit payoff (simulate: judge by the mean).",
+        "value): minimise the expected cost per unit payoff (simulate: judge by the mean; "
+        "plot: draw that plan).",
     ),
 ]
 

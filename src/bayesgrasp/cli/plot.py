@@ -17,11 +17,14 @@ from .common import (
 )
 from .options import (
     AlsoOpt,
+    ContactNoiseOpt,
     JsonOpt,
     MaxMemoryOpt,
     PartPriorOpt,
+    PayoffOpt,
     PlanChoiceOpt,
     SenseOpt,
+    TurnNoiseOpt,
     command_app,
     part_options,
     problem_options,
@@ -54,39 +57,6 @@ ForceOpt = Annotated[
     ),
 ]
 FramesOpt = Annotated[int, typer.Option(min=4, max=240, help="Animation frames per plan step.")]
-# The noise and payoff options of plan (cli/options.py), with what plot does with them.
-TurnNoiseOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--turn-noise",
-        metavar="normal:SIGMA_DEG|uniform:A_DEG",
-        help="Gripper turns executed as alpha + e, e ~ Normal(0, SIGMA^2) or uniform on "
-        "[-A, A] degrees: draw the noise-aware plan (plan's with the same options) and the "
-        "distributions after each step exactly under the noise.",
-    ),
-]
-ContactNoiseOpt = Annotated[
-    float | None,
-    typer.Option(
-        "--contact-noise",
-        metavar="Q",
-        min=0.0,
-        max=1.0,
-        help="Jaws touch one after the other with probability Q (either side first), such a "
-        "squeeze acting as a push-grasp from that side: draw the plan planned for it and "
-        "the distributions under it.",
-    ),
-]
-PayoffOpt = Annotated[
-    Path | None,
-    typer.Option(
-        "--payoff",
-        metavar="FILE",
-        help="Payoff in [0, 1] of final stable orientations (.json or .csv, orientation_deg,"
-        "value): draw the plan of least expected cost per unit payoff.",
-    ),
-]
-
 FIGURES = ("part", "diameter", "transfer", "plan")
 """The figure files, one per image format (:func:`bayesgrasp.figures.files.write_figures`)."""
 ANIMATIONS = ("plan.gif", "plan.mp4")
