@@ -90,3 +90,15 @@ def test_messages_name_the_problem(
     code, out, err = run(capsys, *argv)
     assert (code, out) == (2, "")
     assert words in err and "should be >= 0" not in err
+
+
+@pytest.mark.parametrize("value", ["nan", "0", "-1", "inf"])
+@pytest.mark.parametrize("command", [["plan", "house"], ["squeeze", "house"], ["sweep", "house"]])
+def test_flattening_tolerance_is_checked_for_every_part(
+    capsys: pytest.CaptureFixture[str], command: list[str], value: str
+) -> None:
+    # Polygon parts have no curves to flatten, but a nonsense tolerance is still refused
+    # (as it is for SVG and DXF parts), not passed on.
+    code, out, err = run(capsys, *command, "--flatten-tol", value)
+    assert code == 2 and out == ""
+    assert "--flatten-tol" in err and "> 0" in err and len(err.strip().splitlines()) == 1

@@ -169,3 +169,50 @@ def test_exact_arcs_are_the_limit_of_ever_finer_flattenings() -> None:
         assert_allclose(s.stable, exact.stable, atol=1e-12)
         gap = np.abs(Problem.build(flat).state_distribution() - probs).max()
         assert gap <= 0.3 * math.sqrt(rel)
+
+
+SHALLOW_EDGE_SVG = (
+    b'<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">'
+    b'<path transform="scale(2)" d="M 0 0 L 40 0 C 50 10 45 30 30 35 L 0 25 Z"/></svg>'
+)
+
+
+def _true_minima(svg: bytes, samples: int = 72_000) -> list[float]:
+    """Minima (deg, over [0, 180)) of the diameter of a finely flattened outline, sampled.
+
+    A minimum is a sample lowest within half a degree either side: the flattened chords'
+    own kinks (tiny minima next to the maxima, hundredths of a degree wide) are not.
+    """
+    from scipy.ndimage import minimum_filter1d
+
+    pts = read_part_bytes(svg, "svg", tolerance=1e-4).hull.vertices
+    th = np.linspace(0.0, np.pi, samples, endpoint=False)
+    d = np.ptp(pts[:, 0, None] * np.cos(th) - pts[:, 1, None] * np.sin(th), axis=0)
+    low = minimum_filter1d(d, size=2 * samples // 360 + 1, mode="wrap")
+    return sorted(float(np.degrees(t)) for t in th[d == low])
+
+
+def test_a_shallow_minimum_on_a_straight_edge_survives_the_default_flattening() -> None:
+    # The edge (0, 50)-(60, 70) is exact; the opposite contact is on the cubic. Its minimum
+    # (0.069 px deep) is shallower than 4x the default flattening bound, but flattening
+    # cannot remove it: every tolerance gives the true curve's six states.
+    truth = _true_minima(SHALLOW_EDGE_SVG)
+    assert len(truth) == 3 and abs(truth[2] - 108.435) < 0.01
+    for tol in (None, 0.5, 0.01, 0.001):
+        opts = {} if tol is None else {"tolerance": tol}
+        part = read_part_bytes(SHALLOW_EDGE_SVG, "svg", **opts)
+        d, _ = squeeze_model(part)
+        states = np.degrees(d.minima)
+        assert_allclose(np.sort(states), truth, atol=0.01)
+        p1 = plan_exact(Problem.build(part), max_actions=1).options[0].success_probability
+        assert p1 == pytest.approx(0.2066, abs=5e-5)
+
+
+def test_a_shape_tolerance_still_removes_the_shallow_edge_minimum() -> None:
+    part = read_part_bytes(SHALLOW_EDGE_SVG, "svg")
+    d, _ = squeeze_model(part)
+    assert d.minima.size == 3
+    from bayesgrasp.geometry.curved import with_shape_tol
+
+    loose, _ = squeeze_model(with_shape_tol(part, 0.05))  # 4 x 0.05 > 0.069 px deep
+    assert loose.minima.size == 2

@@ -97,6 +97,13 @@ def accuracy_value(value: float) -> float:
     return value
 
 
+def flatten_value(value: float | None) -> float | None:
+    """The chordal tolerance of ``--flatten-tol``: a finite number > 0 (or left out)."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise typer.BadParameter(f"should be a number > 0 in the part's units; got {value:g}")
+    return value
+
+
 def input_files(part: str | None, prior: str | None = None, *more: str | Path | None) -> list[Path]:
     """The files a command reads: the part file, the prior's file, plan files and the like.
 

@@ -19,7 +19,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
-from .common import accuracy_value, cost_value
+from .common import accuracy_value, cost_value, flatten_value
 from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec, SenseSpec, problem_spec
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -213,7 +213,7 @@ def _part_params(optional: bool = False) -> list[inspect.Parameter]:
         _opt("fmt", PartFormat | None, None, "--format", help=FORMAT_HELP),
         _opt("element", str | None, None, metavar="ID", help=ELEMENT_HELP),
         _opt("layer", str | None, None, help="DXF: read only this layer."),
-        _opt("flatten_tol", float | None, None, help=FLATTEN_HELP),
+        _opt("flatten_tol", float | None, None, callback=flatten_value, help=FLATTEN_HELP),
         _opt("com", str | None, None, "--com", metavar="X,Y", help=COM_HELP),
         _opt("shape_tol", float, 0.0, min=0, help=SHAPE_HELP),
     ]

@@ -9,7 +9,7 @@ from typing import Annotated, Any
 
 import typer
 
-from .common import emit_json, with_progress
+from .common import emit_json, flatten_value, with_progress
 from .options import (
     FLATTEN_HELP,
     POLICY_DEPTH,
@@ -123,7 +123,9 @@ def sweep(
         ),
     ] = None,
     layer: Annotated[str | None, typer.Option(help="DXF: read only this layer.")] = None,
-    flatten_tol: Annotated[float | None, typer.Option(help=FLATTEN_HELP)] = None,
+    flatten_tol: Annotated[
+        float | None, typer.Option(callback=flatten_value, help=FLATTEN_HELP)
+    ] = None,
     shape_tol: Annotated[float, typer.Option(min=0, help=SHAPE_HELP)] = 0.0,
     as_json: JsonOpt = False,
 ) -> None:

@@ -893,6 +893,8 @@ def _extrema(
             at = 0.5 * (lo + hi)
             kink = False
         at = at % period
+        if period - at <= atol:  # the start of the period, not its end
+            at = 0.0
         value = float(_evaluate(breaks, chords, offsets, at, period))
         out.append(Extremum(at, value, runs[i][2] > 0, kink))
     out.sort(key=lambda e: e.theta)
@@ -908,24 +910,86 @@ def _evaluate(
     return float(chords[k, 0] * math.cos(th) - chords[k, 1] * math.sin(th) + offsets[k])
 
 
-def _cancel(ext: list[Extremum], depth: float) -> list[Extremum]:
+def _cancel(
+    ext: list[Extremum],
+    depth: float,
+    exact: Sequence[Extremum] = (),
+    exact_depth: float = 0.0,
+) -> list[Extremum]:
     """Cancel adjacent minimum/maximum pairs at most ``depth`` apart, shallowest first.
 
     A persistence simplification of a cyclic, alternating sequence: what remains are the
     extrema that a perturbation of ``d`` by less than ``depth / 2`` cannot remove. Unlike
     the polygons' barrier, nothing is kept when every pair is shallow (a disc).
+
+    The minima in ``exact`` exist whatever the flattening did (see :func:`_exact_minima`): a
+    pair holding one is cancelled only when at most ``exact_depth`` deep (the uncertainty
+    that is really there: the shape tolerance and the barrier).
     """
     ext = list(ext)
+    sure = {id(e) for e in exact}
     while len(ext) >= 2:
-        gaps = [abs(ext[i].value - ext[i - 1].value) for i in range(len(ext))]
-        i = int(np.argmin(gaps))
-        if gaps[i] > depth:
+        best, at = math.inf, -1
+        for i in range(len(ext)):
+            gap = abs(ext[i].value - ext[i - 1].value)
+            limit = exact_depth if (id(ext[i]) in sure or id(ext[i - 1]) in sure) else depth
+            if gap <= limit and gap < best:
+                best, at = gap, i
+        if at < 0:
             break
         if len(ext) == 2:
             return []
-        j = (i - 1) % len(ext)
-        ext = [e for m, e in enumerate(ext) if m not in (i, j)]
+        j = (at - 1) % len(ext)
+        ext = [e for m, e in enumerate(ext) if m not in (at, j)]
     return ext
+
+
+def _exact_support(hull: CurvedHull, patches: CurvePatches | None) -> Callable[[float], float]:
+    """The true support function ``H = max(h_flat, h_patches)`` (the outline is inscribed)."""
+    if patches is None or not (len(patches.bezier) or len(patches.ellipses)):
+        return lambda phi: float(hull.support(phi))
+    return lambda phi: max(float(hull.support(phi)), patches.support(phi))
+
+
+def _exact_minima(
+    hull: CurvedHull, ext: list[Extremum], patches: CurvePatches | None
+) -> list[Extremum]:
+    """The minima placed exactly: a straight edge of the part flush, and ``d`` falling to it.
+
+    At such a kink the jaw on the edge is exact; the other jaw's contact is on the exact
+    curves (``patches``), so the true ``d = H(-theta) + H(pi - theta)`` is known near it. The
+    minimum is real when the true one-sided slopes are ``-`` and ``+`` (each beyond the
+    rounding of a central difference), however shallow: flattening cannot remove it, only
+    the shape tolerance can. Chords of flattened curves are never exact; nor is anything
+    when some curve has no exact form (rational splines).
+    """
+    if hull.chord_edges is None or (patches is not None and not patches.complete):
+        return []
+    if patches is None and hull.approximate is not None and bool(np.any(hull.approximate)):
+        return []
+    support = _exact_support(hull, patches)
+    tol = hull.tol.angle
+    step = 1e-7
+    margin = 1e-5 * hull.size  # slopes within this (per radian) count as flat
+
+    def d(th: float) -> float:
+        return support(-th) + support(math.pi - th)
+
+    out = []
+    for e in ext:
+        if e.is_max or not e.kink:
+            continue
+        real = False
+        for phi in (-e.theta, math.pi - e.theta):
+            k = int(hull.piece_index(phi + tol))
+            if abs(math.remainder(float(hull.starts[k]) - phi, TWO_PI)) <= tol and hull.edges[k]:
+                real = real or not bool(hull.chord_edges[k])
+        if not real:
+            continue
+        at = d(e.theta)
+        if (at - d(e.theta - step)) / step < -margin and (d(e.theta + step) - at) / step > margin:
+            out.append(e)
+    return out
 
 
 def _needs_refining(hull: CurvedHull, e: Extremum, jaws: tuple[float, ...]) -> bool:
@@ -956,8 +1020,12 @@ def _refined(
     period: float = math.pi,
     jaws: tuple[float, ...] = _BOTH,
     center: FloatArray | None = None,
+    placed: Sequence[Extremum] = (),
 ) -> list[Extremum]:
     """The extrema that flattened curves carry, placed on the exact curves.
+
+    The minima in ``placed`` (a straight edge flush) stay where they are; only their width
+    is read on the exact curves.
 
     Each such extremum of the flattened model is searched again on the exact diameter
     ``d(theta) = H(-theta) + H(pi - theta)``, ``H = max(h_flat, h_curves)``, between the
@@ -978,8 +1046,12 @@ def _refined(
 
     out = list(kept)
     m = len(kept)
+    sure = {id(e) for e in placed}
     for i, e in enumerate(kept):
         if not _needs_refining(hull, e, jaws):
+            continue
+        if id(e) in sure:
+            out[i] = Extremum(e.theta, exact(e.theta), False, True)
             continue
         if m > 1:
             before = (e.theta - kept[i - 1].theta) % period or period
@@ -994,12 +1066,18 @@ def _refined(
             options={"xatol": 1e-12},
         )
         th = float(res.x) % period
+        if period - th <= hull.tol.angle:  # the start of the period, not its end
+            th = 0.0
         out[i] = Extremum(th, exact(th), e.is_max, False)
+    out.sort(key=lambda e: e.theta)  # a refined extremum may have crossed 0
     return out
 
 
 def curved_diameter(
-    hull: CurvedHull, error: float = 0.0, patches: CurvePatches | None = None
+    hull: CurvedHull,
+    error: float = 0.0,
+    patches: CurvePatches | None = None,
+    shape_tol: float = 0.0,
 ) -> CurvedDiameter:
     """The diameter function of a curved hull, its extrema and the certain ones.
 
@@ -1013,6 +1091,11 @@ def curved_diameter(
     patches : CurvePatches, optional
         The flattened curves in exact form: the certain extrema they carry are placed on
         them (see :func:`_refined`).
+    shape_tol : float
+        The part of ``error`` that is the user's shape tolerance. A minimum where a straight
+        edge of the part lies flush is placed exactly and, when the exact curves show the
+        true ``d`` falling to it from both sides, it is real however shallow: only pairs
+        shallower than ``4 shape_tol`` (and the barrier) remove it (:func:`_exact_minima`).
 
     Returns
     -------
@@ -1027,10 +1110,12 @@ def curved_diameter(
     atol = hull.tol.angle
     breaks, chords, offsets = _sub_pieces(hull, atol)
     ext = _extrema(breaks, chords, offsets, hull, atol)
-    depth = max(hull.tol.barrier_for(hull.size), 4.0 * float(error))
-    kept = _cancel(ext, depth)
+    barrier = hull.tol.barrier_for(hull.size)
+    depth = max(barrier, 4.0 * float(error))
+    sure = _exact_minima(hull, ext, patches) if error > shape_tol else []
+    kept = _cancel(ext, depth, sure, max(barrier, 4.0 * float(shape_tol)))
     if patches is not None and (len(patches.bezier) or len(patches.ellipses)):
-        kept = _refined(hull, kept, patches)
+        kept = _refined(hull, kept, patches, placed=sure)
     minima = np.array([e.theta for e in kept if not e.is_max], dtype=np.float64)
     maxima = np.array([e.theta for e in kept if e.is_max], dtype=np.float64)
     for arr in (breaks, chords, offsets, minima, maxima):
@@ -1092,7 +1177,9 @@ class CurvedPart(Part):
     def diameter_function(self) -> CurvedDiameter:
         """The exact diameter function with the certain extrema (computed once)."""
         if "diameter" not in self._model:
-            self._model["diameter"] = curved_diameter(self.curved_hull, self.error, self.patches)
+            self._model["diameter"] = curved_diameter(
+                self.curved_hull, self.error, self.patches, self.shape_tol
+            )
         return self._model["diameter"]  # type: ignore[return-value]
 
 
