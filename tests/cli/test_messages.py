@@ -102,3 +102,23 @@ def test_flattening_tolerance_is_checked_for_every_part(
     code, out, err = run(capsys, *command, "--flatten-tol", value)
     assert code == 2 and out == ""
     assert "--flatten-tol" in err and "> 0" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_one_cycle_policy_simulation_is_valid_json(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    code, out, err = run(capsys, "simulate", "house", "--sense", "width", "--trials", "1", "--json")
+    assert code == 0, err
+    doc = json.loads(out)  # strict: no Infinity
+    assert doc["cycles"] == 1
+    assert doc["cycle_cost"]["interval"] == [None, None]  # one cycle bounds nothing
+    assert doc["success_probability"]["predicted"] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize("command", ["plan", "squeeze", "simulate"])
+def test_an_empty_prior_is_refused_not_taken_as_uniform(
+    capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    code, out, err = run(capsys, command, "house", "--prior", "")
+    assert code == 2 and out == ""
+    assert "prior is empty" in err

@@ -196,7 +196,7 @@ def problem_spec(names: list[str], values: Mapping[str, Any]) -> ProblemSpec:
     first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
     given = frozenset(k for k in ("prior", "goal") if values[k] is not None)
     return ProblemSpec(
-        prior=values["prior"] or "uniform",
+        prior="uniform" if values["prior"] is None else values["prior"],
         costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
         first={n: c for n, c in first.items() if c is not None},
         verify=values["verify_cost"],

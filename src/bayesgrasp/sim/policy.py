@@ -672,14 +672,20 @@ def policy_simulation_text(sim: PolicySimulation, title: str = "") -> str:
 def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
     """``bayesgrasp.policy-simulation/1``: predicted and observed figures with intervals.
 
+    An interval that one cycle cannot bound (or a figure of no cycle) is ``null``.
+
     A policy planned under noisy actions adds ``noise`` (the model its figures are exact
     under, :meth:`~bayesgrasp.model.noise.NoiseModel.to_json`); a MuJoCo run with a jaw lag
     adds ``jaw_lag_s``.
     """
     e = sim.reading_errors if len(sim.reading_errors) else np.full(1, math.nan)
     keys = ["success_probability", "cycle_cost", "expected_actions", "expected_cost"]
+
+    def num(x: float) -> float | None:  # JSON has no infinity: an unbounded end is null
+        return float(x) if math.isfinite(x) else None
+
     figs = {
-        k: {"predicted": pred, "observed": obs, "interval": [lo, hi]}
+        k: {"predicted": num(pred), "observed": num(obs), "interval": [num(lo), num(hi)]}
         for k, (_, pred, (obs, lo, hi)) in zip(keys, _figures(sim), strict=True)
     }
     return {
@@ -696,9 +702,9 @@ def policy_simulation_json(sim: PolicySimulation) -> dict[str, Any]:
         "z": _Z,
         **figs,
         "reading_error": {
-            "mean": float(e.mean()),
-            "sd": float(e.std()),
-            "max_abs": float(np.abs(e).max()),
+            "mean": num(float(e.mean())),
+            "sd": num(float(e.std())),
+            "max_abs": num(float(np.abs(e).max())),
             "readings": len(sim.reading_errors),
         },
         "agrees": sim.agrees,
