@@ -1,8 +1,12 @@
-"""The policy search's memory bound: seen and changed by the user, one line when reached."""
+"""The policy search's memory and time bounds: seen and changed by the user; reaching one
+gives the deepest policy that finished (checked against an unbounded search of that depth),
+its reason and a lower bound, or one line."""
 
 from __future__ import annotations
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bayesgrasp import shapes
 from bayesgrasp.cli import main
@@ -10,17 +14,54 @@ from bayesgrasp.errors import PlanningError
 from bayesgrasp.model import Problem
 from bayesgrasp.model.noise import NoiseModel, TurnNoise
 from bayesgrasp.planning.noisy_policy import plan_noisy_policy
-from bayesgrasp.planning.policy import memory_bytes, plan_policy
+from bayesgrasp.planning.policy import SearchStopped, memory_bytes, plan_policy
 
 HOUSE = Problem.build(shapes.load("house"))
 
 
-def test_a_search_past_its_bound_stops_with_the_reason() -> None:
-    with pytest.raises(PlanningError, match=r"take more than 1 MB .*--max-memory"):
-        plan_policy(HOUSE, "width:0.5,0.1", 3, max_memory_mb=1.0)
+def test_a_search_past_its_bound_answers_with_the_deepest_policy_that_finished() -> None:
+    pol = plan_policy(HOUSE, "width:0.5,0.1", 3, max_memory_mb=1.0)
+    assert not pol.complete and pol.requested_actions == 3 and pol.max_actions < 3
+    assert "took more than 1 MB" in pol.stopped and "--max-memory" in pol.stopped
+    # The answer is the exact best policy of the depth that finished ...
+    shallow = plan_policy(HOUSE, "width:0.5,0.1", pol.max_actions, max_memory_mb=2**30)
+    assert shallow.complete and pol.expected_cost == pytest.approx(shallow.expected_cost, 1e-12)
+    # ... and the lower bound holds for the true best policy of the depth asked for.
+    full = plan_policy(HOUSE, "width:0.5,0.1", 3, max_memory_mb=2**30)
+    assert full.complete and full.lower_bound == full.expected_cost
+    assert pol.lower_bound <= full.expected_cost + 1e-12 <= pol.expected_cost + 2e-12
+
+
+def test_a_search_past_its_time_bound_answers_too() -> None:
+    pol = plan_policy(HOUSE, "width:0.5,0.1", 3, time_limit_s=1e-6)
+    assert not pol.complete and "ran for 1e-06 s" in pol.stopped and "--time-limit" in pol.stopped
+    shallow = plan_policy(HOUSE, "width:0.5,0.1", pol.max_actions)
+    assert pol.expected_cost == pytest.approx(shallow.expected_cost, 1e-12)
+
+
+def test_without_the_fallback_the_search_stops_with_the_reason() -> None:
+    with pytest.raises(SearchStopped, match=r"took more than 1 MB .*--max-memory"):
+        plan_policy(HOUSE, "width:0.5,0.1", 3, max_memory_mb=1.0, best_so_far=False)
     noise = NoiseModel(TurnNoise("normal", 0.03))
-    with pytest.raises(PlanningError, match="take more than 1 MB"):
+    with pytest.raises(PlanningError, match="took more than 1 MB"):
         plan_noisy_policy(HOUSE, "width:0.5,0.1", 3, noise, max_memory_mb=1.0)
+
+
+@given(
+    st.sampled_from(["width", "width:0.5,0.1", "width:0,0.5"]),
+    st.integers(1, 3),
+    st.sampled_from([("squeeze",), ("squeeze", "push-grasp")]),
+)
+@settings(max_examples=12, deadline=None)
+def test_the_lower_bound_is_below_every_optimum(sensor: str, depth: int, actions: tuple) -> None:
+    from bayesgrasp.model.sensing import parse_sensor
+    from bayesgrasp.planning.policy import _first_angles, _lower_bound, _space
+
+    pb = Problem.build(shapes.load("house"), actions=actions)
+    space = _space(pb, None, depth)
+    angles, _ = _first_angles(space, pb.action_kinds, 512)
+    bound = _lower_bound(space, parse_sensor(sensor), angles)
+    assert bound <= plan_policy(pb, sensor, depth).expected_cost + 1e-12
 
 
 def test_the_default_bound_plans_as_before() -> None:
@@ -37,12 +78,25 @@ def test_bad_bounds_are_refused(bad: object) -> None:
 
 
 @pytest.mark.parametrize("command", ["plan", "simulate", "plot"])
-def test_the_option(command: str, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main([command, "house", "--max-memory", "10"]) == 2
-    assert "--max-memory bounds a policy search: it needs --sense" in capsys.readouterr().err
-    args = [command, "house", "--sense", "width:0.5,0.1", "--max-memory", "1"]
-    if command == "simulate":
-        args += ["--trials", "10"]
-    assert main(args) == 2
+@pytest.mark.parametrize("option", [("--max-memory", "10"), ("--time-limit", "5")])
+def test_the_options_need_sense(
+    command: str, option: tuple[str, str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main([command, "house", *option]) == 2
     err = capsys.readouterr().err
-    assert "take more than 1 MB" in err and len(err.strip().splitlines()) == 1
+    assert "--max-memory and --time-limit bound a policy search: they need --sense" in err
+
+
+def test_plan_says_when_the_search_stopped(capsys: pytest.CaptureFixture[str]) -> None:
+    args = ["plan", "house", "--sense", "width:0.5,0.1", "--max-memory", "1"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "search stopped: its beliefs took more than 1 MB" in out
+    assert "best policy of at most" in out and "no policy of 3 actions costs less than" in out
+
+
+def test_a_noisy_policy_past_its_bound_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
+    args = ["plan", "house", "--sense", "width:0.5,0.1", "--turn-noise", "normal:2"]
+    assert main([*args, "--max-memory", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "took more than 1 MB" in err and len(err.strip().splitlines()) == 1

@@ -122,3 +122,14 @@ def test_an_empty_prior_is_refused_not_taken_as_uniform(
     code, out, err = run(capsys, command, "house", "--prior", "")
     assert code == 2 and out == ""
     assert "prior is empty" in err
+
+
+@pytest.mark.parametrize("option", ["--export", "--plot"])
+def test_an_over_long_output_name_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path, option: str
+) -> None:
+    name = str(tmp_path / ("x" * 300 + (".csv" if option == "--export" else ".png")))
+    code, out, err = run(capsys, "plan", "house", option, name)
+    assert code == 2 and out == ""
+    assert "cannot write" in err and "File name too long" in err
+    assert len(err.strip().splitlines()) == 1

@@ -9,6 +9,7 @@ over any other existing file only with ``--force``.
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -163,6 +164,13 @@ def check_outputs(
                     "refusing to write over it, choose another name",
                     param_hint=hint,
                 )
+        try:
+            out.lstat()
+        except OSError as exc:
+            if exc.errno == errno.ENAMETOOLONG:  # the checks below would raise it
+                raise typer.BadParameter(
+                    f"cannot write {str(out)!r} ({exc.strerror})", param_hint=hint
+                ) from None
         if out.is_dir() and not folders:
             raise typer.BadParameter(f"{str(out)!r} is a folder, not a file", param_hint=hint)
     there = [out for out in outputs if out.exists() or out.is_symlink()]

@@ -178,6 +178,18 @@ MaxMemoryOpt = Annotated[
         "beliefs it acts on; past it the search stops with a message (default 2048).",
     ),
 ]
+TimeLimitOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--time-limit",
+        metavar="S",
+        min=0.001,
+        help="With --sense: the most seconds the policy search may take (default 60). Past "
+        "it (or --max-memory) the search plans again within the same bounds, one action more "
+        "at a time, and answers with the deepest policy that finished, saying so and giving "
+        "a lower bound on the cost of any policy of --max-actions.",
+    ),
+]
 FoldOpt = Annotated[
     float,
     typer.Option(
@@ -340,6 +352,7 @@ def sense_spec(
     part_prior: str | None,
     spec: ProblemSpec,
     max_memory_mb: float | None = None,
+    time_limit_s: float | None = None,
 ) -> SenseSpec:
     """The :class:`SenseSpec` of the --sense options, its depth ``spec``'s --max-actions.
 
@@ -360,6 +373,9 @@ def sense_spec(
             f"level); got {depth}",
             param_hint="--max-actions",
         )
-    if max_memory_mb is None:
-        return SenseSpec(sense, tuple(also), part_prior, depth)
-    return SenseSpec(sense, tuple(also), part_prior, depth, max_memory_mb)
+    bounds = {
+        k: v
+        for k, v in (("max_memory_mb", max_memory_mb), ("time_limit_s", time_limit_s))
+        if v is not None
+    }
+    return SenseSpec(sense, tuple(also), part_prior, depth, **bounds)

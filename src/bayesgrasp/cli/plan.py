@@ -23,6 +23,7 @@ from .options import (
     PartPriorOpt,
     PayoffOpt,
     SenseOpt,
+    TimeLimitOpt,
     TurnNoiseOpt,
     command_app,
     part_options,
@@ -137,6 +138,7 @@ def plan(
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
     max_memory: MaxMemoryOpt = None,
+    time_limit: TimeLimitOpt = None,
     fold_below: FoldOpt = 0.01,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
@@ -177,8 +179,10 @@ def plan(
         raise typer.BadParameter("--also and --part-prior need --sense")
     if sense is None and _given(ctx, "fold_below"):
         raise typer.BadParameter("--fold-below needs --sense")
-    if sense is None and max_memory is not None:
-        raise typer.BadParameter("--max-memory bounds a policy search: it needs --sense")
+    if sense is None and (max_memory, time_limit) != (None, None):
+        raise typer.BadParameter(
+            "--max-memory and --time-limit bound a policy search: they need --sense"
+        )
     noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
     if sense is not None:
         refused = [
@@ -193,7 +197,7 @@ def plan(
         if refused:
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
-        sensing = sense_spec(sense, more, part_prior, spec, max_memory)
+        sensing = sense_spec(sense, more, part_prior, spec, max_memory, time_limit)
         fold = fold_below if _given(ctx, "fold_below") else None  # the figure's, when given
         from .sensing import plan_policy_command, sense_noise
 

@@ -24,6 +24,7 @@ from .options import (
     PayoffOpt,
     PlanChoiceOpt,
     SenseOpt,
+    TimeLimitOpt,
     TurnNoiseOpt,
     command_app,
     part_options,
@@ -86,6 +87,7 @@ def plot(
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
     max_memory: MaxMemoryOpt = None,
+    time_limit: TimeLimitOpt = None,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
     payoff: PayoffOpt = None,
@@ -120,14 +122,16 @@ def plot(
         from .sensing import plot_policy_command, sense_noise
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
-        sensing = sense_spec(sense, also or (), part_prior, spec, max_memory)
+        sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
         action = sense_noise(turn_noise, contact_noise, payoff)
         plot_policy_command(part, spec, sensing, out, formats, as_json, action)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
-    if max_memory is not None:
-        raise typer.BadParameter("--max-memory bounds a policy search: it needs --sense")
+    if (max_memory, time_limit) != (None, None):
+        raise typer.BadParameter(
+            "--max-memory and --time-limit bound a policy search: they need --sense"
+        )
     run = (
         noisy.NoisyRun.of(spec, turn_noise, contact_noise, payoff)
         if noisy.asked(turn_noise, contact_noise, payoff)

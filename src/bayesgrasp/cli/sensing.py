@@ -120,6 +120,12 @@ def plan_policy_command(
         f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
         f"(bits): {entropy}"
     )
+    if not pol.complete:
+        typer.echo(
+            f"search stopped: {pol.stopped}. This is the best policy of at most "
+            f"{pol.max_actions} actions (the deepest search that finished); no policy of "
+            f"{pol.requested_actions} actions costs less than {pol.lower_bound:.4f}"
+        )
     if pol.payoff is not None:
         typer.echo("payoff: success is the expected payoff earned, the cost is per unit payoff")
     if pol.noise is not None:

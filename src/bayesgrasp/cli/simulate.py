@@ -28,6 +28,7 @@ from .options import (
     PayoffOpt,
     PlanChoiceOpt,
     SenseOpt,
+    TimeLimitOpt,
     TurnNoiseOpt,
     command_app,
     part_options,
@@ -141,6 +142,7 @@ def simulate(
     also: AlsoOpt = None,
     part_prior: PartPriorOpt = None,
     max_memory: MaxMemoryOpt = None,
+    time_limit: TimeLimitOpt = None,
     sensor_error: SensorErrorOpt = False,
     jaw_lag: JawLagOpt = 0.0,
 ) -> None:
@@ -211,7 +213,7 @@ def simulate(
         model, _, _ = _noise_model(noise, noise_kind, turn_noise, contact_noise)
         asked = not model.exact or payoff is not None
         action = ActionModel(model, payoff) if asked else None
-        sensing = sense_spec(sense, also or (), part_prior, spec, max_memory)
+        sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
             sensor_error, as_json, action, jaw_lag,
@@ -219,8 +221,10 @@ def simulate(
         return
     if also or part_prior is not None or sensor_error:
         raise typer.BadParameter("--also, --part-prior and --sensor-error need --sense")
-    if max_memory is not None:
-        raise typer.BadParameter("--max-memory bounds a policy search: it needs --sense")
+    if (max_memory, time_limit) != (None, None):
+        raise typer.BadParameter(
+            "--max-memory and --time-limit bound a policy search: they need --sense"
+        )
     model, noise_deg, kind = _noise_model(noise, noise_kind, turn_noise, contact_noise)
     p = part.load()
     given = units is not None

@@ -222,6 +222,8 @@ class SenseSpec:
     max_actions: int = 3
     max_memory_mb: float = 2048.0
     """The policy search's memory bound (``--max-memory``)."""
+    time_limit_s: float = 60.0
+    """The policy search's time bound (``--time-limit``)."""
 
     def parts(self, part: PartSpec) -> list[Part]:
         """PART, then each candidate part, read with the same part-file options."""
@@ -242,6 +244,7 @@ class SenseSpec:
             max_actions=self.max_actions,
             part_prior=self.part_prior,
             max_memory_mb=self.max_memory_mb,
+            time_limit_s=self.time_limit_s,
         )
         return problems, pol
 

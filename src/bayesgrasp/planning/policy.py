@@ -151,8 +151,10 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import math
+import time
 from collections.abc import Collection, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast
@@ -183,6 +185,7 @@ __all__ = [
     "Policy",
     "PolicyNode",
     "Reject",
+    "SearchStopped",
     "joint_transition",
     "plan_policy",
     "policy_text",
@@ -328,6 +331,18 @@ class Policy:
         a declaring leaf stops and earns the payoff of the state the part is in (its
         ``success_probability`` is then the expected payoff, and ``success_probability``
         of the policy the expected payoff of a cycle).
+    stopped : str
+        Empty when the search finished. Otherwise why it stopped (its time or memory bound)
+        before proving the best policy of ``requested_actions`` actions: the policy is then
+        the best of at most ``max_actions`` actions (the deepest search that finished), and
+        no policy of ``requested_actions`` costs less than ``lower_bound``.
+    requested_actions : int
+        The number of actions asked for (``max_actions`` unless the search stopped).
+    lower_bound : float
+        A lower bound on the expected cost of every policy of ``requested_actions`` actions
+        (``c_first / U + v``: a cycle acts once and verifies what it declares, and succeeds
+        with at most ``U``; see :func:`plan_policy`). A finished exact search gives its own
+        cost (the optimum); ``nan`` where not known (noisy actions).
     """
 
     root: PolicyNode
@@ -350,6 +365,18 @@ class Policy:
     noise: NoiseModel | None = None
     refinement_bound: float = 0.0
     payoff: tuple[float, ...] | None = None
+    stopped: str = ""
+    requested_actions: int = 0
+    lower_bound: float = math.nan
+
+    def __post_init__(self) -> None:
+        if not self.requested_actions:
+            object.__setattr__(self, "requested_actions", self.max_actions)
+
+    @property
+    def complete(self) -> bool:
+        """Whether the search finished (the policy is the best of ``requested_actions``)."""
+        return not self.stopped
 
     @property
     def expected_total_actions(self) -> float:
@@ -488,6 +515,8 @@ class _Solver:
     searched: int = 0
     max_bytes: int = 0  # most memory (about) for prepared beliefs (0: no limit; `prepared`)
     prep_bytes: int = 0
+    deadline: float = math.inf  # time.monotonic() past which the search stops (`prepared`)
+    time_limit: float = math.inf  # the seconds that deadline allows (for the message)
     memo: _Memo = field(default_factory=dict)
     prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
@@ -738,10 +767,14 @@ class _Solver:
         hit = self.prep_cache.get((key, ti))
         if hit is None:
             if self.max_bytes and self.prep_bytes > self.max_bytes:
-                raise PlanningError(
-                    f"the policy search's beliefs take more than {self.max_bytes / 2**20:,.0f} "
-                    "MB (the memory bound: --max-memory MB, `max_memory_mb` in the library): "
-                    "raise it, or plan fewer actions"
+                raise SearchStopped(
+                    f"its beliefs took more than {self.max_bytes / 2**20:,.0f} MB (the memory "
+                    "bound: --max-memory MB, `max_memory_mb` in the library)"
+                )
+            if time.monotonic() > self.deadline:
+                raise SearchStopped(
+                    f"it ran for {self.time_limit:g} s (the time bound: --time-limit S, "
+                    "`time_limit_s` in the library)"
                 )
             imgs, rows = self.images(q, self.kinds[ti])
             hit = (self.prepare(imgs), rows)
@@ -1108,6 +1141,38 @@ def _pairs(space: StateSpace) -> tuple[IntArray, IntArray, NDArray[np.bool_], bo
 DEFAULT_MAX_MEMORY_MB = 2048.0
 """Default bound on the memory of the beliefs a policy search keeps (their images, readings)."""
 
+DEFAULT_TIME_LIMIT_S = 60.0
+"""Default bound on the seconds of a policy search (then once more for the fallback)."""
+
+
+class SearchStopped(PlanningError):
+    """A policy search reached its time or memory bound (``reason`` says which)."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(
+            f"the policy search stopped: {reason}; raise the bound, or plan fewer actions"
+        )
+        self.reason = reason
+
+
+def time_seconds(time_limit_s: float | None) -> float:
+    """The time bound in seconds (``None``: none), or a PlanningError.
+
+    Examples
+    --------
+    >>> time_seconds(2), time_seconds(None)
+    (2.0, inf)
+    """
+    if time_limit_s is None:
+        return math.inf
+    if (
+        isinstance(time_limit_s, bool)
+        or not isinstance(time_limit_s, int | float)
+        or not 0 < time_limit_s < 1e9
+    ):
+        raise PlanningError(f"`time_limit_s` must be a number of seconds > 0; got {time_limit_s!r}")
+    return float(time_limit_s)
+
 
 def memory_bytes(max_memory_mb: float) -> int:
     """The bound in bytes of ``max_memory_mb`` (a number > 0), or a PlanningError.
@@ -1184,6 +1249,8 @@ def plan_policy(
     max_iterations: int = 50,
     sensorless: bool = True,
     max_memory_mb: float = DEFAULT_MAX_MEMORY_MB,
+    time_limit_s: float | None = DEFAULT_TIME_LIMIT_S,
+    best_so_far: bool = True,
     _prune: Collection[str] = _PRUNE,
 ) -> Policy:
     """The Bayes policy: least expected cost over all policies of at most ``max_actions``.
@@ -1209,8 +1276,17 @@ def plan_policy(
     max_iterations : int
         Most parametric steps.
     max_memory_mb : float
-        Most memory (about, MB) the search may keep for the beliefs it acts on; past it a
-        :class:`~bayesgrasp.errors.PlanningError` says so (default 2048).
+        Most memory (about, MB) the search may keep for the beliefs it acts on (default
+        2048).
+    time_limit_s : float or None
+        Most seconds the search may take (default 60; ``None``: no bound).
+    best_so_far : bool
+        When the search reaches either bound: ``True`` (default) plans again, one action
+        more at a time from one, within the same bounds once more, and returns the deepest
+        policy that finished, with :attr:`Policy.stopped` saying why and
+        :attr:`Policy.lower_bound` how little any policy of ``max_actions`` could cost (so
+        the search may take up to twice ``time_limit_s``); ``False`` raises
+        :class:`SearchStopped`.
     sensorless : bool
         Also plan the sensorless Bayes plan (one part; :func:`plan_exact` within
         ``max_actions``): its cost is reported (``Policy.sensorless_cost``) and starts the
@@ -1227,6 +1303,9 @@ def plan_policy(
     PlanningError
         If ``max_actions < 1``, the problems' actions differ, or their gripper accuracies
         differ (one gripper turns for every candidate part).
+    SearchStopped
+        A bound was reached and no shorter search finished either (or ``best_so_far`` is
+        false).
 
     Examples
     --------
@@ -1239,9 +1318,8 @@ def plan_policy(
     sens = parse_sensor(sensor)
     space = _space(problems, part_prior, max_actions)
     main = space.problems[0]
-    solver = _solver(space, sens, _prune)
-    solver.max_bytes = memory_bytes(max_memory_mb)
-    kinds = solver.kinds
+    max_bytes = memory_bytes(max_memory_mb)
+    seconds = time_seconds(time_limit_s)
     if first_angles is not None:
         angles = [float(a) for a in first_angles]
         if not angles or not all(math.isfinite(a) for a in angles):
@@ -1251,31 +1329,82 @@ def plan_policy(
         angles_exact = False
     else:
         angles, angles_exact = _first_angles(space, main.action_kinds, max_first_angles)
-    roots = np.array(
-        [space.initial(k.name, a) for k in kinds for a in angles]
-    )  # (R, N), kind-major
-    root_kind = [ti for ti in range(len(kinds)) for _ in angles]
-    root_angle = [a for _ in kinds for a in angles]
 
-    # A known policy's ratio starts the parametric search: one action then declare the
-    # likeliest state on every reading, or the sensorless Bayes plan (one part).
-    sensorless_cost: float | None = None
-    if sensorless and space.n_parts == 1:
+    def sensorless_within(depth: int) -> float | None:
+        if not (sensorless and space.n_parts == 1):
+            return None
         from .exact import plan_exact
 
-        sensorless_cost = plan_exact(main, max_actions=max_actions).bayes_plan.expected_cost
-    lam = _start_ratio(solver, roots, root_kind)
-    if sensorless_cost is not None and math.isfinite(sensorless_cost):
-        lam = min(lam, sensorless_cost)
+        return plan_exact(main, max_actions=depth).bayes_plan.expected_cost
 
-    deepen = "deepen" in _prune and sens.sigma > 0
-    best_pick, it = _search(solver, roots, root_kind, lam, max_actions, max_iterations, deepen)
-    builder = _Builder(solver, max_actions)
-    k = kinds[root_kind[best_pick]]
-    root = builder.node(
-        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True
+    def attempt(depth: int, known: float | None, deadline: float) -> Policy:
+        """The best policy within ``depth`` actions; ``known``: a known plan's cost."""
+        solver = _solver(space, sens, _prune)
+        solver.max_bytes, solver.deadline, solver.time_limit = max_bytes, deadline, seconds
+        roots, root_kind, root_angle = _roots(space, solver.kinds, angles)
+        # A known policy's ratio starts the parametric search: one action then declare the
+        # likeliest state on every reading, or the sensorless Bayes plan (one part).
+        lam = _start_ratio(solver, roots, root_kind)
+        if known is not None and math.isfinite(known):
+            lam = min(lam, known)
+        deepen = "deepen" in _prune and sens.sigma > 0
+        best_pick, it = _search(solver, roots, root_kind, lam, depth, max_iterations, deepen)
+        builder = _Builder(solver, depth)
+        k = solver.kinds[root_kind[best_pick]]
+        root = builder.node(
+            k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, depth - 1, 0.0, 1, True
+        )
+        return _finish(builder, root, space, sens, depth, sensorless_cost, it, angles_exact)
+
+    sensorless_cost = sensorless_within(max_actions)
+    try:
+        pol = attempt(max_actions, sensorless_cost, time.monotonic() + seconds)
+        return dataclasses.replace(pol, lower_bound=pol.expected_cost)  # it is the optimum
+    except SearchStopped as exc:
+        stop = exc
+    if not best_so_far or max_actions == 1:
+        raise stop
+    # The best answer so far: the deepest search that finishes within the bounds again.
+    deadline = time.monotonic() + seconds
+    best: Policy | None = None
+    for depth in range(1, max_actions):
+        try:
+            best = attempt(depth, sensorless_within(depth), deadline)
+        except SearchStopped:
+            break
+    if best is None:
+        raise SearchStopped(f"{stop.reason}, and so did the search of one action") from None
+    return dataclasses.replace(
+        best,
+        stopped=stop.reason,
+        requested_actions=max_actions,
+        lower_bound=_lower_bound(space, sens, angles),
     )
-    return _finish(builder, root, space, sens, max_actions, sensorless_cost, it, angles_exact)
+
+
+def _roots(
+    space: StateSpace, kinds: Sequence[_Kind], angles: Sequence[float]
+) -> tuple[FloatArray, list[int], list[float]]:
+    """The beliefs after each first action (kind-major over ``angles``), its kind and angle."""
+    roots = np.array([space.initial(k.name, a) for k in kinds for a in angles])  # (R, N)
+    root_kind = [ti for ti in range(len(kinds)) for _ in angles]
+    root_angle = [a for _ in kinds for a in angles]
+    return roots, root_kind, root_angle
+
+
+def _lower_bound(space: StateSpace, sens: WidthSensor, angles: Sequence[float]) -> float:
+    """A lower bound on the expected cost of every policy, however many actions it takes.
+
+    A cycle pays its first action ``c_first`` and, when it declares, the verification ``v``;
+    it succeeds with probability ``P <= U`` (:meth:`_Solver.bound` of the belief after the
+    first action; 1 without pi pairs), and ``E[cost] >= E[C] / P >= c_first / U + v``.
+    """
+    solver = _solver(space, sens)
+    roots, root_kind, _ = _roots(space, solver.kinds, angles)
+    u, _ = solver.bound(roots)
+    first = np.array([solver.kinds[ti].first_cost for ti in root_kind])
+    with np.errstate(divide="ignore"):
+        return float(np.min(first / u)) + solver.verify
 
 
 def _space(
