@@ -100,3 +100,12 @@ def test_a_noisy_policy_past_its_bound_is_one_line(capsys: pytest.CaptureFixture
     assert main([*args, "--max-memory", "1"]) == 2
     err = capsys.readouterr().err
     assert "took more than 1 MB" in err and len(err.strip().splitlines()) == 1
+
+
+def test_progress_reports_the_seconds_of_the_time_bound() -> None:
+    calls: list[tuple[int, int]] = []
+    pb = Problem.build(shapes.load("key"), actions=("squeeze", "push-grasp"))
+    plan_policy(pb, "width:0.2,0.05", 3, time_limit_s=30, progress=lambda *a: calls.append(a))
+    assert calls and all(total == 30 and 0 <= used <= 30 for used, total in calls)
+    plan_policy(HOUSE, "width", 2, time_limit_s=None, progress=lambda *a: calls.append((-1, -1)))
+    assert (-1, -1) not in calls  # no time bound: nothing to show

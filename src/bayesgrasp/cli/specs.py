@@ -236,15 +236,21 @@ class SenseSpec:
     ) -> tuple[list[Problem], Policy]:
         """The candidates' problems and their Bayes policy (``sensor`` replaces ``sense``)."""
         from ..planning.policy import plan_policy
+        from .common import with_progress
 
         problems = [spec.build(p) for p in parts]
-        pol = plan_policy(
-            problems,
-            sensor=self.sense if sensor is None else sensor,
-            max_actions=self.max_actions,
-            part_prior=self.part_prior,
-            max_memory_mb=self.max_memory_mb,
-            time_limit_s=self.time_limit_s,
+        pol = with_progress(
+            "policy search (seconds of --time-limit)",
+            math.ceil(self.time_limit_s),
+            lambda progress: plan_policy(
+                problems,
+                sensor=self.sense if sensor is None else sensor,
+                max_actions=self.max_actions,
+                part_prior=self.part_prior,
+                max_memory_mb=self.max_memory_mb,
+                time_limit_s=self.time_limit_s,
+                progress=progress,
+            ),
         )
         return problems, pol
 

@@ -155,7 +155,7 @@ import dataclasses
 import logging
 import math
 import time
-from collections.abc import Collection, Iterable, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast
 
@@ -517,6 +517,8 @@ class _Solver:
     prep_bytes: int = 0
     deadline: float = math.inf  # time.monotonic() past which the search stops (`prepared`)
     time_limit: float = math.inf  # the seconds that deadline allows (for the message)
+    progress: Callable[[int, int], None] | None = None  # (seconds used, seconds allowed)
+    shown: float = 0.0  # when progress was last called
     memo: _Memo = field(default_factory=dict)
     prep_cache: dict[tuple[bytes, int], tuple[_Prepared, IntArray]] = field(default_factory=dict)
 
@@ -771,7 +773,12 @@ class _Solver:
                     f"its beliefs took more than {self.max_bytes / 2**20:,.0f} MB (the memory "
                     "bound: --max-memory MB, `max_memory_mb` in the library)"
                 )
-            if time.monotonic() > self.deadline:
+            now = time.monotonic()
+            if self.progress is not None and now - self.shown > 0.25:
+                self.shown = now
+                used = self.time_limit - max(self.deadline - now, 0.0)
+                self.progress(int(used), math.ceil(self.time_limit))
+            if now > self.deadline:
                 raise SearchStopped(
                     f"it ran for {self.time_limit:g} s (the time bound: --time-limit S, "
                     "`time_limit_s` in the library)"
@@ -1251,6 +1258,7 @@ def plan_policy(
     max_memory_mb: float = DEFAULT_MAX_MEMORY_MB,
     time_limit_s: float | None = DEFAULT_TIME_LIMIT_S,
     best_so_far: bool = True,
+    progress: Callable[[int, int], None] | None = None,
     _prune: Collection[str] = _PRUNE,
 ) -> Policy:
     """The Bayes policy: least expected cost over all policies of at most ``max_actions``.
@@ -1287,6 +1295,9 @@ def plan_policy(
         :attr:`Policy.lower_bound` how little any policy of ``max_actions`` could cost (so
         the search may take up to twice ``time_limit_s``); ``False`` raises
         :class:`SearchStopped`.
+    progress : callable, optional
+        Called now and then with ``(seconds used, seconds allowed)`` of the time bound (a
+        progress bar; with no time bound it is not called).
     sensorless : bool
         Also plan the sensorless Bayes plan (one part; :func:`plan_exact` within
         ``max_actions``): its cost is reported (``Policy.sensorless_cost``) and starts the
@@ -1341,6 +1352,7 @@ def plan_policy(
         """The best policy within ``depth`` actions; ``known``: a known plan's cost."""
         solver = _solver(space, sens, _prune)
         solver.max_bytes, solver.deadline, solver.time_limit = max_bytes, deadline, seconds
+        solver.progress = progress if math.isfinite(seconds) else None
         roots, root_kind, root_angle = _roots(space, solver.kinds, angles)
         # A known policy's ratio starts the parametric search: one action then declare the
         # likeliest state on every reading, or the sensorless Bayes plan (one part).
