@@ -411,6 +411,8 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
                     value = json.loads(text)
                 except ValueError as exc:
                     raise PartFileError(f"{label}: not a JSON value: {exc}") from None
+                except RecursionError:
+                    raise PartFileError(f"{label}: JSON nested too deeply") from None
                 if isinstance(value, str):
                     return dataclasses.replace(part, part=value).load()
                 if isinstance(value, dict):  # a .json part file on one line

@@ -98,6 +98,13 @@ def accuracy_value(value: float) -> float:
     return value
 
 
+def bound_value(value: float | None) -> float | None:
+    """A search bound (``--max-memory``, ``--time-limit``): a finite number > 0."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise typer.BadParameter(f"should be a number > 0; got {value:g}")
+    return value
+
+
 def flatten_value(value: float | None) -> float | None:
     """The chordal tolerance of ``--flatten-tol``: a finite number > 0 (or left out)."""
     if value is not None and not (math.isfinite(value) and value > 0):

@@ -19,7 +19,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
-from .common import accuracy_value, cost_value, flatten_value
+from .common import accuracy_value, bound_value, cost_value, flatten_value
 from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec, SenseSpec, problem_spec
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -174,6 +174,7 @@ MaxMemoryOpt = Annotated[
         "--max-memory",
         metavar="MB",
         min=1.0,
+        callback=bound_value,
         help="With --sense: the most memory (MB, about) the policy search may keep for the "
         "beliefs it acts on; past it the search stops with a message (default 2048).",
     ),
@@ -184,6 +185,7 @@ TimeLimitOpt = Annotated[
         "--time-limit",
         metavar="S",
         min=0.001,
+        callback=bound_value,
         help="With --sense: the most seconds the policy search may take (default 60). Past "
         "it (or --max-memory) the search plans again within the same bounds, one action more "
         "at a time, and answers with the deepest policy that finished, saying so and giving "
