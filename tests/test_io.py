@@ -877,7 +877,7 @@ def test_cli_part_options(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
         (["plan", "{tmp}/bow.wkt"], "crosses itself"),
         (["plan", "{tmp}/two.svg"], "--element"),
         (["squeeze", "{ex}/bracket.dxf", "--layer", "NOPE"], "on layer 'NOPE'"),
-        (["squeeze", "{ex}/bracket.dxf", "--flatten-tol", "0"], "tolerance must be a number > 0"),
+        (["squeeze", "{ex}/bracket.dxf", "--flatten-tol", "0"], "should be a number > 0"),
         (["squeeze", "{tmp}/nothing.dxf"], "no such file"),
     ],
 )

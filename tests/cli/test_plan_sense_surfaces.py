@@ -144,9 +144,10 @@ def test_batch_lines_equal_the_single_runs(
     capsys: pytest.CaptureFixture[str], tmp_path: Path, options: list[str]
 ) -> None:
     lever = Path(__file__).resolve().parents[2] / "examples" / "lever.svg"  # a curved part
+    square = {**SQUARE, "units": "mm"}  # the candidates are in mm: widths compare
     part = tmp_path / "sq.json"
-    part.write_text(json.dumps(SQUARE))
-    batch = batch_file(tmp_path, "house", str(part), SQUARE, str(lever))
+    part.write_text(json.dumps(square))
+    batch = batch_file(tmp_path, "house", str(part), square, str(lever))
     code, out, err = run(capsys, "plan", "--batch", str(batch), *options)
     assert (code, err) == (0, "")
     expected = [single(capsys, p, *options) for p in ["house", str(part), str(part), str(lever)]]

@@ -182,12 +182,12 @@ def test_a_curved_part_writes_its_curved_member() -> None:
     "name", ['a "quoted" name', "été\nnext", "\u2603 snow", "nan", "infinite part", ""]
 )
 def test_names_and_units_are_escaped(name: str) -> None:
-    part = Part.from_points([(0, 0), (3, 0), (3, 1.5), (0, 2)], name=name, units="µm")
+    part = Part.from_points([(0, 0), (3, 0), (3, 1.5), (0, 2)], name=name, units="Å")
     res = plan_exact(Problem.build(part))
     text = plan_document_json(res)
     assert text.isascii() and "\n" not in text
     back = json.loads(text)
-    assert (back["part"]["name"], back["part"]["units"]) == (name, "µm")
+    assert (back["part"]["name"], back["part"]["units"]) == (name, "Å")
     check(back, res)
 
 

@@ -226,10 +226,20 @@ class SenseSpec:
     """The policy search's time bound (``--time-limit``)."""
 
     def parts(self, part: PartSpec) -> list[Part]:
-        """PART, then each candidate part, read with the same part-file options."""
+        """PART, then each candidate part, read with the same part-file options.
+
+        Candidates in other units than PART are converted to PART's
+        (:func:`~bayesgrasp.units.convert`): the gripper reads every width in one unit.
+        """
         import dataclasses
 
-        return [part.load(), *(dataclasses.replace(part, part=p).load() for p in self.also)]
+        from ..units import convert
+
+        first = part.load()
+        more = [dataclasses.replace(part, part=p).load() for p in self.also]
+        if first.units is None:
+            return [first, *more]
+        return [first, *(convert(p, first.units) if p.units else p for p in more)]
 
     def policy(
         self, parts: list[Part], spec: ProblemSpec, sensor: WidthSensor | None = None

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import PartError
 from ..sizes import SMALL
 from ..tolerance import DEFAULT_TOLERANCE, Tolerance
+from ..units import unit_name
 
 __all__ = ["ConvexPolygon", "Part", "as_points", "find_crossing", "polygon_area_centroid"]
 
@@ -1170,7 +1171,8 @@ class Part:
     center_of_mass : ndarray of shape (2,)
         Defaults to the hull's area centroid.
     units : str or None
-        The units of the coordinates, when known (reported, never converted).
+        The units of the coordinates, when known: a name of :mod:`bayesgrasp.units`
+        (others are refused; :func:`bayesgrasp.units.convert` converts a part).
     holes : tuple of ndarray of shape (K, 2)
         Holes inside the outline (parts built by :meth:`from_outline`); they move the
         centre of mass, never the hull.
@@ -1248,6 +1250,8 @@ class Part:
         PartError
             A centre of mass outside the hull.
         """
+        if units is not None:
+            units = unit_name(units)
         outline.setflags(write=False)
         if center_of_mass is None:  # the hull's centroid (the same read-only array)
             cx, cy = hull._centroid_xy()
@@ -1318,6 +1322,8 @@ class Part:
         ...
         bayesgrasp.errors.PartError: `outline` must be a simple polygon; it crosses itself ...
         """
+        if units is not None:
+            units = unit_name(units)
         ring = _clean_ring(outline, "outline")
         rings = [ring] + [_clean_ring(h, f"holes[{k}]") for k, h in enumerate(holes)]
         names = ["outline"] + [f"holes[{k}]" for k in range(len(rings) - 1)]

@@ -500,8 +500,9 @@ class StateSpace:
         SensorError
             On a bad part prior (see :func:`parse_part_prior`).
         PlanningError
-            If the problems do not share their action kinds, or two parts are in different
-            known units (their widths could not be compared; units are never converted).
+            If the problems do not share their action kinds, two parts are in different
+            units (:func:`bayesgrasp.units.convert` converts one), or some have units and
+            some do not (their widths could not be compared).
         """
         pbs = (problems,) if isinstance(problems, Problem) else tuple(problems)
         if not pbs or not all(isinstance(p, Problem) for p in pbs):
@@ -517,7 +518,14 @@ class StateSpace:
             raise PlanningError(
                 "the candidate parts' widths are read in one unit, but the parts are in "
                 + ", ".join(f"{p.part.units} ({p.part.name})" for p in pbs if p.part.units)
-                + ": give them all in the same units"
+                + ": convert them to one (bayesgrasp.units.convert; the command line does)"
+            )
+        if known and any(p.part.units is None for p in pbs):
+            bare = next(p.part.name for p in pbs if p.part.units is None)
+            raise PlanningError(
+                f"part {bare!r} has no units and the other candidates are in "
+                f"{next(iter(known))}: their widths cannot be compared; give the units in "
+                "every part file"
             )
         w = parse_part_prior(part_prior, len(pbs))
         sizes = [p.n_states for p in pbs]
