@@ -120,6 +120,7 @@ from .turns import FLAT_SIGMAS, GRID_PER_SIGMA, free_arcs, margin, turn_grid
 
 __all__ = [
     "NoisyEvaluation",
+    "PlanEvaluator",
     "NoisyOption",
     "NoisyPlanResult",
     "evaluate_plan",
@@ -295,8 +296,34 @@ def _json_float(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-class _Evaluator:
-    """Exact evaluation of plans of one problem under one noise model and payoff."""
+class PlanEvaluator:
+    """Exact evaluation of linear plans of one problem under one noise model and payoff.
+
+    What the noise-aware planners share (this one, and the guaranteed planner under noise,
+    :func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`): the forward propagation
+    ``q_k = q_1(a) M_{t_2}(alpha_2) ... M_{t_k}(alpha_k)`` of :meth:`forward` and
+    :meth:`step` (only the states of positive mass, and many turns at once), and the choice
+    of the final state a plan aims at (:meth:`targets`). The same propagation as
+    :func:`~bayesgrasp.planning.strategy.evaluate_tree`, which evaluates any strategy (the
+    tests hold the two equal); this one is batched over the turns a search tries.
+
+    Parameters
+    ----------
+    problem : Problem
+    noise : NoiseModel
+    payoff : ndarray of shape (K,) or None
+        The value of each state (``None``: the problem's goal).
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.noise import TurnNoise
+    >>> pb = Problem.build(Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)]))
+    >>> ev = PlanEvaluator(pb, NoiseModel(TurnNoise("uniform", 0.05)), None)
+    >>> qs = ev.forward(["squeeze", "squeeze"], [0.0, 0.7])
+    >>> [round(float(q.sum()), 12) for q in qs]
+    [1.0, 1.0]
+    """
 
     def __init__(self, problem: Problem, noise: NoiseModel, payoff: FloatArray | None) -> None:
         self.problem = problem
@@ -412,7 +439,7 @@ def evaluate_plan(
         raise PlanningError("a plan needs at least one step")
     plan_actions(problem, [s.kind for s in steps])
     u = None if payoff is None else as_vector(payoff, problem.states)
-    ev = _Evaluator(problem, noise, u)
+    ev = PlanEvaluator(problem, noise, u)
     return ev.evaluate([s.kind for s in steps], [s.alpha for s in steps])
 
 
@@ -438,7 +465,7 @@ def step_distributions_noisy(
     if not steps:
         raise PlanningError("a plan needs at least one step")
     plan_actions(problem, [s.kind for s in steps])
-    ev = _Evaluator(problem, noise, None)
+    ev = PlanEvaluator(problem, noise, None)
     return ev.forward([s.kind for s in steps], [s.alpha for s in steps])
 
 
@@ -467,7 +494,7 @@ class _Planner:
     def __init__(self, problem: Problem, noise: NoiseModel, payoff: FloatArray | None) -> None:
         self.problem = problem
         self.noise = noise
-        self.ev = _Evaluator(problem, noise, payoff)
+        self.ev = PlanEvaluator(problem, noise, payoff)
         self.turn = noise.turn
         self.p_tol = problem.part.hull.tol.probability
         self.a_tol = problem.states.angle_tol
@@ -696,7 +723,7 @@ def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list
     return out
 
 
-def _payoff_bound(problem: Problem, ev: _Evaluator, payoff: FloatArray | None) -> float:
+def _payoff_bound(problem: Problem, ev: PlanEvaluator, payoff: FloatArray | None) -> float:
     """The highest expected payoff any plan can reach (see the module notes)."""
     noise = ev.noise
     targets = ev.masks if payoff is None else payoff[None, :]  # (T, K)
@@ -775,7 +802,7 @@ def plan_noisy(
     ev = pl.ev
     if noise.exact and u is None and not all_lengths:
         return _noise_free(problem, noise, max_actions, pl)
-    exact = ev if noise.exact else _Evaluator(problem, NoiseModel(), u)
+    exact = ev if noise.exact else PlanEvaluator(problem, NoiseModel(), u)
     cost = problem.cost
     kinds_all = problem.action_kinds
     limit = min(max_plan_length(problem), max_actions or max_plan_length(problem))
@@ -904,7 +931,7 @@ def _noise_free(
 
 
 def _noisy_option(
-    problem: Problem, exact: _Evaluator, c: _Cand, tolerance: float | None = None
+    problem: Problem, exact: PlanEvaluator, c: _Cand, tolerance: float | None = None
 ) -> NoisyOption:
     """The reported plan of a candidate (``exact``: an evaluator without noise).
 

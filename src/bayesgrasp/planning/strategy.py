@@ -71,7 +71,7 @@ from ..model.noise import NoiseModel, NoisyTransitions
 from ..model.payoff import Payoff
 from ..model.problem import Problem, nearest_state
 from ..model.sensing import ReadingBins, StateSpace, WidthSensor, parse_sensor
-from .exact import plan_exact
+from . import exact, policy
 from .guaranteed import GuaranteedPlan, plan_guaranteed
 from .noisy import NoisyPlanResult
 from .policy import (
@@ -81,7 +81,6 @@ from .policy import (
     Policy,
     PolicyNode,
     Reject,
-    plan_policy,
 )
 from .result import PlanOption, PlanResult, Status
 
@@ -808,7 +807,7 @@ def solve(
         depth = 3 if max_actions is None else max_actions
         memory = DEFAULT_MAX_MEMORY_MB if max_memory_mb is None else max_memory_mb
         if noise is None and payoff is None:
-            pol = plan_policy(
+            pol = policy.plan_policy(  # looked up at each call, as the exact planner
                 pbs, sensor=sensor, max_actions=depth, part_prior=part_prior, max_memory_mb=memory
             )
         else:
@@ -844,8 +843,9 @@ def solve(
             res = res.best_only()
         sure = plan_guaranteed_noisy(pb, model) if guaranteed else None
         return _with_guarantee(StrategyResult(pbs, res), sure)
-    if method == "exact" and best_only:  # the same plans, without those of other lengths
-        found = plan_exact(pb, max_actions, report="best")
+    if method == "exact":  # looked up at each call (a test may stand in for the planner)
+        report: Literal["all", "best"] = "best" if best_only else "all"
+        found = exact.plan_exact(pb, max_actions=max_actions, report=report)
     else:
         found = plan_with(pb, method, max_actions)  # type: ignore[arg-type]
         if best_only:
