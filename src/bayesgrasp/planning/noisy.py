@@ -120,9 +120,9 @@ from .turns import FLAT_SIGMAS, GRID_PER_SIGMA, free_arcs, margin, turn_grid
 
 __all__ = [
     "NoisyEvaluation",
-    "PlanEvaluator",
     "NoisyOption",
     "NoisyPlanResult",
+    "PlanEvaluator",
     "evaluate_plan",
     "plan_noisy",
     "step_distributions_noisy",
@@ -411,6 +411,11 @@ def evaluate_plan(
 ) -> NoisyEvaluation:
     """Evaluate a plan exactly under a noise model (and a payoff).
 
+    The final distribution is :func:`~bayesgrasp.planning.strategy.evaluate_tree`'s (the
+    evaluator of every strategy) of the plan as the strategy that never branches; the
+    payoff is scored on it as the noise-aware planner scores its candidates
+    (:meth:`PlanEvaluator.finish`).
+
     Parameters
     ----------
     problem : Problem
@@ -435,12 +440,22 @@ def evaluate_plan(
     >>> round(ev.success_probability, 6) == round(plan.success_probability, 6)
     True
     """
+    from ..model.sensing import StateSpace
+    from .policy import Reject
+    from .strategy import NoisyJointTransitions, evaluate_tree, linear_strategy
+
     if not steps:
         raise PlanningError("a plan needs at least one step")
-    plan_actions(problem, [s.kind for s in steps])
+    kinds = [s.kind for s in steps]
+    plan_actions(problem, kinds)
     u = None if payoff is None else as_vector(payoff, problem.states)
     ev = PlanEvaluator(problem, noise, u)
-    return ev.evaluate([s.kind for s in steps], [s.alpha for s in steps])
+    # The final distribution by the one evaluator of every strategy (the plan: a strategy
+    # that never branches; its leaf does not matter, only the distribution reaching it).
+    space = StateSpace.build(problem)
+    model = NoisyJointTransitions(space, noise, [ev.nt])
+    q = evaluate_tree(space, linear_strategy(steps, Reject()), model).final_distribution
+    return ev.finish(kinds, q)
 
 
 def step_distributions_noisy(

@@ -82,7 +82,7 @@ from .policy import (
     PolicyNode,
     Reject,
 )
-from .result import PlanOption, PlanResult, Status
+from .result import PlanOption, PlanResult, PlanStep, Status
 
 __all__ = [
     "Alternative",
@@ -93,6 +93,7 @@ __all__ = [
     "Transitions",
     "evaluate",
     "evaluate_tree",
+    "linear_strategy",
     "plan_strategy",
     "solve",
     "transitions",
@@ -163,12 +164,25 @@ def plan_strategy(problem: Problem, option: PlanOption, part: int = 0) -> Policy
     >>> [b.lo for b in root.branches], root.branches[0].next.step.kind
     ([-inf], 'squeeze')
     """
-    if not option.steps:
-        raise PlanningError("a plan must have at least one action")
-    nxt: PolicyNode | Leaf = Declare(
+    leaf = Declare(
         part, problem.part.name, float(option.final_orientation), float(option.success_probability)
     )
-    for step in reversed(option.steps):
+    return linear_strategy(option.steps, leaf)
+
+
+def linear_strategy(steps: Sequence[PlanStep], leaf: Declare | Reject) -> PolicyNode:
+    """The strategy that makes ``steps`` whatever it reads, then ends at ``leaf``.
+
+    Examples
+    --------
+    >>> root = linear_strategy([PlanStep("squeeze", 0.0)], Reject())
+    >>> root.step.kind, root.branches[0].next
+    ('squeeze', Reject())
+    """
+    if not steps:
+        raise PlanningError("a plan must have at least one action")
+    nxt: PolicyNode | Leaf = leaf
+    for step in reversed(steps):
         nxt = PolicyNode(step, (Branch(-math.inf, math.inf, 1.0, nxt),))
     return cast(PolicyNode, nxt)  # the loop ran at least once
 
@@ -210,9 +224,19 @@ class ExactTransitions:
 class NoisyJointTransitions:
     """Noisy actions: the block-diagonal matrices of each part's :class:`NoisyTransitions`."""
 
-    def __init__(self, space: StateSpace, noise: NoiseModel) -> None:
+    def __init__(
+        self,
+        space: StateSpace,
+        noise: NoiseModel,
+        parts: Sequence[NoisyTransitions] | None = None,
+    ) -> None:
         self.space = space
-        self.parts = [NoisyTransitions(p, noise) for p in space.problems]
+        # each part's matrices (``parts``: made already, one per candidate, kept between calls)
+        self.parts = (
+            list(parts)
+            if parts is not None
+            else [NoisyTransitions(p, noise) for p in space.problems]
+        )
 
     def initial(self, kind: str, angle: float) -> FloatArray:
         """The prior convolved with the first action's error, times the part prior."""
@@ -224,6 +248,8 @@ class NoisyJointTransitions:
     def matrix(self, kind: str, alpha: float) -> FloatArray:
         """The block-diagonal matrix of every part's noisy action turned by ``alpha``."""
         sp = self.space
+        if len(self.parts) == 1:
+            return self.parts[0].matrix(kind, alpha)
         m = np.zeros((sp.n_states, sp.n_states))
         for j, nt in enumerate(self.parts):
             lo, hi = int(sp.offsets[j]), int(sp.offsets[j + 1])
@@ -268,7 +294,7 @@ class _Walk:
                 raise PlanningError(
                     "a strategy that branches on readings needs the sensor it was planned for"
                 )
-            return np.ones((self.space.n_states, 1)), [np.zeros(1, dtype=np.intp)]
+            return _NO_READING, [_ONE_BIN]
         b = self.bins
         # A bin lies inside one branch (the planners' branches join whole bins): its lower
         # end (for the first bin, -inf) falls in that branch.
@@ -290,8 +316,11 @@ class _Walk:
         n = self.space.n_states
         out: list[Branch] = []
         for br, ix in zip(node.branches, bins, strict=True):
-            # (H * bins, N): every history continued by every reading of the branch
-            per = (img[:, None, :] * lik[:, ix].T[None, :, :]).reshape(-1, n)
+            # (H * bins, N): every history continued by every reading of the branch (without
+            # a sensor, nothing is read: the histories go on as they are)
+            per = (
+                img if self.bins is None else (img[:, None, :] * lik[:, ix].T[None]).reshape(-1, n)
+            )
             w = per.sum(axis=1)
             keep = w > 0
             per, w = per[keep], w[keep]
@@ -334,6 +363,11 @@ class _Walk:
         return tuple(out)
 
 
+# Without a sensor: no likelihood (the walk reads nothing), and one bin.
+_NO_READING = np.ones((0, 1))
+_ONE_BIN = np.zeros(1, dtype=np.intp)
+
+
 def _unreached(node: PolicyNode) -> PolicyNode:
     """A subtree no reading history reaches: its probabilities 0."""
     return PolicyNode(
@@ -350,9 +384,9 @@ def _unreached(node: PolicyNode) -> PolicyNode:
 
 def _entropies(q: FloatArray) -> FloatArray:
     """Shannon entropy (bits) of each row of normalised beliefs ``q`` (M, N)."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        terms = np.where(q > 0, q * np.log2(np.where(q > 0, q, 1.0)), 0.0)
-    return np.asarray(-terms.sum(axis=1), dtype=np.float64)
+    logs = np.zeros_like(q)
+    np.log2(q, out=logs, where=q > 0)  # 0 log 0 = 0
+    return np.asarray(-(q * logs).sum(axis=1), dtype=np.float64)
 
 
 def _depth(node: PolicyNode) -> int:
