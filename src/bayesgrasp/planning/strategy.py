@@ -651,9 +651,19 @@ class StrategyResult:
                 None,
             )
             return (alt,)
-        plans = self.plans
-        assert plans is not None
         pb = self.problem
+        if isinstance(src, NoisyPlanResult):  # the payoff earned (a 0/1 payoff: P(success))
+            return tuple(
+                Alternative(
+                    plan_strategy(pb, o.option),
+                    o.option.n_actions,
+                    o.expected_payoff,
+                    o.option.expected_cost,
+                    o.option.tolerance,
+                    o.option,
+                )
+                for o in src.options
+            )
         return tuple(
             Alternative(
                 plan_strategy(pb, o),
@@ -663,7 +673,7 @@ class StrategyResult:
                 o.tolerance,
                 o,
             )
-            for o in plans.options
+            for o in src.options
         )
 
     @property
