@@ -268,7 +268,7 @@ def test_each_candidate_turn_is_one_action_once(name: str, noise: str) -> None:
     sensor = parse_sensor("width")
     model = npol._Model(space, sensor, NOISES[noise])
     for k in _solver(space, sensor, _PRUNE).kinds:
-        mid, half = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
+        mid, _ = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
         mats = model.matrices(k.name, mid)
         kept = mats[npol._first_of_each_matrix(mats)]
         flat = {m.tobytes() for m in kept}
