@@ -262,8 +262,8 @@ class _Model:
         halves = np.concatenate([half, widths / 2])
         order = np.argsort(-halves, kind="stable")
         mids, halves = mids[order], halves[order]
-        keep = _first_of_each_turn(mids, _SAME_TURN)
-        return np.asarray(mids[keep]), np.asarray(halves[keep])
+        once = _first_of_each_turn(mids, _SAME_TURN)
+        return np.asarray(mids[once]), np.asarray(halves[once])
 
     def initial(self, kind: str, angle: float) -> FloatArray:
         """Joint distribution after the first action at world angle ``angle``."""
@@ -661,8 +661,8 @@ def plan_noisy_policy(
         # A turn whose matrix an earlier (wider) candidate has already is the same action:
         # under exact turns, the middle of a noise-free class lies in a class of the
         # refinement (where the matrix is constant), whose middle is a candidate too.
-        keep = _first_of_each_matrix(mats)
-        mid, half, mats = mid[keep], half[keep], mats[keep]
+        once = _first_of_each_matrix(mats)
+        mid, half, mats = mid[once], half[once], mats[once]
         k.mid, k.half_width = mid, half
         k.classes = np.arange(len(mid), dtype=np.intp)
         k.transfer = np.zeros((len(mid), space.n_states), dtype=np.intp)  # unused: matrices
