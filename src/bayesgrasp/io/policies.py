@@ -5,6 +5,7 @@ schema is described in :mod:`bayesgrasp.io.plans`, the one module of documents.
 
 Examples
 --------
+>>> from bayesgrasp.io import plans
 >>> policy_document is plans.policy_document
 True
 """
