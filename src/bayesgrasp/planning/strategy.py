@@ -777,6 +777,7 @@ def solve(
     guaranteed: bool = False,
     part_prior: str | Sequence[float] | None = None,
     max_memory_mb: float | None = None,
+    stroke: tuple[float, float] | None = None,
 ) -> StrategyResult:
     """Plan with whichever planner the model calls for; one :class:`StrategyResult`.
 
@@ -810,6 +811,9 @@ def solve(
         Weights of the candidate parts (policies only).
     max_memory_mb : float, optional
         The policy search's memory bound.
+    stroke : (float, float), optional
+        ``(min_opening, max_opening)`` in part units: plan only actions the gripper's stroke
+        allows (:func:`~bayesgrasp.planning.stroke.plan_within_stroke`; noise-free plans).
 
     Raises
     ------
@@ -836,6 +840,21 @@ def solve(
     pbs = (problems,) if isinstance(problems, Problem) else tuple(problems)
     if not pbs:
         raise PlanningError("no problem to plan for")
+    if stroke is not None:
+        others = sensor, noise, payoff, part_prior, max_memory_mb
+        if any(x is not None for x in others) or method != "exact" or len(pbs) > 1:
+            raise PlanningError(
+                "planning within the stroke searches noise-free linear plans of one part: it "
+                "takes no sensor, noise, payoff, part prior or other method (check any "
+                "strategy against the stroke with bayesgrasp.io.export.check_stroke)"
+            )
+        from .stroke import plan_within_stroke
+
+        found_s = plan_within_stroke(pbs[0], stroke[0], stroke[1], max_actions)
+        if best_only:
+            found_s = found_s.best_only()
+        sure_s = plan_guaranteed(pbs[0]) if guaranteed else None
+        return _with_guarantee(StrategyResult(pbs, found_s), sure_s)
     if sensor is not None:
         refused = [
             name
