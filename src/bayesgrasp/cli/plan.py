@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import functools
 import math
@@ -92,6 +93,16 @@ ExportOpt = Annotated[
 ]
 
 
+WithinStrokeOpt = Annotated[
+    bool,
+    typer.Option(
+        "--within-stroke",
+        help="Plan only actions the stroke allows (--max-opening, --min-opening): the best "
+        "plan of each length whose every step fits, instead of refusing a plan that does not "
+        "(noise-free plans of one part; up to --max-actions, default 4).",
+    ),
+]
+
 MorePartsArg = Annotated[
     list[str] | None,
     typer.Argument(
@@ -147,6 +158,7 @@ def plan(
     batch: BatchOpt = None,
     max_opening: MaxOpeningOpt = None,
     min_opening: MinOpeningOpt = None,
+    within_stroke: WithinStrokeOpt = False,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -178,6 +190,8 @@ def plan(
         raise typer.BadParameter("--fold-below needs --sense")
     if sense is None and max_memory is not None:
         raise typer.BadParameter("--max-memory bounds a policy search: it needs --sense")
+    if within_stroke:
+        _check_within_stroke(stroke, sense, spec, turn_noise, contact_noise, payoff)
     if sense is not None:
         refused = [
             name
@@ -209,6 +223,8 @@ def plan(
     if part.part is None and not several:
         raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
     run = noisy.strategy_run(spec, turn_noise, contact_noise, payoff, only is Only.best, guaranteed)
+    if within_stroke and stroke is not None:
+        run = dataclasses.replace(run, stroke=(stroke.min_opening, stroke.max_opening))
     files = input_files(part.part, spec.prior, batch, payoff)
     outputs = PartOutputs.of(plot_file, export, force, files, several)
     if several:
@@ -235,6 +251,37 @@ def plan(
     code = exit_code(result)
     if code:  # no guaranteed plan reached the goal asked for
         raise typer.Exit(code)
+
+
+def _check_within_stroke(
+    stroke: Stroke | None,
+    sense: str | None,
+    spec: ProblemSpec,
+    turn: str | None,
+    contact: float | None,
+    payoff: Path | None,
+) -> None:
+    """Refuse ``--within-stroke`` where it cannot plan (exit 2, one line)."""
+    hint = "--within-stroke"
+    if stroke is None:
+        raise typer.BadParameter(
+            "needs the stroke: --max-opening and/or --min-opening", param_hint=hint
+        )
+    if sense is not None:
+        raise typer.BadParameter(
+            "plans linear plans; a policy is checked against the stroke (drop --within-stroke)",
+            param_hint=hint,
+        )
+    if turn is not None or contact is not None or payoff is not None:
+        raise typer.BadParameter(
+            "searches noise-free plans; a noise-aware plan is checked against the stroke "
+            "(drop --within-stroke)",
+            param_hint=hint,
+        )
+    if spec.method.value != "exact":
+        raise typer.BadParameter("is its own planner; drop --method", param_hint=hint)
+    if spec.accuracy_deg:
+        raise typer.BadParameter("takes exact turns; drop --accuracy", param_hint=hint)
 
 
 def _policy_batch(

@@ -51,6 +51,8 @@ class StrategyRun:
         Whether a noise or payoff option was given (the noise-aware planner then plans).
     sensing : SenseSpec or None
         ``--sense`` and its options: a policy is planned.
+    stroke : (float, float) or None
+        ``--within-stroke``: ``(min_opening, max_opening)``, plans only of actions within it.
     """
 
     spec: ProblemSpec
@@ -60,6 +62,7 @@ class StrategyRun:
     payoff: Payoff | None = None
     noisy: bool = False
     sensing: SenseSpec | None = None
+    stroke: tuple[float, float] | None = None
 
     def solve(
         self, problems: Problem | list[Problem], sensor: WidthSensor | None = None
@@ -92,6 +95,7 @@ class StrategyRun:
             max_actions=spec.max_actions,
             best_only=self.best_only,
             guaranteed=self.guaranteed,
+            stroke=self.stroke,
         )
 
     def solve_parts(self, parts: list[Part], sensor: WidthSensor | None = None) -> StrategyResult:
