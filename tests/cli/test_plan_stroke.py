@@ -1,4 +1,4 @@
-"""``plan --within-stroke``: plans of actions the gripper's stroke allows, through plan's surfaces."""
+"""``plan --within-stroke``: plans of actions the stroke allows, through plan's surfaces."""
 
 from __future__ import annotations
 
