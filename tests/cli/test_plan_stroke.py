@@ -96,3 +96,8 @@ def test_refused_where_it_cannot_plan(
 ) -> None:
     err = refused(capsys, "plan", "key", "--within-stroke", *more)
     assert words in err and "--within-stroke" in err
+
+
+def test_a_part_wider_than_the_stroke_has_no_plan(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "plan", "rectangle", "--max-opening", "30", "--within-stroke")
+    assert code == 1 and out == "" and "no plan" in err and "widest" in err

@@ -245,7 +245,7 @@ def run_policy_batch(
     The --also parts are read and the sensor checked once, before the first line (a bad one
     is the run's error, exit 2). ``part`` gives the part-file options (its PART is
     ``None``); ``outputs``, ``stroke``: as :func:`run_batch`; ``fold``: the figures' folding
-    (:func:`write_policy_outputs`); ``noise``: the action noise and payoff each policy is
+    (:func:`~.strategies.write_outputs`); ``noise``: the action noise and payoff each policy is
     planned under (:class:`~.sensing.ActionModel`). The parts are planned one at a time.
 
     Raises
