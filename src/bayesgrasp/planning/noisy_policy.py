@@ -658,11 +658,14 @@ def plan_noisy_policy(
             keep = half >= main.accuracy
             mid, half = mid[keep], half[keep]
         mats = model.matrices(k.name, mid)
-        # A turn whose matrix an earlier (wider) candidate has already is the same action:
-        # under exact turns, the middle of a noise-free class lies in a class of the
-        # refinement (where the matrix is constant), whose middle is a candidate too.
-        once = _first_of_each_matrix(mats)
-        mid, half, mats = mid[once], half[once], mats[once]
+        if noise.contact > 0:
+            # A turn whose matrix an earlier (wider) candidate has already is the same
+            # action: under exact turns, the middle of a noise-free class lies in a class
+            # of the refinement (where the matrix is constant), whose middle is a candidate
+            # too. (Without contact noise the candidates are the noise-free classes, each
+            # its own action.)
+            once = _first_of_each_matrix(mats)
+            mid, half, mats = mid[once], half[once], mats[once]
         k.mid, k.half_width = mid, half
         k.classes = np.arange(len(mid), dtype=np.intp)
         k.transfer = np.zeros((len(mid), space.n_states), dtype=np.intp)  # unused: matrices
