@@ -245,6 +245,18 @@ class NoisyJointTransitions:
             [w * nt.initial(kind, angle) for w, nt in zip(weights, self.parts, strict=True)]
         )
 
+    def propagate(self, hist: FloatArray, kind: str, alpha: float) -> FloatArray:
+        """``hist @ matrix(kind, alpha)`` for beliefs ``hist`` (H, N), from the rows with mass.
+
+        One part: only the rows of the states some belief gives mass are computed (as the
+        noise-aware planner's :meth:`~bayesgrasp.planning.noisy.PlanEvaluator.step`).
+        """
+        if len(self.parts) != 1:
+            return np.asarray(hist @ self.matrix(kind, alpha), dtype=np.float64)
+        rows = np.flatnonzero(hist.any(axis=0))
+        m = self.parts[0].matrices(kind, [alpha], rows)[0]  # (R, N)
+        return np.asarray(hist[:, rows] @ m, dtype=np.float64)
+
     def matrix(self, kind: str, alpha: float) -> FloatArray:
         """The block-diagonal matrix of every part's noisy action turned by ``alpha``."""
         sp = self.space
@@ -275,6 +287,9 @@ class _Walk:
         payoff: FloatArray | None,
     ) -> None:
         self.space, self.model, self.bins, self.payoff = space, model, bins, payoff
+        # ``hist @ M(alpha)`` computed by the model itself, when it can (only the rows of
+        # states with mass, say); else by its matrix
+        self.propagate = getattr(model, "propagate", None)
         self.cost = space.problems[0].cost
         self.success = self.action_cost = self.verify_cost = self.reject = self.actions = 0.0
         self.final = np.zeros(space.n_states)
@@ -308,7 +323,12 @@ class _Walk:
         Each row of ``hist`` is the unnormalised belief of one reading history before the
         node's action (the root: after it, as the first action is the prior's).
         """
-        img = hist if first else hist @ self.model.matrix(node.step.kind, node.step.alpha)
+        if first:
+            img = hist
+        elif self.propagate is not None:
+            img = self.propagate(hist, node.step.kind, node.step.alpha)
+        else:
+            img = hist @ self.model.matrix(node.step.kind, node.step.alpha)
         mass = float(img.sum())
         self.actions += mass
         self.action_cost += mass * self.cost.action_cost(node.step.kind, first)
