@@ -671,19 +671,11 @@ def read_plan(
     (True, 'single', 'uniform')
     """
     if isinstance(source, str | os.PathLike):
-        path = Path(source)
-        try:
-            doc = json.loads(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            reason = exc.strerror or exc
-            raise SimulationError(f"plan file {str(path)!r} cannot be read ({reason})") from None
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            why = exc.msg if isinstance(exc, json.JSONDecodeError) else "not UTF-8"
-            raise SimulationError(f"plan file {str(path)!r} is not valid JSON ({why})") from None
+        doc = _load(source, "plan file")
         try:
             return _read_source(doc, which)
         except SimulationError as exc:
-            raise SimulationError(f"plan file {str(path)!r}: {exc}") from None
+            raise SimulationError(f"plan file {str(Path(source))!r}: {exc}") from None
     return _read_source(source, which)
 
 
