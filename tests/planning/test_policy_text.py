@@ -72,7 +72,9 @@ def test_candidate_parts_in_different_units_are_refused() -> None:
     bare = Problem.build(Part.from_points(tri, name="c"))
     with pytest.raises(PlanningError, match=r"mm \(a\), in \(b\)"):
         plan_policy([mm, inch], "width", 1)
-    assert StateSpace.build([mm, bare]).n_parts == 2  # unknown units are not a conflict
+    with pytest.raises(PlanningError, match="'c' has no units"):  # never mixed silently
+        StateSpace.build([mm, bare])
+    assert StateSpace.build([bare, bare]).n_parts == 2  # no units at all: one scale
 
 
 def test_plan_sense_folds_the_printed_tree(capsys: pytest.CaptureFixture[str]) -> None:

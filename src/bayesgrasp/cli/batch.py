@@ -16,24 +16,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
 from ..errors import BayesGraspError
-from .specs import (
-    PartSpec,
-    ProblemSpec,
-    SenseSpec,
-    guaranteed_plan,
-    run_inputs,
-)
+from .specs import PartSpec, ProblemSpec, SenseSpec, run_inputs
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
     from ..io.export import Stroke
-    from ..model.problem import Problem
-    from ..planning.guaranteed import GuaranteedPlan
-    from ..planning.policy import Policy
-    from ..planning.result import PlanReport
-    from .noisy import NoisyRun
+    from ..planning.strategy import StrategyResult
     from .outputs import PartOutputs
     from .sensing import ActionModel
+    from .strategies import StrategyRun
 
 __all__ = ["BatchFileError", "run_batch", "run_policy_batch"]
 
@@ -51,11 +42,8 @@ def run_batch(
     part: PartSpec,
     more: list[str],
     batch: Path | None,
-    spec: ProblemSpec,
-    guaranteed: bool,
-    best_only: bool,
+    run: StrategyRun,
     *,
-    noisy: NoisyRun | None = None,
     outputs: PartOutputs | None = None,
     stroke: Stroke | None = None,
 ) -> int:
@@ -76,13 +64,14 @@ def run_batch(
     that is not a bad part (a bug) makes the group planned again one part at a time, so the
     lines before it are written before it is raised.
 
-    ``noisy``: plan each part under the noise options (:class:`~.noisy.NoisyRun`), each
-    line what ``plan PART --json`` prints with them. ``outputs``: each part's ``--plot``
+    ``run``: how each part is planned (:class:`~.strategies.StrategyRun`: the problem
+    options, ``--only best``, ``--guaranteed``, the noise and payoff options), each line
+    what ``plan PART --json`` prints with them. ``outputs``: each part's ``--plot``
     and ``--export`` files (:class:`~.outputs.PartOutputs`, a path template); a part whose
     file is refused or cannot be written gets an error line instead of its document. With
-    either, the parts are planned one at a time (:func:`_one_at_a_time`), as with
-    ``stroke`` (the gripper's stroke: a part whose Bayes plan needs an opening outside it
-    gets an error line, :func:`~bayesgrasp.io.export.check_stroke`).
+    noise, files or ``stroke`` (the gripper's stroke: a part whose Bayes plan needs an
+    opening outside it gets an error line, :func:`~bayesgrasp.io.export.check_stroke`), the
+    parts are planned one at a time (:func:`_one_at_a_time`).
 
     Raises
     ------
@@ -90,29 +79,23 @@ def run_batch(
         The batch file cannot be opened (before its first line; PARTs are written first).
     """
     from ..geometry.polygon import Part as PlainPart
-    from ..io.plans import plan_document_json
+    from ..io.plans import strategy_document_json
     from ..sizes import SMALL
 
+    spec = run.spec
     inputs = run_inputs(part, spec)
     # json.dumps(doc, allow_nan=False); documents are trees, so no test for cycles
     encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
     out = sys.stdout
-    if noisy is not None or outputs is not None or stroke is not None:
-        stage = _one_at_a_time(spec, inputs, guaranteed, best_only, noisy, outputs, encode, stroke)
+    if run.noisy or outputs is not None or stroke is not None:
+        stage = _one_at_a_time(run, inputs, outputs, encode, stroke)
         return _each_alone(_batch_parts(part, more, batch), stage, encode, out)
-    build, plan = _builder(spec), spec.planner(best_only)
+    build, planned = _builder(spec), run.solve
     memo: dict[str, Any] = {}  # what the documents share (the provenance)
 
-    def planned(pb: Problem) -> tuple[PlanReport, GuaranteedPlan | str | None]:
-        return plan(pb), guaranteed_plan(pb) if guaranteed else None
-
-    def document(done: tuple[PlanReport, GuaranteedPlan | str | None]) -> _Line:
-        result, found = done
-        sure, missing = (None, found) if isinstance(found, str) else (found, None)
-        text = plan_document_json(
-            result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs, memo=memo
-        )
-        return text, 0 if missing is None else 1
+    def document(result: StrategyResult) -> _Line:
+        text = strategy_document_json(result, inputs=inputs, memo=memo)
+        return text, 0 if result.guaranteed_missing is None else 1
 
     stages = (build, planned, document)
     size = 1 if batch is not None and str(batch) == "-" else GROUP
@@ -202,58 +185,37 @@ def _each_alone(
 
 
 def _one_at_a_time(
-    spec: ProblemSpec,
+    run: StrategyRun,
     inputs: dict[str, Any],
-    guaranteed: bool,
-    best_only: bool,
-    noisy: NoisyRun | None,
     outputs: PartOutputs | None,
     encode: Callable[[Any], str],
     stroke: Stroke | None = None,
 ) -> Callable[[tuple[int, str, Part]], _Line]:
     """The one stage of a part planned with noise or with files: its line.
 
-    The same document as the single-part run: :meth:`NoisyRun.document` or
-    :func:`~bayesgrasp.io.plans.plan_document_json`; a file refused or not written makes
-    the line an error (exit code 2), as the single run exits 2.
+    The same document as the single-part run (:func:`~.strategies.document`); a file refused
+    or not written makes the line an error (exit code 2), as the single run exits 2.
     """
     import typer
 
-    from ..io.export import check_stroke
-    from ..io.plans import plan_document_json
     from .common import input_files
+    from .strategies import check_stroke, document, exit_code, write_outputs
 
-    build, plan = _builder(spec), spec.planner(best_only)
+    build = _builder(run.spec)
 
     def stage(item: tuple[int, str, Part]) -> _Line:
         index, label, found = item
         try:
             if outputs is not None:
                 outputs.check(found.name, index, input_files(label))
-            pb = build(found)
-            if noisy is not None:
-                done = noisy.plan(pb)
-                if stroke is not None:
-                    check_stroke(pb, done[0].bayes_plan.option, stroke)
-                text = encode(noisy.document(done, inputs))
-                missing = isinstance(done[1], str)
-                if outputs is not None:
-                    noisy.write_outputs(outputs, index, pb, done[0])
-            else:
-                result = plan(pb)
-                if stroke is not None:
-                    check_stroke(pb, result.bayes_plan, stroke)
-                found_g = guaranteed_plan(pb) if guaranteed else None
-                sure, gone = (None, found_g) if isinstance(found_g, str) else (found_g, None)
-                text = plan_document_json(
-                    result, guaranteed=sure, guaranteed_missing=gone, inputs=inputs
-                )
-                missing = gone is not None
-                if outputs is not None:
-                    write_plain_outputs(outputs, index, pb, result)
+            result = run.solve(build(found))
+            check_stroke(result, stroke)
+            text = encode(document(result, inputs))
+            if outputs is not None:
+                write_outputs(outputs, index, result)
         except typer.BadParameter as exc:  # a file refused: this part's error
             return _refused(label, exc, encode)
-        return text, 1 if missing else 0
+        return text, exit_code(result)
 
     return stage
 
@@ -283,7 +245,7 @@ def run_policy_batch(
     The --also parts are read and the sensor checked once, before the first line (a bad one
     is the run's error, exit 2). ``part`` gives the part-file options (its PART is
     ``None``); ``outputs``, ``stroke``: as :func:`run_batch`; ``fold``: the figures' folding
-    (:func:`write_policy_outputs`); ``noise``: the action noise and payoff each policy is
+    (:func:`~.strategies.write_outputs`); ``noise``: the action noise and payoff each policy is
     planned under (:class:`~.sensing.ActionModel`). The parts are planned one at a time.
 
     Raises
@@ -293,72 +255,31 @@ def run_policy_batch(
     """
     import typer
 
-    from ..io.export import check_stroke
-    from ..io.policies import policy_document
     from ..model.sensing import parse_sensor
     from .common import input_files
-    from .sensing import plan_sensing_policy
+    from .sensing import sensing_run
+    from .strategies import check_stroke, document, write_outputs
 
     parse_sensor(sensing.sense)  # a malformed sensor: the run's one error line
     others = [dataclasses.replace(part, part=p).load() for p in sensing.also]
     encode = json.JSONEncoder(allow_nan=False, check_circular=False).encode
+    run = sensing_run(spec, sensing, noise, len(others) + 1)
 
     def stage(item: tuple[int, str, Part]) -> _Line:
         index, label, found = item
         try:
             if outputs is not None:
                 outputs.check(found.name, index, input_files(label))
-            problems, pol = plan_sensing_policy(sensing, [found, *others], spec, noise)
-            if stroke is not None:
-                check_stroke(problems, pol, stroke)
-            text = encode(policy_document(pol))
+            result = run.solve_parts([found, *others])
+            check_stroke(result, stroke)
+            text = encode(document(result))
             if outputs is not None:
-                write_policy_outputs(outputs, index, problems, pol, fold)
+                write_outputs(outputs, index, result, fold)
         except typer.BadParameter as exc:  # a file refused: this part's error
             return _refused(label, exc, encode)
         return text, 0
 
     return _each_alone(_batch_parts(part, [], batch), stage, encode, sys.stdout)
-
-
-def write_policy_outputs(
-    outputs: PartOutputs,
-    index: int,
-    problems: list[Problem],
-    policy: Policy,
-    fold: float | None = None,
-) -> None:
-    """Write a policy's ``--plot`` and ``--export`` files (its tree, its state machine).
-
-    The figure is :func:`~bayesgrasp.figures.policy.policy_figure`, as ``plot --sense``
-    draws it; ``fold``: its ``min_probability`` (default: the figure's own).
-    """
-    from ..figures.policy import policy_figure
-    from ..io.export import write_robot
-
-    def figure() -> Any:
-        if fold is None:
-            return policy_figure(problems, policy)
-        return policy_figure(problems, policy, min_probability=fold)
-
-    def robot(path: Path) -> None:
-        meta: dict[str, Any] = {} if policy.noise is None else {"noise": policy.noise.to_json()}
-        if policy.payoff is not None:
-            meta["payoff"] = list(policy.payoff)
-        write_robot(path, problems, policy, meta)
-
-    outputs.write(problems[0].part.name, index, figure, robot)
-
-
-def write_plain_outputs(outputs: PartOutputs, index: int, pb: Problem, result: PlanReport) -> None:
-    """Write a part's ``--plot`` and ``--export`` files (the plan figure, the Bayes plan)."""
-    from ..figures.plans import plan_figure
-    from ..io.export import write_robot
-
-    def robot(path: Path) -> None:
-        write_robot(path, pb, result.bayes_plan)
-
-    outputs.write(pb.part.name, index, lambda: plan_figure(result), robot)
 
 
 def _builder(spec: ProblemSpec) -> Any:

@@ -6,7 +6,9 @@ when they are given); this module parses them (:meth:`NoisyRun.of`), calls
 surfaces the noise-aware plan: the table or ``--json``, ``--only best``, ``--guaranteed``
 (:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`), ``--plot`` (the distributions
 under the noise), ``--export`` (the robot file, with the noise model in its header) and
-several parts or ``--batch`` (:func:`~bayesgrasp.cli.batch.run_batch`, one document a line).
+several parts or ``--batch`` (:func:`~bayesgrasp.cli.batch.run_batch`, one document a line),
+all through :mod:`.strategies` (:func:`strategy_run`); :class:`NoisyRun` is the same run
+for the plot command, the web service and sweeps.
 """
 
 from __future__ import annotations
@@ -18,20 +20,19 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from ..io.plans import noisy_plan_document
-from .common import emit_json
 
 noisy_document = noisy_plan_document  # the document is written by io.plans
 
 if TYPE_CHECKING:
-    from ..geometry.polygon import Part
-    from ..io.export import Stroke
     from ..model.noise import NoiseModel, TurnNoise
     from ..model.payoff import Payoff
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
     from ..planning.noisy import NoisyPlanResult
+    from ..planning.strategy import StrategyResult
     from .outputs import PartOutputs
     from .specs import ProblemSpec
+    from .strategies import StrategyRun
 
 #: A noise-aware plan and its guaranteed plan (or the reason there is none, or not asked).
 Planned = tuple["NoisyPlanResult", "GuaranteedPlan | str | None"]
@@ -53,6 +54,26 @@ def turn_noise(spec: str | None) -> TurnNoise:
         return parse_turn_noise(spec)
     except PlanningError as exc:
         raise typer.BadParameter(str(exc), param_hint="--turn-noise") from None
+
+
+def strategy_run(
+    spec: ProblemSpec,
+    turn: str | None,
+    contact: float | None,
+    payoff: Path | None,
+    best_only: bool = False,
+    guaranteed: bool = False,
+) -> StrategyRun:
+    """The run of ``plan``'s options (:class:`~.strategies.StrategyRun`).
+
+    The noise-aware planner when a noise or payoff option was given (checked by
+    :meth:`NoisyRun.of`), else the problem's own planner.
+    """
+    if asked(turn, contact, payoff):
+        return NoisyRun.of(spec, turn, contact, payoff, best_only, guaranteed).strategy_run(spec)
+    from .strategies import StrategyRun
+
+    return StrategyRun(spec, best_only, guaranteed)
 
 
 def noise_model(turn: str | None, contact: float | None) -> NoiseModel:
@@ -102,24 +123,47 @@ class NoisyRun:
         u = read_payoff(payoff) if payoff is not None else None
         return cls(noise, u, spec.max_actions, best_only, guaranteed)
 
-    def plan(self, pb: Problem) -> Planned:
+    def strategy_run(self, spec: ProblemSpec) -> StrategyRun:
+        """The run of these options (:class:`~.strategies.StrategyRun`, the noise-aware planner)."""
+        from .strategies import StrategyRun
+
+        return StrategyRun(
+            spec, self.best_only, self.guaranteed, self.noise, self.payoff, noisy=True
+        )
+
+    def solve(self, pb: Problem) -> StrategyResult:
         """The noise-aware plans of a problem, and its guaranteed plan under the noise."""
-        from ..planning.noisy import plan_noisy
-        from ..planning.robust import plan_guaranteed_noisy
+        from ..planning.strategy import solve
 
-        res = plan_noisy(pb, self.noise, self.payoff, self.max_actions)
-        if self.best_only:
-            res = res.best_only()
-        if not self.guaranteed:
-            return res, None
-        found = plan_guaranteed_noisy(pb, self.noise)
-        return res, found if found.status == "ok" else str(found.reason or "no guaranteed plan")
+        return solve(
+            pb,
+            noise=self.noise,
+            payoff=self.payoff,
+            max_actions=self.max_actions,
+            best_only=self.best_only,
+            guaranteed=self.guaranteed,
+        )
 
-    def document(self, done: Planned, inputs: dict[str, Any] | None = None) -> dict[str, Any]:
+    def plan(self, pb: Problem) -> Planned:
+        """:meth:`solve` as the pair (noise-aware plans, guaranteed plan or why none)."""
+        from ..planning.noisy import NoisyPlanResult
+
+        res = self.solve(pb)
+        assert isinstance(res.source, NoisyPlanResult)
+        found = res.guaranteed if res.guaranteed_missing is None else res.guaranteed_missing
+        return res.source, found
+
+    def document(
+        self, done: Planned | StrategyResult, inputs: dict[str, Any] | None = None
+    ) -> dict[str, Any]:
         """The plan document (``plan --json``) of a planned part."""
-        res, found = done
-        sure, missing = (None, found) if isinstance(found, str) else (found, None)
-        return noisy_document(res, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+        from ..io.plans import strategy_document
+
+        if isinstance(done, tuple):
+            res, found = done
+            sure, missing = (None, found) if isinstance(found, str) else (found, None)
+            return noisy_document(res, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+        return strategy_document(done, inputs=inputs)
 
     def robot_metadata(self, res: NoisyPlanResult) -> dict[str, Any]:
         """What a robot file of the plan says about the noise it was planned for."""
@@ -162,45 +206,3 @@ def noisy_text(res: NoisyPlanResult) -> str:
         f"{res.refinement_bound:.2g} in E[payoff]"
     )
     return "\n".join(lines)
-
-
-def plan_noisy_command(
-    part: Part,
-    spec: ProblemSpec,
-    run: NoisyRun,
-    as_json: bool,
-    outputs: PartOutputs | None = None,
-    inputs: dict[str, Any] | None = None,
-    stroke: Stroke | None = None,
-) -> int:
-    """``plan PART`` with the noise and payoff options: plan, print, write; the exit code.
-
-    ``stroke``: the noise-aware Bayes plan must fit the gripper's stroke
-    (:func:`~bayesgrasp.io.export.check_stroke`).
-
-    1 when a guaranteed plan was asked for and there is none (after printing why).
-    """
-    from .. import report
-
-    if outputs is not None:
-        outputs.check(part.name, 1)
-    pb = spec.build(part)
-    done = run.plan(pb)
-    res, found = done
-    if stroke is not None:
-        from ..io.export import check_stroke
-
-        check_stroke(pb, res.bayes_plan.option, stroke)
-    if as_json:
-        emit_json(run.document(done, inputs))
-    else:
-        typer.echo(noisy_text(res))
-        if isinstance(found, str):
-            typer.echo(f"Guaranteed plan: none ({found})")
-        elif found is not None:
-            typer.echo(report.guaranteed_text(found))
-            if not run.noise.exact:
-                typer.echo(f"(guaranteed under {run.noise.describe()})")
-    if outputs is not None:
-        run.write_outputs(outputs, 1, pb, res)
-    return 1 if isinstance(found, str) else 0

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import functools
 import math
@@ -30,7 +31,7 @@ from .options import (
     problem_options,
     sense_spec,
 )
-from .specs import PartSpec, ProblemSpec, SenseSpec, guaranteed_plan, run_inputs
+from .specs import PartSpec, ProblemSpec, SenseSpec, run_inputs
 
 if TYPE_CHECKING:
     from ..io.export import Stroke
@@ -93,6 +94,16 @@ ExportOpt = Annotated[
 ]
 
 
+WithinStrokeOpt = Annotated[
+    bool,
+    typer.Option(
+        "--within-stroke",
+        help="Plan only actions the stroke allows (--max-opening, --min-opening): the best "
+        "plan of each length whose every step fits, instead of refusing a plan that does not "
+        "(noise-free plans of one part; up to --max-actions, default 4).",
+    ),
+]
+
 MorePartsArg = Annotated[
     list[str] | None,
     typer.Argument(
@@ -149,6 +160,7 @@ def plan(
     batch: BatchOpt = None,
     max_opening: MaxOpeningOpt = None,
     min_opening: MinOpeningOpt = None,
+    within_stroke: WithinStrokeOpt = False,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -165,10 +177,9 @@ def plan(
     on its line and the others go on; the exit code is the largest of the parts'. --plot
     and --export then write one file a part, named by a path with {name}.
     """
-    from .. import report
-    from ..io.plans import plan_document
     from . import noisy
     from .outputs import PartOutputs
+    from .strategies import check_stroke, document, exit_code, text, write_outputs
 
     stroke = None
     if max_opening is not None or min_opening is not None:
@@ -183,7 +194,8 @@ def plan(
         raise typer.BadParameter(
             "--max-memory and --time-limit bound a policy search: they need --sense"
         )
-    noise_asked = noisy.asked(turn_noise, contact_noise, payoff)
+    if within_stroke:
+        _check_within_stroke(stroke, sense, spec, turn_noise, contact_noise, payoff)
     if sense is not None:
         refused = [
             name
@@ -214,64 +226,66 @@ def plan(
     several = batch is not None or bool(more_parts)
     if part.part is None and not several:
         raise typer.BadParameter("give a PART (or --batch FILE.jsonl)")
-    run = (
-        noisy.NoisyRun.of(spec, turn_noise, contact_noise, payoff, only is Only.best, guaranteed)
-        if noise_asked
-        else None
-    )
+    run = noisy.strategy_run(spec, turn_noise, contact_noise, payoff, only is Only.best, guaranteed)
+    if within_stroke and stroke is not None:
+        run = dataclasses.replace(run, stroke=(stroke.min_opening, stroke.max_opening))
     files = input_files(part.part, spec.prior, batch, payoff)
     outputs = PartOutputs.of(plot_file, export, force, files, several)
     if several:
         from .batch import BatchFileError, run_batch
 
         try:
-            code = run_batch(
-                part,
-                more_parts or [],
-                batch,
-                spec,
-                guaranteed,
-                only is Only.best,
-                noisy=run,
-                outputs=outputs,
-                stroke=stroke,
-            )
+            code = run_batch(part, more_parts or [], batch, run, outputs=outputs, stroke=stroke)
         except BatchFileError as exc:
             raise typer.BadParameter(str(exc), param_hint="--batch") from None
         if code:
             raise typer.Exit(code)
         return
     loaded = part.load()
-    inputs = run_inputs(part, spec)
-    if run is not None:
-        code = noisy.plan_noisy_command(loaded, spec, run, as_json, outputs, inputs, stroke)
-        if code:
-            raise typer.Exit(code)
-        return
     if outputs is not None:
         outputs.check(loaded.name, 1)
-    pb = spec.build(loaded)
-    result = spec.plan(pb, best_only=only is Only.best)
-    if stroke is not None:
-        from ..io.export import check_stroke
-
-        check_stroke(pb, result.bayes_plan, stroke)
-    found = guaranteed_plan(pb) if guaranteed else None
-    sure, missing = (None, found) if isinstance(found, str) else (found, None)
+    result = run.solve(spec.build(loaded))
+    check_stroke(result, stroke)
     if as_json:
-        emit_json(plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs))
+        emit_json(document(result, run_inputs(part, spec)))
     else:
-        typer.echo(report.plan_table(result, spec.max_actions))
-        if sure is not None:
-            typer.echo(report.guaranteed_text(sure))
-        if missing is not None:
-            typer.echo(f"Guaranteed plan: none ({missing})")
+        typer.echo(text(result, spec.max_actions))
     if outputs is not None:
-        from .batch import write_plain_outputs
+        write_outputs(outputs, 1, result)
+    code = exit_code(result)
+    if code:  # no guaranteed plan reached the goal asked for
+        raise typer.Exit(code)
 
-        write_plain_outputs(outputs, 1, pb, result)
-    if missing is not None:  # no plan reached the goal asked for
-        raise typer.Exit(1)
+
+def _check_within_stroke(
+    stroke: Stroke | None,
+    sense: str | None,
+    spec: ProblemSpec,
+    turn: str | None,
+    contact: float | None,
+    payoff: Path | None,
+) -> None:
+    """Refuse ``--within-stroke`` where it cannot plan (exit 2, one line)."""
+    hint = "--within-stroke"
+    if stroke is None:
+        raise typer.BadParameter(
+            "needs the stroke: --max-opening and/or --min-opening", param_hint=hint
+        )
+    if sense is not None:
+        raise typer.BadParameter(
+            "plans linear plans; a policy is checked against the stroke (drop --within-stroke)",
+            param_hint=hint,
+        )
+    if turn is not None or contact is not None or payoff is not None:
+        raise typer.BadParameter(
+            "searches noise-free plans; a noise-aware plan is checked against the stroke "
+            "(drop --within-stroke)",
+            param_hint=hint,
+        )
+    if spec.method.value != "exact":
+        raise typer.BadParameter("is its own planner; drop --method", param_hint=hint)
+    if spec.accuracy_deg:
+        raise typer.BadParameter("takes exact turns; drop --accuracy", param_hint=hint)
 
 
 def _policy_batch(

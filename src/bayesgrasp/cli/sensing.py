@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from ..model.sensing import WidthSensor
     from ..planning.policy import Policy
     from .outputs import PartOutputs
+    from .strategies import StrategyRun
 
 
 @dataclass(frozen=True)
@@ -33,6 +34,25 @@ class ActionModel:
     payoff: Path | None = None
 
 
+def sensing_run(
+    spec: ProblemSpec, sensing: SenseSpec, model: ActionModel | None, n_parts: int = 1
+) -> StrategyRun:
+    """The run of a --sense command (:class:`~.strategies.StrategyRun`) for ``n_parts`` parts.
+
+    Reads the payoff file; a payoff with candidate parts is refused (exit 2).
+    """
+    from .strategies import StrategyRun
+
+    if model is None:
+        return StrategyRun(spec, sensing=sensing)
+    from ..model.payoff import read_payoff
+
+    payoff = read_payoff(model.payoff) if model.payoff is not None else None
+    if payoff is not None and n_parts > 1:
+        raise typer.BadParameter("a payoff is for one part: drop --also", param_hint="--payoff")
+    return StrategyRun(spec, noise=model.noise, payoff=payoff, noisy=True, sensing=sensing)
+
+
 def plan_sensing_policy(
     sensing: SenseSpec,
     parts: list[Part],
@@ -41,25 +61,11 @@ def plan_sensing_policy(
     sensor: WidthSensor | None = None,
 ) -> tuple[list[Problem], Policy]:
     """The candidates' problems and their Bayes policy, under the action noise if given."""
-    if model is None:
-        return sensing.policy(parts, spec, sensor)
-    from ..model.payoff import read_payoff
-    from ..planning.noisy_policy import plan_noisy_policy
+    from ..planning.policy import Policy
 
-    payoff = read_payoff(model.payoff) if model.payoff is not None else None
-    if payoff is not None and len(parts) > 1:
-        raise typer.BadParameter("a payoff is for one part: drop --also", param_hint="--payoff")
-    problems = [spec.build(p) for p in parts]
-    pol = plan_noisy_policy(
-        problems,
-        sensing.sense if sensor is None else sensor,
-        sensing.max_actions,
-        model.noise,
-        payoff=payoff,
-        part_prior=sensing.part_prior,
-        max_memory_mb=sensing.max_memory_mb,
-    )
-    return problems, pol
+    res = sensing_run(spec, sensing, model, len(parts)).solve_parts(parts, sensor)
+    assert isinstance(res.source, Policy)
+    return list(res.problems), res.source
 
 
 def sense_noise(turn: str | None, contact: float | None, payoff: Path | None) -> ActionModel | None:
@@ -92,47 +98,19 @@ def plan_policy_command(
     With ``noise`` the policy is planned, and its figures computed, under that action noise
     (and payoff).
     """
-    from ..io.export import check_stroke
-    from ..io.policies import policy_document
-    from ..planning.policy import policy_text
+    from .strategies import check_stroke, document, text, write_outputs
 
     parts = sensing.parts(part)
     if outputs is not None:
         outputs.check(parts[0].name, 1)
-    problems, pol = plan_sensing_policy(sensing, parts, spec, noise)
-    if stroke is not None:
-        check_stroke(problems, pol, stroke)
+    result = sensing_run(spec, sensing, noise, len(parts)).solve_parts(parts)
+    check_stroke(result, stroke)
     if outputs is not None:
-        from .batch import write_policy_outputs
-
-        write_policy_outputs(outputs, 1, problems, pol, fold_figure)
+        write_outputs(outputs, 1, result, fold_figure)
     if as_json:
-        emit_json(policy_document(pol))
+        emit_json(document(result))
         return
-    typer.echo(policy_text(pol, units=parts[0].units, min_probability=fold_below))
-    entropy = ", ".join(f"{h:.3f}" for h in pol.expected_entropy)
-    blind = pol.sensorless_cost
-    under = "" if pol.noise is None else " under the noise"
-    versus = "" if blind is None else f" (sensorless Bayes plan{under} {blind:.4f})"
-    typer.echo(
-        f"expected cost {pol.expected_cost:.4f}{versus}, "
-        f"success {pol.success_probability:.4f} a cycle, "
-        f"{pol.expected_actions:.3f} actions a cycle; expected entropy after each level "
-        f"(bits): {entropy}"
-    )
-    if not pol.complete:
-        typer.echo(
-            f"search stopped: {pol.stopped}. This is the best policy of at most "
-            f"{pol.max_actions} actions (the deepest search that finished); no policy of "
-            f"{pol.requested_actions} actions costs less than {pol.lower_bound:.4f}"
-        )
-    if pol.payoff is not None:
-        typer.echo("payoff: success is the expected payoff earned, the cost is per unit payoff")
-    if pol.noise is not None:
-        typer.echo(
-            f"noise: {pol.noise.describe()}; every figure is exact under it; no single turn "
-            f"lowers the cost's value by more than {pol.refinement_bound:.2g}"
-        )
+    typer.echo(text(result, fold_below=fold_below))
 
 
 def simulate_policy_command(

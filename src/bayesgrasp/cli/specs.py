@@ -13,9 +13,7 @@ if TYPE_CHECKING:
     from ..geometry.polygon import Part
     from ..model.prior import Prior
     from ..model.problem import Problem
-    from ..model.sensing import WidthSensor
     from ..planning.guaranteed import GuaranteedPlan
-    from ..planning.policy import Policy
     from ..planning.result import PlanReport
 
 
@@ -240,29 +238,6 @@ class SenseSpec:
         if first.units is None:
             return [first, *more]
         return [first, *(convert(p, first.units) if p.units else p for p in more)]
-
-    def policy(
-        self, parts: list[Part], spec: ProblemSpec, sensor: WidthSensor | None = None
-    ) -> tuple[list[Problem], Policy]:
-        """The candidates' problems and their Bayes policy (``sensor`` replaces ``sense``)."""
-        from ..planning.policy import plan_policy
-        from .common import with_progress
-
-        problems = [spec.build(p) for p in parts]
-        pol = with_progress(
-            "policy search (seconds of --time-limit)",
-            math.ceil(self.time_limit_s),
-            lambda progress: plan_policy(
-                problems,
-                sensor=self.sense if sensor is None else sensor,
-                max_actions=self.max_actions,
-                part_prior=self.part_prior,
-                max_memory_mb=self.max_memory_mb,
-                time_limit_s=self.time_limit_s,
-                progress=progress,
-            ),
-        )
-        return problems, pol
 
 
 def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:

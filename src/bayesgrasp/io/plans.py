@@ -1,7 +1,12 @@
-"""Plan documents: the one module that writes and reads the JSON of plans.
+"""Documents: the one module that writes and reads the JSON of every strategy.
 
-A plan document is what ``bayesgrasp plan --json`` prints (``plan --batch`` one a line, the
-web service's ``/plan`` too) and ``bayesgrasp simulate --plan FILE`` (or
+:func:`strategy_document` writes the document of any planner's result (a
+:class:`~bayesgrasp.planning.strategy.StrategyResult`): the plan document of linear plans
+(noise-free or noise-aware) and the policy document of a policy; :func:`read_strategy` reads
+either back. The sections below give both schemas.
+
+*Plan documents.* A plan document is what ``bayesgrasp plan --json`` prints (``plan
+--batch`` one a line, the web service's ``/plan`` too) and ``bayesgrasp simulate --plan FILE`` (or
 :func:`read_plan_document`) reads back. :func:`plan_document` builds it, the only writer;
 the standard ``json`` encoder writes its text. Its fields, in the order written (``?``: only
 in some documents)::
@@ -57,6 +62,62 @@ rounded to the part's symmetry tolerance), so a plan read for another part is no
 that rebuilds it (:func:`prior_from_document`), so a re-run from the document gives the
 same numbers.
 
+Noise-aware plan documents (``plan --turn-noise / --contact-noise / --payoff``) add, after
+``provenance``: ``expected_payoff`` and ``expected_cost_per_unit_payoff`` of the Bayes plan,
+``noise``, ``payoff``, ``candidates``, ``refinement_bound``, ``payoff_bound`` and
+``noisy_options`` (each option's figures under the noise, :func:`noisy_plan_document`).
+
+*Policy documents.* The policy document ``bayesgrasp.policy/1`` (:func:`policy_document`,
+read back by :func:`read_policy_document`). Fields (angles in radians, readings in the
+parts' units)::
+
+    {
+      "schema": "bayesgrasp.policy/1",
+      "parts": [NAME, ...],            candidate parts, in order
+      "part_prior": [W, ...],          prior probability of each part (sums to 1)
+      "sensor": {"kind": "width", "sigma": S, "resolution": R},
+                                       reading = R round((d + e) / R), e ~ N(0, S^2);
+                                       S = R = 0: exact readings
+      "max_actions": K,                no path has more actions
+      "expected_cost": C,              E[cost until a cycle succeeds] = cycle_cost / P
+      "success_probability": P,        a cycle declares the true orientation (and part)
+      "expected_actions": A,           expected actions in one cycle
+      "cycle_cost": c,                 E[cost of one cycle], retry overhead included
+      "reject_probability": r,         a cycle ends in a rejection
+      "expected_total_actions": A / P, expected actions until success
+      "expected_entropy_bits": [H1, ...],
+                                       expected entropy (bits) of the belief over the
+                                       states after the reading of action 1, 2, ...
+                                       (paths that ended keep their last belief)
+      "sensorless_cost": C0 | null,    the sensorless Bayes plan's expected cost (one part)
+      "first_angle_exact": bool,       every first angle that can be optimal was tried
+      "noise": {"turn": {"kind": "normal" | "uniform", "scale_rad": s}, "contact": q},
+                                       only for a policy planned under noisy actions
+                                       (plan --sense --turn-noise / --contact-noise): every
+                                       figure and probability is exact under that noise
+      "refinement_bound": eps,         with "noise": no single turn, the rest kept, lowers
+                                       cycle_cost - expected_cost * P by more
+      "payoff": [U, ...],              only for a policy with a payoff (plan --sense
+                                       --payoff FILE): the value of each stable state; a
+                                       declaring leaf stops and earns the payoff of the state
+                                       reached, P is the expected payoff of a cycle and C
+                                       the expected cost per unit payoff
+      "root": NODE
+    }
+    NODE = {"action": {"type": "squeeze" | "push-grasp", "alpha_rad": a, "margin_rad": m},
+            "branches": [{"reading": [lo, hi], "probability": p, "next": NODE | LEAF}]}
+    LEAF = {"declare": {"orientation_rad": t, "part": NAME}, "success_probability": q}
+         | {"reject": true}
+
+``alpha_rad`` is the world gripper angle at the root and the turn relative to the previous
+action below it; ``margin_rad`` is how far that turn may err without changing any state's
+outcome (``null`` at the root; 0 under noisy actions, whose error is in the figures).
+``reading`` is the half-open interval ``[lo, hi)``, ``null`` for an unbounded end; the
+branches of a node tile every reading in increasing order, and ``probability`` is that of
+the branch given that the node is reached. A declared ``orientation_rad`` is in the frame of
+the last action, in ``[0, 2 pi)``; ``q`` is the probability that the declaration is right
+given that the leaf is reached.
+
 Examples
 --------
 >>> from bayesgrasp.geometry.polygon import Part
@@ -91,18 +152,24 @@ from ..model.prior import HistogramPrior, Prior, SamplePrior, UniformPrior
 from ..sizes import SMALL
 
 if TYPE_CHECKING:  # the planners are imported by what reads plans, not by every document
+    from ..model.noise import NoiseModel
     from ..model.problem import Problem
+    from ..model.sensing import WidthSensor
     from ..planning.guaranteed import GuaranteedPlan
     from ..planning.noisy import NoisyPlanResult
+    from ..planning.policy import Declare, Policy, PolicyNode, Reject
     from ..planning.result import PlanOption, PlanReport, PlanStep
+    from ..planning.strategy import StrategyResult
 
 __all__ = [
     "PLAN_SCHEMA",
     "PLAN_SCHEMAS",
     "PLAN_SCHEMA_1",
     "PLAN_SCHEMA_2",
+    "POLICY_SCHEMA",
     "SIMULATE_SCHEMA",
     "PlanSource",
+    "PolicySource",
     "guaranteed_document",
     "json_float",
     "noisy_plan_document",
@@ -112,12 +179,17 @@ __all__ = [
     "plan_document",
     "plan_document_json",
     "plan_schema",
+    "policy_document",
     "prior_document",
     "prior_from_document",
     "provenance",
     "read_plan",
     "read_plan_document",
+    "read_policy_document",
+    "read_strategy",
     "same_part",
+    "strategy_document",
+    "strategy_document_json",
 ]
 
 PLAN_SCHEMA_1 = "bayesgrasp.plan/1"
@@ -128,6 +200,8 @@ PLAN_SCHEMAS = (PLAN_SCHEMA_1, PLAN_SCHEMA_2)
 """Every plan schema :func:`read_plan_document` reads."""
 SIMULATE_SCHEMA = "bayesgrasp.simulate/1"
 """A simulation's document; its ``"plan"`` is read as a plan."""
+POLICY_SCHEMA = "bayesgrasp.policy/1"
+"""The schema of a policy document."""
 
 #: Which plan of a document to read: the key of its index (``"guaranteed"`` is an option).
 _PLAN_INDEX = {"bayes": "bayes", "most-certain": "most_certain"}
@@ -597,19 +671,11 @@ def read_plan(
     (True, 'single', 'uniform')
     """
     if isinstance(source, str | os.PathLike):
-        path = Path(source)
-        try:
-            doc = json.loads(path.read_text(encoding="utf-8"))
-        except OSError as exc:
-            reason = exc.strerror or exc
-            raise SimulationError(f"plan file {str(path)!r} cannot be read ({reason})") from None
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            why = exc.msg if isinstance(exc, json.JSONDecodeError) else "not UTF-8"
-            raise SimulationError(f"plan file {str(path)!r} is not valid JSON ({why})") from None
+        doc = _load(source, "plan file")
         try:
             return _read_source(doc, which)
         except SimulationError as exc:
-            raise SimulationError(f"plan file {str(path)!r}: {exc}") from None
+            raise SimulationError(f"plan file {str(Path(source))!r}: {exc}") from None
     return _read_source(source, which)
 
 
@@ -703,3 +769,300 @@ def _read_option(doc: Any) -> PlanOption:
         tol if math.isfinite(tol) else None,
         (math.nan, math.nan),
     )
+
+
+# Every strategy's document
+
+
+def strategy_document(
+    result: StrategyResult,
+    *,
+    inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """The document of any planner's result: what ``plan ... --json`` prints.
+
+    A policy: :func:`policy_document`; noise-aware plans: :func:`noisy_plan_document`; the
+    exact, breadth-first or guaranteed planner's plans: :func:`plan_document`. The result's
+    guaranteed plan (or the reason there is none) is written with the plans. ``inputs`` and
+    ``memo``: as :func:`plan_document` (a policy document has no provenance).
+
+    Examples
+    --------
+    >>> from bayesgrasp.model.problem import Problem
+    >>> from bayesgrasp.planning import solve
+    >>> pb = Problem.build(Part.from_points([(0, 0), (3, 0), (3, 2), (0, 2)], name="r"))
+    >>> [strategy_document(solve(pb, sensor=s))["schema"] for s in (None, "width")]
+    ['bayesgrasp.plan/1', 'bayesgrasp.policy/1']
+    """
+    from ..planning.noisy import NoisyPlanResult
+    from ..planning.policy import Policy
+
+    src = result.source
+    if isinstance(src, Policy):
+        return policy_document(src)
+    sure, missing = result.guaranteed, result.guaranteed_missing
+    if isinstance(src, NoisyPlanResult):
+        return noisy_plan_document(src, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+    return plan_document(src, guaranteed=sure, guaranteed_missing=missing, inputs=inputs, memo=memo)
+
+
+def strategy_document_json(
+    result: StrategyResult,
+    *,
+    inputs: Mapping[str, Any] | None = None,
+    memo: dict[str, Any] | None = None,
+) -> str:
+    """:func:`strategy_document` on one line (what ``plan --batch`` writes for a part)."""
+    return str(_encode(strategy_document(result, inputs=inputs, memo=memo)))
+
+
+def _end(x: float) -> float | None:
+    return None if math.isinf(x) else float(x)
+
+
+def _policy_node(node: PolicyNode) -> dict[str, Any]:
+    return {
+        "action": {
+            "type": node.step.kind,
+            "alpha_rad": node.step.alpha,
+            "margin_rad": _end(node.margin),
+        },
+        "branches": [
+            {
+                "reading": [_end(b.lo), _end(b.hi)],
+                "probability": b.probability,
+                "next": _policy_next(b.next),
+            }
+            for b in node.branches
+        ],
+    }
+
+
+def _policy_next(x: PolicyNode | Declare | Reject) -> dict[str, Any]:
+    from ..planning.policy import PolicyNode, Reject
+
+    if isinstance(x, PolicyNode):
+        return _policy_node(x)
+    if isinstance(x, Reject):
+        return {"reject": True}
+    return {
+        "declare": {"orientation_rad": x.orientation, "part": x.part_name},
+        "success_probability": x.success_probability,
+    }
+
+
+def policy_document(policy: Policy) -> dict[str, Any]:
+    """The ``bayesgrasp.policy/1`` document of a policy (see the module notes).
+
+    Examples
+    --------
+    >>> from bayesgrasp.model import Problem
+    >>> from bayesgrasp.planning.policy import plan_policy
+    >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)], name="rect"))
+    >>> doc = policy_document(plan_policy(pb, "width", 1))
+    >>> doc["schema"], doc["parts"], doc["root"]["branches"][0]["reading"]
+    ('bayesgrasp.policy/1', ['rect'], [None, 1.5])
+    """
+    doc: dict[str, Any] = {
+        "schema": POLICY_SCHEMA,
+        "parts": list(policy.parts),
+        "part_prior": list(policy.part_prior),
+        "sensor": policy.sensor.to_json(),
+        "max_actions": policy.max_actions,
+        "expected_cost": policy.expected_cost,
+        "success_probability": policy.success_probability,
+        "expected_actions": policy.expected_actions,
+        "cycle_cost": policy.cycle_cost,
+        "reject_probability": policy.reject_probability,
+        "expected_total_actions": policy.expected_total_actions,
+        "expected_entropy_bits": list(policy.expected_entropy),
+        "sensorless_cost": policy.sensorless_cost,
+        "first_angle_exact": policy.first_angle_exact,
+    }
+    if policy.noise is not None:
+        doc["noise"] = policy.noise.to_json()
+        doc["refinement_bound"] = policy.refinement_bound
+    if policy.payoff is not None:
+        doc["payoff"] = list(policy.payoff)
+    doc["root"] = _policy_node(policy.root)
+    return doc
+
+
+@dataclass(frozen=True, slots=True)
+class PolicySource:
+    """A policy read from its document (:func:`read_policy_document`).
+
+    Attributes
+    ----------
+    root : PolicyNode
+        The tree, as written (its probabilities the document's).
+    parts : tuple of str
+        The candidate parts' names, in order (a declaration's ``part`` indexes them).
+    part_prior : tuple of float
+    sensor : WidthSensor
+    max_actions : int
+    noise : NoiseModel or None
+        The action noise it was planned under (``None``: exact actions).
+    payoff : tuple of float or None
+    figures : mapping
+        The document's figures (``expected_cost``, ``success_probability``, ...).
+    """
+
+    root: PolicyNode
+    parts: tuple[str, ...]
+    part_prior: tuple[float, ...]
+    sensor: WidthSensor
+    max_actions: int
+    noise: NoiseModel | None
+    payoff: tuple[float, ...] | None
+    figures: Mapping[str, Any]
+
+
+_POLICY_FIGURES = (
+    "expected_cost",
+    "success_probability",
+    "expected_actions",
+    "cycle_cost",
+    "reject_probability",
+    "expected_total_actions",
+    "expected_entropy_bits",
+    "sensorless_cost",
+    "first_angle_exact",
+    "refinement_bound",
+)
+
+
+def read_policy_document(source: Mapping[str, Any] | str | os.PathLike[str]) -> PolicySource:
+    """A policy from its ``bayesgrasp.policy/1`` document, or a file of one.
+
+    The inverse of :func:`policy_document`: the tree, its candidates, sensor, noise and
+    payoff, so that :func:`~bayesgrasp.planning.strategy.evaluate` can check its figures.
+
+    Raises
+    ------
+    SimulationError
+        The file cannot be read, is not a policy document, or a node, branch or leaf is
+        malformed (the message says where).
+
+    Examples
+    --------
+    >>> from bayesgrasp.model import Problem
+    >>> from bayesgrasp.planning.policy import plan_policy
+    >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)], name="rect"))
+    >>> pol = plan_policy(pb, "width", 2)
+    >>> read_policy_document(policy_document(pol)).root == pol.root
+    True
+    """
+    from ..model.noise import NoiseModel, TurnNoise
+    from ..model.sensing import WidthSensor
+
+    doc = _load(source, "policy file")
+    if not isinstance(doc, Mapping) or doc.get("schema") != POLICY_SCHEMA:
+        got = doc.get("schema") if isinstance(doc, Mapping) else type(doc).__name__
+        raise SimulationError(f"expected a {POLICY_SCHEMA} document; got {got!r}")
+    try:
+        parts = tuple(str(p) for p in doc["parts"])
+        prior = tuple(float(w) for w in doc["part_prior"])
+        sensor = WidthSensor(float(doc["sensor"]["sigma"]), float(doc["sensor"]["resolution"]))
+        depth = int(doc["max_actions"])
+        noise = None
+        if doc.get("noise") is not None:
+            turn = doc["noise"]["turn"]
+            noise = NoiseModel(
+                TurnNoise(turn["kind"], float(turn["scale_rad"])), float(doc["noise"]["contact"])
+            )
+        payoff = None if doc.get("payoff") is None else tuple(float(u) for u in doc["payoff"])
+    except (KeyError, TypeError, ValueError, BayesGraspError) as exc:
+        raise SimulationError(f"the policy document is malformed ({exc!r})") from None
+    root = _read_policy_node(doc.get("root"), parts, "root")
+    figures = {k: doc[k] for k in _POLICY_FIGURES if k in doc}
+    return PolicySource(root, parts, prior, sensor, depth, noise, payoff, figures)
+
+
+def _read_policy_node(doc: Any, parts: tuple[str, ...], where: str) -> PolicyNode:
+    """One node of a policy document (``where``: its path, for the message)."""
+    from ..planning.policy import Branch, Declare, PolicyNode, Reject
+    from ..planning.result import PlanStep
+
+    def num(x: Any, end: float) -> float:
+        if x is None:
+            return end
+        if isinstance(x, bool) or not isinstance(x, int | float):
+            raise SimulationError(f"{where}: expected a number; got {x!r}")
+        return float(x)
+
+    try:
+        action, raw = doc["action"], doc["branches"]
+        kind = action["type"]
+        if kind not in ACTIONS:
+            raise SimulationError(f"{where}: unknown action {kind!r}")
+        step = PlanStep(str(kind), num(action["alpha_rad"], math.nan))
+        margin = num(action.get("margin_rad"), math.inf)
+        branches = []
+        for i, b in enumerate(raw):
+            lo, hi = b["reading"]
+            nxt_doc = b["next"]
+            here = f"{where}.branches[{i}]"
+            nxt: PolicyNode | Declare | Reject
+            if "action" in nxt_doc:
+                nxt = _read_policy_node(nxt_doc, parts, here + ".next")
+            elif nxt_doc.get("reject") is True:
+                nxt = Reject()
+            else:
+                name = nxt_doc["declare"]["part"]
+                nxt = Declare(
+                    parts.index(name),
+                    str(name),
+                    float(nxt_doc["declare"]["orientation_rad"]),
+                    float(nxt_doc["success_probability"]),
+                )
+            branches.append(
+                Branch(num(lo, -math.inf), num(hi, math.inf), float(b["probability"]), nxt)
+            )
+    except SimulationError:
+        raise
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise SimulationError(f"{where}: malformed policy node ({exc!r})") from None
+    if not branches or not math.isfinite(step.alpha):
+        raise SimulationError(f"{where}: a node needs a finite alpha_rad and branches")
+    return PolicyNode(step, tuple(branches), margin)
+
+
+def read_strategy(
+    source: Mapping[str, Any] | str | os.PathLike[str], which: str = "bayes"
+) -> PlanSource | PolicySource:
+    """Any strategy document: a :class:`PolicySource` for a policy, else a :class:`PlanSource`.
+
+    ``which``: the plan of a plan document to read (see :func:`read_plan_document`).
+
+    Examples
+    --------
+    >>> from bayesgrasp.model.problem import Problem
+    >>> from bayesgrasp.planning import solve
+    >>> pb = Problem.build(Part.from_points([(0, 0), (3, 0), (3, 2), (0, 2)], name="r"))
+    >>> type(read_strategy(strategy_document(solve(pb)))).__name__
+    'PlanSource'
+    >>> type(read_strategy(strategy_document(solve(pb, sensor="width")))).__name__
+    'PolicySource'
+    """
+    doc = _load(source, "strategy file")
+    if isinstance(doc, Mapping) and doc.get("schema") == POLICY_SCHEMA:
+        return read_policy_document(doc)
+    return read_plan(doc, which)
+
+
+def _load(source: Any, what: str) -> Any:
+    """A parsed document, or the JSON of the file ``source`` names."""
+    if not isinstance(source, str | os.PathLike):
+        return source
+    path = Path(source)
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SimulationError(
+            f"{what} {str(path)!r} cannot be read ({exc.strerror or exc})"
+        ) from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        why = exc.msg if isinstance(exc, json.JSONDecodeError) else "not UTF-8"
+        raise SimulationError(f"{what} {str(path)!r} is not valid JSON ({why})") from None

@@ -1,133 +1,17 @@
-"""The policy document ``bayesgrasp.policy/1``: a Bayes policy as JSON.
+"""The policy document ``bayesgrasp.policy/1``: written and read by :mod:`bayesgrasp.io.plans`.
 
-Fields (angles in radians, readings in the parts' units)::
+This module keeps the names it had (:func:`policy_document`, :data:`POLICY_SCHEMA`); the
+schema is described in :mod:`bayesgrasp.io.plans`, the one module of documents.
 
-    {
-      "schema": "bayesgrasp.policy/1",
-      "parts": [NAME, ...],            candidate parts, in order
-      "part_prior": [W, ...],          prior probability of each part (sums to 1)
-      "sensor": {"kind": "width", "sigma": S, "resolution": R},
-                                       reading = R round((d + e) / R), e ~ N(0, S^2);
-                                       S = R = 0: exact readings
-      "max_actions": K,                no path has more actions
-      "expected_cost": C,              E[cost until a cycle succeeds] = cycle_cost / P
-      "success_probability": P,        a cycle declares the true orientation (and part)
-      "expected_actions": A,           expected actions in one cycle
-      "cycle_cost": c,                 E[cost of one cycle], retry overhead included
-      "reject_probability": r,         a cycle ends in a rejection
-      "expected_total_actions": A / P, expected actions until success
-      "expected_entropy_bits": [H1, ...],
-                                       expected entropy (bits) of the belief over the
-                                       states after the reading of action 1, 2, ...
-                                       (paths that ended keep their last belief)
-      "sensorless_cost": C0 | null,    the sensorless Bayes plan's expected cost (one part)
-      "first_angle_exact": bool,       every first angle that can be optimal was tried
-      "noise": {"turn": {"kind": "normal" | "uniform", "scale_rad": s}, "contact": q},
-                                       only for a policy planned under noisy actions
-                                       (plan --sense --turn-noise / --contact-noise): every
-                                       figure and probability is exact under that noise
-      "refinement_bound": eps,         with "noise": no single turn, the rest kept, lowers
-                                       cycle_cost - expected_cost * P by more
-      "payoff": [U, ...],              only for a policy with a payoff (plan --sense
-                                       --payoff FILE): the value of each stable state; a
-                                       declaring leaf stops and earns the payoff of the state
-                                       reached, P is the expected payoff of a cycle and C
-                                       the expected cost per unit payoff
-      "root": NODE
-    }
-    NODE = {"action": {"type": "squeeze" | "push-grasp", "alpha_rad": a, "margin_rad": m},
-            "branches": [{"reading": [lo, hi], "probability": p, "next": NODE | LEAF}]}
-    LEAF = {"declare": {"orientation_rad": t, "part": NAME}, "success_probability": q}
-         | {"reject": true}
-
-``alpha_rad`` is the world gripper angle at the root and the turn relative to the previous
-action below it; ``margin_rad`` is how far that turn may err without changing any state's
-outcome (``null`` at the root; 0 under noisy actions, whose error is in the figures).
-``reading`` is the half-open interval ``[lo, hi)``, ``null`` for an unbounded end; the
-branches of a node tile every reading in increasing order, and ``probability`` is that of
-the branch given that the node is reached. A declared ``orientation_rad`` is in the frame of
-the last action, in ``[0, 2 pi)``; ``q`` is the probability that the declaration is right
-given that the leaf is reached.
+Examples
+--------
+>>> from bayesgrasp.io import plans
+>>> policy_document is plans.policy_document
+True
 """
 
 from __future__ import annotations
 
-import math
-from typing import Any
+from .plans import POLICY_SCHEMA, policy_document, read_policy_document
 
-from ..planning.policy import Declare, Policy, PolicyNode, Reject
-
-__all__ = ["POLICY_SCHEMA", "policy_document"]
-
-POLICY_SCHEMA = "bayesgrasp.policy/1"
-
-
-def _end(x: float) -> float | None:
-    return None if math.isinf(x) else float(x)
-
-
-def _node(node: PolicyNode) -> dict[str, Any]:
-    return {
-        "action": {
-            "type": node.step.kind,
-            "alpha_rad": node.step.alpha,
-            "margin_rad": _end(node.margin),
-        },
-        "branches": [
-            {
-                "reading": [_end(b.lo), _end(b.hi)],
-                "probability": b.probability,
-                "next": _next(b.next),
-            }
-            for b in node.branches
-        ],
-    }
-
-
-def _next(x: PolicyNode | Declare | Reject) -> dict[str, Any]:
-    if isinstance(x, PolicyNode):
-        return _node(x)
-    if isinstance(x, Reject):
-        return {"reject": True}
-    return {
-        "declare": {"orientation_rad": x.orientation, "part": x.part_name},
-        "success_probability": x.success_probability,
-    }
-
-
-def policy_document(policy: Policy) -> dict[str, Any]:
-    """The ``bayesgrasp.policy/1`` document of a policy (see the module notes).
-
-    Examples
-    --------
-    >>> from bayesgrasp.geometry import Part
-    >>> from bayesgrasp.model import Problem
-    >>> from bayesgrasp.planning.policy import plan_policy
-    >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)], name="rect"))
-    >>> doc = policy_document(plan_policy(pb, "width", 1))
-    >>> doc["schema"], doc["parts"], doc["root"]["branches"][0]["reading"]
-    ('bayesgrasp.policy/1', ['rect'], [None, 1.5])
-    """
-    doc: dict[str, Any] = {
-        "schema": POLICY_SCHEMA,
-        "parts": list(policy.parts),
-        "part_prior": list(policy.part_prior),
-        "sensor": policy.sensor.to_json(),
-        "max_actions": policy.max_actions,
-        "expected_cost": policy.expected_cost,
-        "success_probability": policy.success_probability,
-        "expected_actions": policy.expected_actions,
-        "cycle_cost": policy.cycle_cost,
-        "reject_probability": policy.reject_probability,
-        "expected_total_actions": policy.expected_total_actions,
-        "expected_entropy_bits": list(policy.expected_entropy),
-        "sensorless_cost": policy.sensorless_cost,
-        "first_angle_exact": policy.first_angle_exact,
-    }
-    if policy.noise is not None:
-        doc["noise"] = policy.noise.to_json()
-        doc["refinement_bound"] = policy.refinement_bound
-    if policy.payoff is not None:
-        doc["payoff"] = list(policy.payoff)
-    doc["root"] = _node(policy.root)
-    return doc
+__all__ = ["POLICY_SCHEMA", "policy_document", "read_policy_document"]

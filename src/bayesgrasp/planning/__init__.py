@@ -13,11 +13,17 @@ Noise and sensing: :func:`~.noisy.plan_noisy` (plans under noisy actions and a p
 :func:`~.noisy_policy.plan_noisy_policy` (both together). Every plan and policy is a tree of
 :mod:`.strategy`, whose :func:`~.strategy.evaluate` gives its exact figures under any noise,
 sensor and payoff.
+
+One front door for all of them: :func:`solve` (:func:`.strategy.solve`) plans with whichever
+planner the model calls for (a sensor, noise, a payoff, a method) and returns one
+:class:`StrategyResult` (:class:`.strategy.StrategyResult`): the chosen strategy as a tree,
+its exact evaluation, the alternatives, tolerances and provenance. (Both are imported on first
+use: the policy planners load only when asked for.)
 """
 
 from __future__ import annotations
 
-from typing import Literal, get_args
+from typing import TYPE_CHECKING, Any, Literal, get_args
 
 from ..errors import PlanningError
 from ..model.problem import Problem
@@ -35,6 +41,9 @@ from .result import (
     max_plan_length,
 )
 
+if TYPE_CHECKING:
+    from .strategy import StrategyResult, solve
+
 __all__ = [
     "METHODS",
     "GuaranteedPlan",
@@ -45,13 +54,25 @@ __all__ = [
     "PlanResult",
     "PlanStep",
     "Status",
+    "StrategyResult",
     "execute_plan",
     "max_plan_length",
     "plan",
     "plan_bfs",
     "plan_exact",
     "plan_guaranteed",
+    "solve",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """:class:`StrategyResult` and :func:`solve`, imported on first use."""
+    if name in ("StrategyResult", "solve"):
+        from . import strategy
+
+        return getattr(strategy, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 Method = Literal["exact", "bfs", "guaranteed"]
 METHODS: tuple[Method, ...] = get_args(Method)

@@ -122,6 +122,7 @@ __all__ = [
     "NoisyEvaluation",
     "NoisyOption",
     "NoisyPlanResult",
+    "PlanEvaluator",
     "evaluate_plan",
     "plan_noisy",
     "step_distributions_noisy",
@@ -295,8 +296,34 @@ def _json_float(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
-class _Evaluator:
-    """Exact evaluation of plans of one problem under one noise model and payoff."""
+class PlanEvaluator:
+    """Exact evaluation of linear plans of one problem under one noise model and payoff.
+
+    What the noise-aware planners share (this one, and the guaranteed planner under noise,
+    :func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`): the forward propagation
+    ``q_k = q_1(a) M_{t_2}(alpha_2) ... M_{t_k}(alpha_k)`` of :meth:`forward` and
+    :meth:`step` (only the states of positive mass, and many turns at once), and the choice
+    of the final state a plan aims at (:meth:`targets`). The same propagation as
+    :func:`~bayesgrasp.planning.strategy.evaluate_tree`, which evaluates any strategy (the
+    tests hold the two equal); this one is batched over the turns a search tries.
+
+    Parameters
+    ----------
+    problem : Problem
+    noise : NoiseModel
+    payoff : ndarray of shape (K,) or None
+        The value of each state (``None``: the problem's goal).
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import Part
+    >>> from bayesgrasp.model.noise import TurnNoise
+    >>> pb = Problem.build(Part.from_points([(0, 0), (1.55, 0), (1.55, 1), (0, 1)]))
+    >>> ev = PlanEvaluator(pb, NoiseModel(TurnNoise("uniform", 0.05)), None)
+    >>> qs = ev.forward(["squeeze", "squeeze"], [0.0, 0.7])
+    >>> [round(float(q.sum()), 12) for q in qs]
+    [1.0, 1.0]
+    """
 
     def __init__(self, problem: Problem, noise: NoiseModel, payoff: FloatArray | None) -> None:
         self.problem = problem
@@ -384,6 +411,11 @@ def evaluate_plan(
 ) -> NoisyEvaluation:
     """Evaluate a plan exactly under a noise model (and a payoff).
 
+    The final distribution is :func:`~bayesgrasp.planning.strategy.evaluate_tree`'s (the
+    evaluator of every strategy) of the plan as the strategy that never branches; the
+    payoff is scored on it as the noise-aware planner scores its candidates
+    (:meth:`PlanEvaluator.finish`).
+
     Parameters
     ----------
     problem : Problem
@@ -408,12 +440,22 @@ def evaluate_plan(
     >>> round(ev.success_probability, 6) == round(plan.success_probability, 6)
     True
     """
+    from ..model.sensing import StateSpace
+    from .policy import Reject
+    from .strategy import NoisyJointTransitions, evaluate_tree, linear_strategy
+
     if not steps:
         raise PlanningError("a plan needs at least one step")
-    plan_actions(problem, [s.kind for s in steps])
+    kinds = [s.kind for s in steps]
+    plan_actions(problem, kinds)
     u = None if payoff is None else as_vector(payoff, problem.states)
-    ev = _Evaluator(problem, noise, u)
-    return ev.evaluate([s.kind for s in steps], [s.alpha for s in steps])
+    ev = PlanEvaluator(problem, noise, u)
+    # The final distribution by the one evaluator of every strategy (the plan: a strategy
+    # that never branches; its leaf does not matter, only the distribution reaching it).
+    space = StateSpace.build(problem)
+    model = NoisyJointTransitions(space, noise, [ev.nt])
+    q = evaluate_tree(space, linear_strategy(steps, Reject()), model).final_distribution
+    return ev.finish(kinds, q)
 
 
 def step_distributions_noisy(
@@ -438,7 +480,7 @@ def step_distributions_noisy(
     if not steps:
         raise PlanningError("a plan needs at least one step")
     plan_actions(problem, [s.kind for s in steps])
-    ev = _Evaluator(problem, noise, None)
+    ev = PlanEvaluator(problem, noise, None)
     return ev.forward([s.kind for s in steps], [s.alpha for s in steps])
 
 
@@ -467,7 +509,7 @@ class _Planner:
     def __init__(self, problem: Problem, noise: NoiseModel, payoff: FloatArray | None) -> None:
         self.problem = problem
         self.noise = noise
-        self.ev = _Evaluator(problem, noise, payoff)
+        self.ev = PlanEvaluator(problem, noise, payoff)
         self.turn = noise.turn
         self.p_tol = problem.part.hull.tol.probability
         self.a_tol = problem.states.angle_tol
@@ -696,7 +738,7 @@ def _seeds(problem: Problem, noise: NoiseModel, max_actions: int | None) -> list
     return out
 
 
-def _payoff_bound(problem: Problem, ev: _Evaluator, payoff: FloatArray | None) -> float:
+def _payoff_bound(problem: Problem, ev: PlanEvaluator, payoff: FloatArray | None) -> float:
     """The highest expected payoff any plan can reach (see the module notes)."""
     noise = ev.noise
     targets = ev.masks if payoff is None else payoff[None, :]  # (T, K)
@@ -775,7 +817,7 @@ def plan_noisy(
     ev = pl.ev
     if noise.exact and u is None and not all_lengths:
         return _noise_free(problem, noise, max_actions, pl)
-    exact = ev if noise.exact else _Evaluator(problem, NoiseModel(), u)
+    exact = ev if noise.exact else PlanEvaluator(problem, NoiseModel(), u)
     cost = problem.cost
     kinds_all = problem.action_kinds
     limit = min(max_plan_length(problem), max_actions or max_plan_length(problem))
@@ -904,7 +946,7 @@ def _noise_free(
 
 
 def _noisy_option(
-    problem: Problem, exact: _Evaluator, c: _Cand, tolerance: float | None = None
+    problem: Problem, exact: PlanEvaluator, c: _Cand, tolerance: float | None = None
 ) -> NoisyOption:
     """The reported plan of a candidate (``exact``: an evaluator without noise).
 

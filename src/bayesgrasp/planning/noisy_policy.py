@@ -159,6 +159,49 @@ _GAIN_TOL = 1e-12
 # -- the noisy model of a state space -------------------------------------------------------
 
 
+_SAME_TURN = 1e-9
+"""Candidate turns closer than this (radians, modulo 2 pi) are one turn."""
+
+
+def _first_of_each_turn(turns: FloatArray, tol: float) -> IntArray:
+    """Indices of the first of each group of turns within ``tol`` of each other, mod 2 pi.
+
+    In the order of ``turns`` (the first of a group is kept, the others dropped).
+
+    Examples
+    --------
+    >>> _first_of_each_turn(np.array([math.pi, 0.5, -math.pi, 0.5 + 1e-12, 1.0]), 1e-9).tolist()
+    [0, 1, 4]
+    """
+    if len(turns) < 2:
+        return np.arange(len(turns), dtype=np.intp)
+    k = np.mod(turns, TWO_PI)
+    srt = np.argsort(k, kind="stable")
+    ks = k[srt]
+    group = np.cumsum(np.append(True, np.diff(ks) > tol)) - 1
+    if ks[0] + TWO_PI - ks[-1] <= tol:  # the groups at 0 and just below 2 pi are one
+        group[group == group[-1]] = 0
+    ids = np.empty_like(group)
+    ids[srt] = group
+    _, first = np.unique(ids, return_index=True)
+    return np.sort(first).astype(np.intp)
+
+
+def _first_of_each_matrix(mats: FloatArray) -> IntArray:
+    """Indices of the first of each group of equal matrices ``mats`` (A, N, N), in order.
+
+    Examples
+    --------
+    >>> m = np.array([np.eye(2), np.ones((2, 2)) / 2, np.eye(2)])
+    >>> _first_of_each_matrix(m).tolist()
+    [0, 1]
+    """
+    if len(mats) < 2:
+        return np.arange(len(mats), dtype=np.intp)
+    _, first = np.unique(mats.reshape(len(mats), -1), axis=0, return_index=True)
+    return np.sort(first).astype(np.intp)
+
+
 class _Model:
     """Joint noisy matrices, first actions and reading likelihoods of a state space."""
 
@@ -200,7 +243,9 @@ class _Model:
         The noise-free classes' middles ``mid`` (half widths ``half``); with contact
         asynchrony also the middles of the common refinement of the classes of every way
         the action may go (each turn at which some state's basin changes in one of them):
-        with exact turns ``M(alpha)`` is constant on each such class.
+        with exact turns ``M(alpha)`` is constant on each such class. A turn is a candidate
+        once: a noise-free class that no other way of the action splits is also a class of
+        the refinement, and a middle at pi is one at -pi; the widest class of a turn is kept.
         """
         comps = [(nt, c) for nt in self.nts for c in nt.components(kind)]
         if len(comps) == len(self.nts):  # one way to go: the noise-free classes
@@ -216,7 +261,9 @@ class _Model:
         mids = np.concatenate([mid, more])
         halves = np.concatenate([half, widths / 2])
         order = np.argsort(-halves, kind="stable")
-        return np.asarray(mids[order]), np.asarray(halves[order])
+        mids, halves = mids[order], halves[order]
+        once = _first_of_each_turn(mids, _SAME_TURN)
+        return np.asarray(mids[once]), np.asarray(halves[once])
 
     def initial(self, kind: str, angle: float) -> FloatArray:
         """Joint distribution after the first action at world angle ``angle``."""
@@ -610,10 +657,19 @@ def plan_noisy_policy(
         if main.accuracy > 0:  # only turns that keep their class under the accuracy
             keep = half >= main.accuracy
             mid, half = mid[keep], half[keep]
+        mats = model.matrices(k.name, mid)
+        if noise.contact > 0:
+            # A turn whose matrix an earlier (wider) candidate has already is the same
+            # action: under exact turns, the middle of a noise-free class lies in a class
+            # of the refinement (where the matrix is constant), whose middle is a candidate
+            # too. (Without contact noise the candidates are the noise-free classes, each
+            # its own action.)
+            once = _first_of_each_matrix(mats)
+            mid, half, mats = mid[once], half[once], mats[once]
         k.mid, k.half_width = mid, half
         k.classes = np.arange(len(mid), dtype=np.intp)
         k.transfer = np.zeros((len(mid), space.n_states), dtype=np.intp)  # unused: matrices
-        k.matrices = np.ascontiguousarray(model.matrices(k.name, mid))
+        k.matrices = np.ascontiguousarray(mats)
     kinds = solver.kinds
     angles, angles_exact = _first_angles(space, main.action_kinds, max_first_angles)
     roots = np.array([model.initial(k.name, a) for k in kinds for a in angles])  # (R, N)

@@ -295,7 +295,7 @@ def plan_guaranteed_noisy(
     >>> g.status, g.reason.split(" deg:")[0]
     ('no-plan', 'no plan guarantees under turn error uniform:30')
     """
-    from .noisy import _Evaluator
+    from .noisy import PlanEvaluator
 
     turn = noise.turn
     if not turn.exact and turn.kind == "normal":
@@ -329,12 +329,12 @@ def plan_guaranteed_noisy(
             problem, (option,), 0, 0, "guaranteed", period=period, widths=()
         )  # fmt: skip
         # The final orientation: the state of the orbit the problem's prior favours.
-        q = _Evaluator(problem, noise, None).forward(got.kinds, got.angles)[-1]
+        q = PlanEvaluator(problem, noise, None).forward(got.kinds, got.angles)[-1]
         j = int(np.argmax(np.where(got.final, q, -1.0)))
         option = dataclasses.replace(option, final_orientation=float(problem.states.stable[j]))
     kinds, angles = option.kinds, [s.alpha for s in option.steps]
     final = int(nearest_state(problem.states, np.array([option.final_orientation]))[0])
-    e = _Evaluator(problem, noise, None).evaluate(kinds, angles, final)
+    e = PlanEvaluator(problem, noise, None).evaluate(kinds, angles, final)
     opt = dataclasses.replace(
         option, success_probability=e.success_probability, expected_cost=e.expected_cost
     )
