@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from .common import emit_json, input_files
+from .meshes import GoalPoseOpt, PoseOpt, PosePriorOpt
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
@@ -147,6 +148,9 @@ def plan(
     batch: BatchOpt = None,
     max_opening: MaxOpeningOpt = None,
     min_opening: MinOpeningOpt = None,
+    pose: PoseOpt = None,
+    goal_pose: GoalPoseOpt = None,
+    pose_prior: PosePriorOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -166,8 +170,11 @@ def plan(
     from .. import report
     from ..io.plans import plan_document
     from . import noisy
+    from .meshes import is_mesh_part, mesh_options, pose_sensing
     from .outputs import PartOutputs
 
+    candidates = bool(more_parts or also or part_prior is not None)
+    part = mesh_options(part, sense, pose, goal_pose, pose_prior, candidates, batch)
     stroke = None
     if max_opening is not None or min_opening is not None:
         from ..io.export import Stroke
@@ -194,6 +201,8 @@ def plan(
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
         sensing = sense_spec(sense, more, part_prior, spec, max_memory)
+        if is_mesh_part(part):  # the candidates are the mesh's resting poses
+            sensing, spec = pose_sensing(part, sensing, spec, goal_pose, pose_prior)
         fold = fold_below if _given(ctx, "fold_below") else None  # the figure's, when given
         from .sensing import plan_policy_command, sense_noise
 
