@@ -395,14 +395,17 @@ def footprint(points: ArrayLike, frame: ArrayLike, origin: ArrayLike) -> FloatAr
     >>> footprint(box, pose_frame([0, 0, -1]), [0.5, 1, 2]).tolist()
     [[-0.5, -1.0], [0.5, -1.0], [0.5, 1.0], [-0.5, 1.0]]
     """
-    from scipy.spatial import ConvexHull
+    from ..geometry.polygon import ConvexPolygon
 
     xy = (np.asarray(points, dtype=np.float64) - np.asarray(origin, dtype=np.float64)) @ (
         np.asarray(frame, dtype=np.float64)[:2].T
     )
-    h = ConvexHull(xy)
-    ring = xy[h.vertices]  # counter-clockwise (scipy, 2-D)
-    start = int(np.lexsort((ring[:, 0], ring[:, 1]))[0])  # lowest, then leftmost, first
+    # The planar hull drops points within its length tolerance of an edge (a point on a
+    # solid's edge projects onto the footprint's edge, to rounding).
+    ring = np.array(ConvexPolygon.from_points(xy).vertices)  # counter-clockwise
+    scale = float(np.max(np.abs(ring))) or 1.0
+    key = np.round(ring / scale, 9)
+    start = int(np.lexsort((key[:, 0], key[:, 1]))[0])  # lowest, then leftmost, first
     return np.asarray(np.roll(ring, -start, axis=0) + 0.0, dtype=np.float64)
 
 
