@@ -115,7 +115,10 @@ def _mc_rest(points: np.ndarray, com: np.ndarray, rng: np.random.Generator, n: i
     force in 3-D (face polygons from the points on each plane, edges by segment tests)."""
     normals, d = _planes(points)
     size = np.ptp(points, axis=0).max()
-    on = [np.flatnonzero(np.abs(points @ nn - dd) < 1e-9 * size) for nn, dd in zip(normals, d)]
+    on = [
+        np.flatnonzero(np.abs(points @ nn - dd) < 1e-9 * size)
+        for nn, dd in zip(normals, d, strict=True)
+    ]
 
     def rest_of(f: int) -> int:
         for _ in range(len(normals) + 1):
@@ -166,7 +169,7 @@ def _mc_rest(points: np.ndarray, com: np.ndarray, rng: np.random.Generator, n: i
     rots = Rotation.random(n, random_state=rng)
     down = rots.inv().apply(np.array([0.0, 0.0, -1.0]))  # world "down" in body coordinates
     verts = points - com
-    for u, r in zip(down, rots):
+    for u, r in zip(down, rots, strict=False):
         # the lowest point of the rotated solid lies on the first face the downward ray meets
         low = int(np.argmin(r.apply(verts)[:, 2]))
         hit = normals @ u
@@ -220,7 +223,7 @@ def _trimesh_poses(points: np.ndarray, com: np.ndarray) -> dict:
     mesh = trimesh.Trimesh(points, ConvexHull(points).simplices).convex_hull
     tfs, probs = compute_stable_poses(mesh, center_mass=com)
     out: dict = {}
-    for tf, p in zip(tfs, probs):
+    for tf, p in zip(tfs, probs, strict=False):
         key = tuple(np.round(-tf[2, :3], 6) + 0.0)
         out[key] = out.get(key, 0.0) + float(p)
     return out
@@ -325,7 +328,7 @@ def test_triangulation_does_not_change_the_poses(seed: int, extra: int) -> None:
     assert a.keys() == b.keys()
     for k in a:
         assert_allclose(a[k], b[k], atol=1e-12)
-    for p, q in zip(ref.poses, got.poses):
+    for p, q in zip(ref.poses, got.poses, strict=False):
         assert_allclose(p.footprint, q.footprint, atol=1e-9)  # same vertices, same start
 
 

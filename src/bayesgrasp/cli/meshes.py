@@ -90,7 +90,9 @@ def mesh_options(
         raise typer.BadParameter("a mesh PART is planned alone, not with --batch")
     if sense is None:
         if given:
-            raise typer.BadParameter(f"{', '.join(given)} plan a policy over the poses: add --sense")
+            raise typer.BadParameter(
+                f"{', '.join(given)} plan a policy over the poses: add --sense"
+            )
         if candidates:
             raise typer.BadParameter("a mesh PART is planned alone: drop the other parts")
         if pose is not None and part.element is not None:
@@ -117,7 +119,9 @@ def load_mesh_part(part: PartSpec) -> Part:
     solid = load_solid(part)
     study = _study(solid)
     k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
-    return with_shape_tol(pose_part(study, k, f"{solid.name}-pose-{k}", solid.units), part.shape_tol)
+    return with_shape_tol(
+        pose_part(study, k, f"{solid.name}-pose-{k}", solid.units), part.shape_tol
+    )
 
 
 def load_solid(part: PartSpec) -> Solid:
@@ -189,9 +193,7 @@ def goal_pose_index(text: str | None, n: int) -> int | None:
     try:
         return pose_index(text, n, "--goal-pose")
     except Exception as exc:
-        raise typer.BadParameter(
-            f"{exc}; or give any", param_hint="--goal-pose"
-        ) from None
+        raise typer.BadParameter(f"{exc}; or give any", param_hint="--goal-pose") from None
 
 
 def pose_prior_weights(text: str | None, solid: Solid, study: PoseStudy) -> list[float]:
@@ -280,9 +282,7 @@ def pose_sensing(
     goal = goal_pose_index(goal_pose, n) if goal_pose is not None else 0
     weights = pose_prior_weights(pose_prior, solid, study)
     footprints = tuple(pose_parts(study, solid.units))
-    undeclared = frozenset(
-        f"pose-{k}" for k in range(n) if goal is not None and k != goal
-    )
+    undeclared = frozenset(f"pose-{k}" for k in range(n) if goal is not None and k != goal)
     values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(ProblemSpec)}
     problems = PoseProblems(**values, undeclared=undeclared)
     prior = ",".join(repr(w) for w in weights)

@@ -227,7 +227,7 @@ def poses(
     study = resting_poses(
         solid.vertices[_used(solid)],
         solid.center_of_mass,
-        estimator=estimator.value,  # type: ignore[arg-type]
+        estimator=estimator.value,
         sigma=sigma,
         samples=samples,
         rng=seed,

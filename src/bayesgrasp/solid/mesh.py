@@ -320,12 +320,23 @@ def read_mesh_bytes(
 
     logging.getLogger("trimesh").setLevel(logging.ERROR)  # its warnings are ours to word
     try:
-        loaded = trimesh.load(io.BytesIO(data), file_type=kind, force="mesh", process=True)
+        # Unprocessed: trimesh's processing drops NaN vertices silently; they are refused.
+        loaded = trimesh.load(io.BytesIO(data), file_type=kind, force="mesh", process=False)
     except Exception as exc:  # trimesh raises many kinds on malformed files
         reason = " ".join(str(exc).split())[:200] or type(exc).__name__
         raise PartFileError(f"{source}: not a readable {kind.upper()} file ({reason})") from None
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
     faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.intp)
+    if len(vertices) and np.isfinite(vertices).all() and faces.size:
+        # Vertices repeated exactly (an STL repeats each one per triangle) are one, and
+        # triangles with a repeated corner enclose nothing.
+        vertices, inverse = np.unique(vertices, axis=0, return_inverse=True)
+        faces = inverse.reshape(-1)[faces]
+        faces = faces[
+            (faces[:, 0] != faces[:, 1])
+            & (faces[:, 1] != faces[:, 2])
+            & (faces[:, 2] != faces[:, 0])
+        ]
     file_units = getattr(loaded, "units", None)
     chosen = units if units is not None else file_units
     if units is not None:

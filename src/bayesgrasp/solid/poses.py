@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -223,7 +223,10 @@ def hull_faces(points: ArrayLike) -> HullFaces:
     )
 
 
-def _frozen(a: NDArray[np.generic]) -> NDArray[np.generic]:
+_A = TypeVar("_A", bound=NDArray[Any])
+
+
+def _frozen(a: _A) -> _A:
     a.setflags(write=False)
     return a
 
@@ -312,13 +315,18 @@ def quasi_static(hull: HullFaces, com: ArrayLike) -> tuple[FloatArray, IntArray]
     a, b, d = (pts[hull.triangles[:, i]] for i in range(3))
     area = 0.5 * np.linalg.norm(np.cross(b - a, d - a), axis=1)
     total = np.bincount(hull.face_of, weights=area, minlength=hull.n_faces)
-    cen = np.stack(
-        [
-            np.bincount(hull.face_of, weights=area * (a + b + d)[:, k] / 3, minlength=hull.n_faces)
-            for k in range(3)
-        ],
-        axis=1,
-    ) / total[:, None]  # (F, 3)
+    cen = (
+        np.stack(
+            [
+                np.bincount(
+                    hull.face_of, weights=area * (a + b + d)[:, k] / 3, minlength=hull.n_faces
+                )
+                for k in range(3)
+            ],
+            axis=1,
+        )
+        / total[:, None]
+    )  # (F, 3)
     # Signed distance of the projection (and of the centroid) to each boundary edge's line,
     # positive inside the face: s = ((q - p0) x (p1 - p0)) . (-n) / |p1 - p0|.
     f = hull.edge_face
@@ -515,7 +523,7 @@ def resting_poses(
     hull = points if isinstance(points, HullFaces) else hull_faces(points)
     c = np.asarray(com, dtype=np.float64)
     first, rest = quasi_static(hull, c)
-    mass = np.bincount(rest, weights=first, minlength=hull.n_faces)
+    mass: FloatArray = np.bincount(rest, weights=first, minlength=hull.n_faces).astype(float)
     if estimator == "perturbed":
         if not (math.isfinite(sigma) and sigma > 0):
             raise PartError(f"`sigma` must be a number > 0; got {sigma!r}")
