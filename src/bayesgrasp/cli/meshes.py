@@ -14,7 +14,7 @@ import dataclasses
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -25,36 +25,6 @@ if TYPE_CHECKING:
     from ..model.problem import Problem
     from ..solid.mesh import Solid
     from ..solid.poses import PoseStudy
-
-PoseOpt = Annotated[
-    int | None,
-    typer.Option(
-        "--pose",
-        min=0,
-        metavar="K",
-        help="With a mesh PART: plan resting pose K (0 the most probable, as `poses` lists "
-        "them), its footprint a planar part (default 0).",
-    ),
-]
-GoalPoseOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--goal-pose",
-        metavar="K|any",
-        help="With a mesh PART and --sense: only pose K may be declared, the others are "
-        "rejected (dropped again, --retry-cost) (default 0); any: every pose may be declared.",
-    ),
-]
-PosePriorOpt = Annotated[
-    str | None,
-    typer.Option(
-        "--pose-prior",
-        metavar="quasi-static|perturbed|drops:N|FILE",
-        help="With a mesh PART and --sense: the poses' prior: the quasi-static estimate "
-        "(default), the perturbed one, the frequencies of N MuJoCo drops (extra `sim`), or a "
-        "bayesgrasp.poses/1 file (`poses --json`; its probabilities, matched by normal).",
-    ),
-]
 
 
 def is_mesh_part(part: PartSpec) -> bool:

@@ -11,18 +11,20 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from .common import emit_json, input_files
-from .meshes import GoalPoseOpt, PoseOpt, PosePriorOpt
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
     FoldOpt,
     ForceOpt,
+    GoalPoseOpt,
     JsonOpt,
     MaxMemoryOpt,
     MaxOpeningOpt,
     MinOpeningOpt,
     PartPriorOpt,
     PayoffOpt,
+    PoseOpt,
+    PosePriorOpt,
     SenseOpt,
     TurnNoiseOpt,
     command_app,
