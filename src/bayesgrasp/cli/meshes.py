@@ -119,7 +119,7 @@ def _study(solid: Solid, estimator: str = "quasi-static") -> PoseStudy:
     from ..solid.poses import resting_poses
 
     return resting_poses(
-        solid.vertices[np.unique(solid.faces)],
+        solid.hull if solid.hull is not None else solid.vertices[np.unique(solid.faces)],
         solid.center_of_mass,
         estimator=estimator,  # type: ignore[arg-type]
         rng=0,

@@ -225,7 +225,7 @@ def poses(
         check_outputs([plot_file], [Path(mesh)], force, hint="--plot")
     solid = load_solid(mesh, com, units)
     study = resting_poses(
-        solid.vertices[_used(solid)],
+        solid.hull if solid.hull is not None else solid.vertices[_used(solid)],
         solid.center_of_mass,
         estimator=estimator.value,
         sigma=sigma,

@@ -32,11 +32,15 @@ import os
 import struct
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import MissingExtraError, PartError, PartFileError
+
+if TYPE_CHECKING:
+    from .poses import HullFaces
 
 __all__ = [
     "MESH_EXTENSIONS",
@@ -100,6 +104,8 @@ class Solid:
         A short unit name (:data:`UNITS`), ``None`` when unknown.
     volume : float or None
         The enclosed volume (``None`` for an open mesh, whose centre of mass was given).
+    hull : HullFaces
+        The convex hull (:func:`bayesgrasp.solid.poses.hull_faces`), computed once.
 
     Examples
     --------
@@ -115,6 +121,7 @@ class Solid:
     center_of_mass: FloatArray
     units: str | None = None
     volume: float | None = None
+    hull: HullFaces | None = None
 
 
 def is_mesh(path: str | os.PathLike[str], fmt: str | None = None) -> bool:
@@ -241,7 +248,7 @@ def solid_from_arrays(
         )
     for a in (v, f, c):
         a.setflags(write=False)
-    return Solid(name, v, f, c, _units(units, source), volume)
+    return Solid(name, v, f, c, _units(units, source), volume, hull)
 
 
 def _check_stl(data: bytes, source: str) -> None:

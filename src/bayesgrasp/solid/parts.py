@@ -91,7 +91,8 @@ def study_of(solid: Solid) -> PoseStudy:
     """The quasi-static poses of a solid."""
     from .poses import resting_poses
 
-    return resting_poses(solid.vertices[np.unique(solid.faces)], solid.center_of_mass)
+    points = solid.hull if solid.hull is not None else solid.vertices[np.unique(solid.faces)]
+    return resting_poses(points, solid.center_of_mass)
 
 
 def mesh_part(

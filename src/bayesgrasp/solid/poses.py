@@ -191,13 +191,17 @@ def hull_faces(points: ArrayLike) -> HullFaces:
     face_of = face_of.astype(np.intp)
     # Face planes: area-weighted normals (all equal within the merge tolerance).
     area2 = np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    normals = np.zeros((n_faces, 3))
-    np.add.at(normals, face_of, n * area2[:, None])
+    normals: FloatArray = np.stack(
+        [np.bincount(face_of, weights=n[:, k] * area2, minlength=n_faces) for k in range(3)],
+        axis=1,
+    ).astype(np.float64)
     normals /= np.linalg.norm(normals, axis=1)[:, None]
-    first = np.zeros(n_faces, dtype=np.intp)
-    first[face_of[::-1]] = np.arange(t)[::-1]  # one triangle of each face
-    offsets = np.einsum("ij,ij->i", normals, pts[tri[first, 0]])
-    offsets = np.maximum(offsets, np.max(pts @ normals.T, axis=0))  # support values
+    # The plane's offset: the largest over the face's corners (its support value, to rounding).
+    fn = normals[face_of]  # (T, 3)
+    corner = np.max(np.stack([np.einsum("ij,ij->i", fn, x) for x in (a, b, c)]), axis=0)
+    order_f = np.argsort(face_of, kind="stable")
+    starts = np.searchsorted(face_of[order_f], np.arange(n_faces))
+    offsets = np.maximum.reduceat(corner[order_f], starts)
     # Directed edges (a, b) of every triangle; an edge is on its face's boundary when the
     # reverse edge (b, a) belongs to a triangle of another face.
     src = tri.ravel()
@@ -403,11 +407,15 @@ def footprint(points: ArrayLike, frame: ArrayLike, origin: ArrayLike) -> FloatAr
     >>> footprint(box, pose_frame([0, 0, -1]), [0.5, 1, 2]).tolist()
     [[-0.5, -1.0], [0.5, -1.0], [0.5, 1.0], [-0.5, 1.0]]
     """
+    from scipy.spatial import ConvexHull
+
     from ..geometry.polygon import ConvexPolygon
 
     xy = (np.asarray(points, dtype=np.float64) - np.asarray(origin, dtype=np.float64)) @ (
         np.asarray(frame, dtype=np.float64)[:2].T
     )
+    if len(xy) > 64:  # Qhull's 2-D hull first: the exact hull below then sees few points
+        xy = xy[ConvexHull(xy, qhull_options="Qc").vertices]
     # The planar hull drops points within its length tolerance of an edge (a point on a
     # solid's edge projects onto the footprint's edge, to rounding).
     ring = np.array(ConvexPolygon.from_points(xy).vertices)  # counter-clockwise
@@ -546,6 +554,7 @@ def resting_poses(
     # Most probable first; ties (to rounding) by the normal, so no triangulation decides.
     nr = np.round(hull.normals[faces], 9)
     faces = faces[np.lexsort((nr[:, 2], nr[:, 1], nr[:, 0], -np.round(mass[faces], 12)))]
+    corners = hull.points[np.unique(hull.triangles)]
     poses = []
     for f in faces.tolist():
         normal = np.array(hull.normals[f])
@@ -557,7 +566,7 @@ def resting_poses(
                 normal=_frozen(normal),
                 com_height=float(hull.offsets[f] - normal @ c),
                 frame=_frozen(frame),
-                footprint=_frozen(footprint(hull.points[np.unique(hull.triangles)], frame, c)),
+                footprint=_frozen(footprint(corners, frame, c)),
             )
         )
     return PoseStudy(tuple(poses), _frozen(c.copy()), estimator, hull, _frozen(first))
