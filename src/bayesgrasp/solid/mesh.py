@@ -253,7 +253,8 @@ def solid_from_arrays(
 
 def _check_stl(data: bytes, source: str) -> None:
     """Refuse a binary STL whose header's triangle count does not match the file's size."""
-    if data.lstrip()[:5].lower() == b"solid" and b"facet" in data[:4096]:
+    head = data[:4096]
+    if data.lstrip()[:5].lower() == b"solid" and (b"facet" in head or b"\0" not in head):
         try:
             data[:4096].decode("ascii")
             return  # ASCII STL
