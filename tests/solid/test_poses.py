@@ -350,3 +350,28 @@ def test_perturbed_estimator_is_near_and_smooth() -> None:
         resting_poses(BOX, com, estimator="perturbed", sigma=0)
     with pytest.raises(PartError, match="estimator"):
         resting_poses(BOX, com, estimator="bogus")  # type: ignore[arg-type]
+
+
+@settings(max_examples=30)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_rigid_motions_move_the_poses_and_keep_the_probabilities(seed: int) -> None:
+    """Rotating and translating the solid rotates the normals; probabilities, heights and
+    footprint areas stay; the probabilities sum to one."""
+    g = np.random.default_rng(seed)
+    pts = g.normal(size=(int(g.integers(6, 30)), 3)) * g.uniform(0.2, 3, size=3)
+    hull = ConvexHull(pts)
+    w = g.dirichlet(np.ones(len(hull.vertices)))
+    com = w @ pts[hull.vertices]  # strictly inside: every weight > 0
+    rot = Rotation.random(random_state=g)
+    shift = g.normal(size=3) * 10
+    a = resting_poses(pts, com)
+    b = resting_poses(rot.apply(pts) + shift, rot.apply(com) + shift)
+    assert_allclose(a.probabilities.sum(), 1.0, atol=1e-12)
+    assert len(a.poses) == len(b.poses)
+    moved = {tuple(np.round(rot.apply(p.normal.copy()), 6) + 0.0): p for p in a.poses}
+    for q in b.poses:
+        key = tuple(np.round(q.normal, 6) + 0.0)
+        p = moved[key]
+        assert_allclose(q.probability, p.probability, atol=1e-11)
+        assert_allclose(q.com_height, p.com_height, rtol=1e-9)
+        assert_allclose(ConvexHull(q.footprint).volume, ConvexHull(p.footprint).volume, rtol=1e-9)

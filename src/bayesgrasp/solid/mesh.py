@@ -203,8 +203,8 @@ def solid_from_arrays(
     """
     from .poses import hull_faces
 
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces)
+    v = np.array(vertices, dtype=np.float64)  # copies: they are kept, read-only
+    f = np.array(faces)
     if v.ndim != 2 or v.shape[1] != 3 or len(v) == 0 or f.size == 0:
         raise PartFileError(f"{source}: the mesh is empty (no vertices or no faces)")
     if f.ndim != 2 or f.shape[1] != 3 or not np.issubdtype(f.dtype, np.integer):
@@ -238,7 +238,7 @@ def solid_from_arrays(
             )
         c = closed[1]
     else:
-        c = np.asarray(com, dtype=np.float64)
+        c = np.array(com, dtype=np.float64)
         if c.shape != (3,) or not np.isfinite(c).all():
             raise PartError(f"`com` must be three finite numbers X,Y,Z; got {com!r}")
     if not np.all(hull.normals @ c - hull.offsets < -1e-12 * hull.size):

@@ -31,10 +31,11 @@ triangles of a face tile it and do not overlap, so their solid angles add).
 
 The *perturbed* estimator averages the quasi-static one over centres of mass drawn from an
 isotropic normal distribution about ``c`` (standard deviation ``sigma`` times the part's
-size, draws outside the hull discarded), as ``trimesh.poses.compute_stable_poses`` does with
-its ``sigma`` and ``n_samples``: it blurs the sharp boundaries of the quasi-static model
-(a face whose centre-of-mass projection is near an edge shares its mass with its neighbour),
-which is how the paper accounts for the small energy a real part still has when it lands.
+size, draws outside the hull discarded), the form ``trimesh.poses.compute_stable_poses``
+gives the paper's perturbed estimator with its ``sigma`` and ``n_samples``. It blurs the
+sharp boundaries of the quasi-static model: a face whose centre-of-mass projection lies near
+an edge shares its probability with its neighbour, as a part that still moves a little when
+it lands would.
 
 Each stable pose has a planar frame: ``z`` points up (minus the face's outward normal), ``x``
 is the mesh axis most parallel to the table projected on it, ``y = z x x``, and the origin
@@ -158,7 +159,7 @@ def hull_faces(points: ArrayLike) -> HullFaces:
     """
     from scipy.spatial import ConvexHull, QhullError
 
-    pts = np.asarray(points, dtype=np.float64)
+    pts = np.array(points, dtype=np.float64)  # a copy: it is kept, read-only
     if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) < 4:
         raise PartError(f"`points` must have shape (V, 3) with V >= 4; got shape {pts.shape}")
     if not np.isfinite(pts).all():
