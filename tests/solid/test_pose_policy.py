@@ -194,3 +194,18 @@ def test_drops_glue_with_a_fake_engine(wedge_file: Path, monkeypatch, capsys) ->
     assert main([*argv, "--pose-prior", "drops:50"]) == 0
     pol = json.loads(capsys.readouterr().out)
     assert pol["part_prior"][-1] == 1.0 and sum(pol["part_prior"][:-1]) == 0
+
+
+def test_simulate_and_plot_take_a_mesh_policy(wedge_file: Path, tmp_path: Path, capsys) -> None:
+    """simulate and plot --sense plan the same pose policy as plan (goal pose 0)."""
+    assert main(["plan", str(wedge_file), "--sense", "width", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    argv = ["simulate", str(wedge_file), "--sense", "width", "--trials", "4000", "--json"]
+    assert main(argv) == 0
+    sim = json.loads(capsys.readouterr().out)
+    text = json.dumps(sim)
+    assert "pose-0" in text and str(round(doc["expected_cost"], 6))[:6] in text
+    assert main(["plot", str(wedge_file), "--sense", "width", "--out", str(tmp_path / "f")]) == 0
+    assert (tmp_path / "f" / "policy.png").exists()
+    assert main(["simulate", str(wedge_file), "--sense", "width", "--also", "house"]) == 2
+    assert "candidates are its poses" in capsys.readouterr().err

@@ -265,3 +265,17 @@ def pose_sensing(
         footprints=footprints,
     )
     return sense, problems
+
+
+def mesh_sensing(
+    part: PartSpec, sensing: SenseSpec, spec: ProblemSpec, candidates: bool
+) -> tuple[SenseSpec, ProblemSpec]:
+    """``simulate`` and ``plot`` with --sense: a mesh PART's policy is over its poses.
+
+    As ``plan MESH --sense`` with its defaults (goal pose 0, the quasi-static pose prior);
+    any other PART is returned as it came.
+    """
+    if not is_mesh_part(part):
+        return sensing, spec
+    mesh_options(part, sensing.sense, None, None, None, candidates, None)
+    return pose_sensing(part, sensing, spec, None, None)
