@@ -209,3 +209,13 @@ def test_simulate_and_plot_take_a_mesh_policy(wedge_file: Path, tmp_path: Path, 
     assert (tmp_path / "f" / "policy.png").exists()
     assert main(["simulate", str(wedge_file), "--sense", "width", "--also", "house"]) == 2
     assert "candidates are its poses" in capsys.readouterr().err
+
+
+def test_pose_prior_perturbed_is_near_the_quasi_static(wedge_file: Path, capsys) -> None:
+    argv = ["plan", str(wedge_file), "--sense", "width", "--goal-pose", "any", "--json"]
+    assert main([*argv, "--pose-prior", "perturbed"]) == 0
+    pert = json.loads(capsys.readouterr().out)["part_prior"]
+    assert main(argv) == 0
+    qs = json.loads(capsys.readouterr().out)["part_prior"]
+    assert_allclose(sum(pert), 1.0, atol=1e-12)
+    assert_allclose(pert, qs, atol=0.03)
