@@ -27,6 +27,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "squeeze": ("parts", "Stable orientations of a squeeze and their probabilities."),
     "push": ("parts", "Stable orientations of a push and of a push-grasp."),
     "plan": ("plan", "The best plan of every length; the Bayes and most certain plans."),
+    "poses": ("poses", "Resting poses of a mesh, their probabilities and footprints."),
     "plot": ("plot", "Figures of a part and a plan, and the plan's animation."),
     "simulate": ("simulate", "Execute a plan many times; compare with the prediction."),
     "sweep": ("sweep", "Plan every part of a catalogue on Dask; one row a part."),

@@ -162,6 +162,36 @@ MinOpeningOpt = Annotated[
         "step that may close the jaws on a width narrower than this.",
     ),
 ]
+# A mesh PART's options (plan MESH; see cli/meshes.py).
+PoseOpt = Annotated[
+    int | None,
+    typer.Option(
+        "--pose",
+        min=0,
+        metavar="K",
+        help="With a mesh PART: plan resting pose K (0 the most probable, as `poses` lists "
+        "them), its footprint a planar part (default 0).",
+    ),
+]
+GoalPoseOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--goal-pose",
+        metavar="K|any",
+        help="With a mesh PART and --sense: only pose K may be declared, the others are "
+        "rejected (dropped again, --retry-cost) (default 0); any: every pose may be declared.",
+    ),
+]
+PosePriorOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--pose-prior",
+        metavar="quasi-static|perturbed|drops:N|FILE",
+        help="With a mesh PART and --sense: the poses' prior: the quasi-static estimate "
+        "(default), the perturbed one, the frequencies of N MuJoCo drops (extra `sim`), or a "
+        "bayesgrasp.poses/1 file (`poses --json`; its probabilities, matched by normal).",
+    ),
+]
 # SenseOpt, AlsoOpt, PartPriorOpt and the problem option --max-actions: the options of a
 # sensing policy (plan, simulate and plot --sense), gathered into a SenseSpec (sense_spec).
 POLICY_DEPTH = 3

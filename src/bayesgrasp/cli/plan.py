@@ -17,12 +17,15 @@ from .options import (
     ContactNoiseOpt,
     FoldOpt,
     ForceOpt,
+    GoalPoseOpt,
     JsonOpt,
     MaxMemoryOpt,
     MaxOpeningOpt,
     MinOpeningOpt,
     PartPriorOpt,
     PayoffOpt,
+    PoseOpt,
+    PosePriorOpt,
     SenseOpt,
     TimeLimitOpt,
     TurnNoiseOpt,
@@ -161,6 +164,9 @@ def plan(
     max_opening: MaxOpeningOpt = None,
     min_opening: MinOpeningOpt = None,
     within_stroke: WithinStrokeOpt = False,
+    pose: PoseOpt = None,
+    goal_pose: GoalPoseOpt = None,
+    pose_prior: PosePriorOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -178,9 +184,12 @@ def plan(
     and --export then write one file a part, named by a path with {name}.
     """
     from . import noisy
+    from .meshes import is_mesh_part, mesh_options, pose_sensing
     from .outputs import PartOutputs
     from .strategies import check_stroke, document, exit_code, text, write_outputs
 
+    candidates = bool(more_parts or also or part_prior is not None)
+    part = mesh_options(part, sense, pose, goal_pose, pose_prior, candidates, batch)
     stroke = None
     if max_opening is not None or min_opening is not None:
         from ..io.export import Stroke
@@ -210,6 +219,8 @@ def plan(
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
         sensing = sense_spec(sense, more, part_prior, spec, max_memory, time_limit)
+        if is_mesh_part(part):  # the candidates are the mesh's resting poses
+            sensing, spec = pose_sensing(part, sensing, spec, goal_pose, pose_prior)
         fold = fold_below if _given(ctx, "fold_below") else None  # the figure's, when given
         from .sensing import plan_policy_command, sense_noise
 

@@ -123,6 +123,9 @@ def plot(
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
         sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
+        from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
+
+        sensing, spec = mesh_sensing(part, sensing, spec, bool(also or part_prior))
         action = sense_noise(turn_noise, contact_noise, payoff)
         plot_policy_command(part, spec, sensing, out, formats, as_json, action)
         return

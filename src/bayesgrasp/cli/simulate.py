@@ -214,6 +214,9 @@ def simulate(
         asked = not model.exact or payoff is not None
         action = ActionModel(model, payoff) if asked else None
         sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
+        from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
+
+        sensing, spec = mesh_sensing(part, sensing, spec, bool(also or part_prior))
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
             sensor_error, as_json, action, jaw_lag,

@@ -26,6 +26,11 @@ class PartFormat(enum.StrEnum):
     geojson = "geojson"
     svg = "svg"
     dxf = "dxf"
+    stl = "stl"
+    obj = "obj"
+    ply = "ply"
+    threemf = "3mf"
+    glb = "glb"
 
 
 class Method(enum.StrEnum):
@@ -72,8 +77,13 @@ class PartSpec:
         from ..geometry.curved import with_shape_tol
         from ..geometry.polygon import Part
         from ..io import resolve_part
+        from ..solid.mesh import is_mesh
 
         fmt = self.fmt.value if self.fmt else None
+        if is_mesh(self.part, fmt):  # a solid: one resting pose's footprint (cli/meshes.py)
+            from .meshes import load_mesh_part
+
+            return load_mesh_part(self)
         part = resolve_part(
             self.part, fmt, element=self.element, layer=self.layer, tolerance=self.flatten_tol
         )

@@ -11,6 +11,9 @@ geojson    ``.geojson``         a ``Polygon`` geometry, feature or collection
 svg        ``.svg``             the outline of a path, polygon, rect, circle or ellipse
 dxf        ``.dxf``             closed polylines, circles, ellipses, splines, and loops
                                 of lines and arcs
+stl, obj,  ``.stl``, ``.obj``,  a solid (:mod:`bayesgrasp.solid.mesh`): the footprint
+ply, 3mf,  ``.ply``, ``.3mf``,  of one of its resting poses (``element``: the pose,
+glb        ``.glb``             default 0, the most probable; extra ``mesh``)
 =========  ===================  =====================================================
 
 Outline formats (WKT, GeoJSON, SVG, DXF) give an ordered outline that may be non-convex,
@@ -52,6 +55,7 @@ The readers of WKT and GeoJSON need shapely, SVG needs svgelements and DXF needs
 
 from __future__ import annotations
 
+import functools
 import numbers
 import os
 import sys
@@ -61,6 +65,7 @@ from typing import Any
 
 from ..errors import PartFileError
 from ..geometry import Part
+from ..solid.mesh import MESH_FORMATS
 from ._common import (
     DEFAULT_RELATIVE_TOLERANCE,
     MAX_BYTES,
@@ -103,6 +108,10 @@ def _parser(fmt: str) -> Parser:
         from . import points
 
         return points.parse_json if fmt == "json" else points.parse_csv
+    if fmt in MESH_FORMATS:  # a solid: the footprint of one resting pose (bayesgrasp.solid)
+        from ..solid.parts import mesh_part
+
+        return functools.partial(mesh_part, fmt=fmt)
     if fmt == "wkt":
         from .wkt import parse_wkt
 
@@ -152,7 +161,7 @@ def _format(fmt: Any, path: Path | None) -> str:
 
 
 #: Format names, in the order the documentation lists them.
-FORMATS = ("json", "csv", "wkt", "geojson", "svg", "dxf")
+FORMATS = ("json", "csv", "wkt", "geojson", "svg", "dxf", *MESH_FORMATS)
 
 #: File extensions (lower case, without the dot) and their formats.
 EXTENSIONS = {
@@ -162,6 +171,7 @@ EXTENSIONS = {
     "geojson": "geojson",
     "svg": "svg",
     "dxf": "dxf",
+    **{f: f for f in MESH_FORMATS},
 }
 
 

@@ -1,0 +1,289 @@
+"""``plan MESH``: one resting pose's footprint as a planar part, or a policy over the poses.
+
+``plan MESH [--pose K]`` plans pose K's footprint (default 0, the most probable) as any
+planar part. ``plan MESH --sense S [--goal-pose K|any] [--pose-prior P]`` plans the policy
+that tells the poses apart by their widths (:mod:`bayesgrasp.solid.policy`): the candidate
+parts are the footprints ``pose-0``, ``pose-1``, ... in the order ``poses`` lists them, the
+part prior their probabilities. The rest (printing, --json, --plot, --export, noise) is the
+recognition policy's own path (:func:`.sensing.plan_policy_command`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import typer
+
+from .specs import PartSpec, ProblemSpec, SenseSpec
+
+if TYPE_CHECKING:
+    from ..geometry.polygon import Part
+    from ..model.problem import Problem
+    from ..solid.mesh import Solid
+    from ..solid.poses import PoseStudy
+
+
+def is_mesh_part(part: PartSpec) -> bool:
+    """Whether PART is a mesh file (by ``--format`` or its extension)."""
+    from ..solid.mesh import is_mesh
+
+    if part.part is None:
+        return False
+    return is_mesh(part.part, part.fmt.value if part.fmt else None)
+
+
+def mesh_options(
+    part: PartSpec,
+    sense: str | None,
+    pose: int | None,
+    goal_pose: str | None,
+    pose_prior: str | None,
+    candidates: bool,
+    batch: Path | None,
+) -> PartSpec:
+    """Check the mesh options of ``plan``; PART with the pose to plan chosen.
+
+    ``candidates``: more parts were given (further PARTs, --also or --part-prior).
+    """
+    mesh = is_mesh_part(part)
+    given = [n for n, v in (("--goal-pose", goal_pose), ("--pose-prior", pose_prior)) if v]
+    if not mesh:
+        if pose is not None or given:
+            names = ", ".join(([] if pose is None else ["--pose"]) + given)
+            raise typer.BadParameter(f"{names}: for a mesh PART (.stl, .obj, .ply, .3mf, .glb)")
+        return part
+    if batch is not None:
+        raise typer.BadParameter("a mesh PART is planned alone, not with --batch")
+    if sense is None:
+        if given:
+            raise typer.BadParameter(
+                f"{', '.join(given)} plan a policy over the poses: add --sense"
+            )
+        if candidates:
+            raise typer.BadParameter("a mesh PART is planned alone: drop the other parts")
+        if pose is not None and part.element is not None:
+            raise typer.BadParameter("give the pose once: --pose K (not --element)")
+        return part if pose is None else dataclasses.replace(part, element=str(pose))
+    if pose is not None:
+        raise typer.BadParameter(
+            "--sense plans a policy over every pose: choose the pose to orient with "
+            "--goal-pose K, not --pose"
+        )
+    if candidates:
+        raise typer.BadParameter(
+            "with a mesh PART and --sense the candidates are its poses: drop --also, "
+            "--part-prior and other PARTs (--pose-prior sets the poses' prior)"
+        )
+    return part
+
+
+def load_mesh_part(part: PartSpec) -> Part:
+    """PART's pose footprint (``element``: the pose), ``--com X,Y,Z`` and ``--shape-tol``."""
+    from ..geometry.curved import with_shape_tol
+    from ..solid.parts import pose_index, pose_part
+
+    solid = load_solid(part)
+    study = _study(solid)
+    k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
+    return with_shape_tol(
+        pose_part(study, k, f"{solid.name}-pose-{k}", solid.units), part.shape_tol
+    )
+
+
+def load_solid(part: PartSpec) -> Solid:
+    """The solid of PART (a mesh file or ``-`` with --format), ``--com X,Y,Z`` applied."""
+    from ..solid.mesh import read_mesh, read_mesh_bytes
+    from ..solid.parts import parse_com
+
+    com = parse_com(part.com)
+    if part.layer is not None or part.flatten_tol is not None:
+        raise typer.BadParameter("a mesh has no layers or curves: drop --layer, --flatten-tol")
+    if part.part == "-":
+        import sys
+
+        from ..io import MAX_BYTES
+
+        data = sys.stdin.buffer.read(MAX_BYTES + 1)
+        fmt = part.fmt.value if part.fmt else ""
+        return read_mesh_bytes(data, fmt, "<stdin>", com=com)
+    return read_mesh(part.part, part.fmt.value if part.fmt else None, com=com)
+
+
+def _study(solid: Solid, estimator: str = "quasi-static") -> PoseStudy:
+    import numpy as np
+
+    from ..solid.poses import resting_poses
+
+    return resting_poses(
+        solid.hull if solid.hull is not None else solid.vertices[np.unique(solid.faces)],
+        solid.center_of_mass,
+        estimator=estimator,  # type: ignore[arg-type]
+        rng=0,
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class PoseSense(SenseSpec):
+    """A sensing policy whose candidate parts are a solid's pose footprints."""
+
+    footprints: tuple[Part, ...] = ()
+
+    def parts(self, part: PartSpec) -> list[Part]:
+        """The footprints ``pose-0``, ``pose-1``, ... (PART is the mesh they come from)."""
+        return list(self.footprints)
+
+
+@dataclass(frozen=True, slots=True)
+class PoseProblems(ProblemSpec):
+    """The problem options, with the poses that may not be declared."""
+
+    undeclared: frozenset[str] = frozenset()
+
+    def build(self, part: Part, more_actions: tuple[str, ...] = (), prior: Any = None) -> Problem:
+        """The problem of a footprint; an undeclared pose's goal is no success."""
+        from ..model.problem import Problem
+        from ..solid.policy import NoDeclaration
+
+        inputs = self.problem_inputs(more_actions, prior)
+        if part.name in self.undeclared:
+            inputs["goal"] = NoDeclaration(inputs["goal"].kind)
+        return Problem.build(part, **inputs)
+
+
+def goal_pose_index(text: str | None, n: int) -> int | None:
+    """``--goal-pose``: a pose index, or ``None`` for any."""
+    from ..solid.parts import pose_index
+
+    if text is not None and text.strip().lower() == "any":
+        return None
+    try:
+        return pose_index(text, n, "--goal-pose")
+    except Exception as exc:
+        raise typer.BadParameter(f"{exc}; or give any", param_hint="--goal-pose") from None
+
+
+def pose_prior_weights(text: str | None, solid: Solid, study: PoseStudy) -> list[float]:
+    """``--pose-prior``: the poses' weights, in the study's order."""
+    import numpy as np
+
+    if text is None or text.strip().lower() == "quasi-static":
+        return [p.probability for p in study.poses]
+    key = text.strip()
+    if key.lower() == "perturbed":
+        other = _study(solid, "perturbed")
+        # Faces stable only for some perturbed centres are no pose of the mesh: left out.
+        return _match(other.normals, other.probabilities, study, "perturbed", strict=False)
+    if key.lower().startswith("drops:"):
+        try:
+            n = int(key.partition(":")[2])
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise typer.BadParameter(
+                f"drops:N needs N >= 1 drops; got {key!r}", param_hint="--pose-prior"
+            )
+        from .poses import drop_frequencies
+
+        _, rows = drop_frequencies(solid, study, n, 0)
+        w = [r[0] for r in rows]
+        if not sum(w) > 0:
+            raise typer.BadParameter(
+                f"none of the {n} drops came to rest on a listed pose", param_hint="--pose-prior"
+            )
+        return w
+    path = Path(key)
+    if not path.is_file():
+        raise typer.BadParameter(
+            f"expected quasi-static, perturbed, drops:N or a poses file; got {key!r}",
+            param_hint="--pose-prior",
+        )
+    from .. import files
+    from ..errors import PartFileError
+
+    try:
+        doc = json.loads(files.read_bytes(path, PartFileError, "poses file"))
+        normals = np.array([p["normal"] for p in doc["poses"]], dtype=float).reshape(-1, 3)
+        probs = np.array([p["probability"] for p in doc["poses"]], dtype=float)
+        if doc.get("schema") != "bayesgrasp.poses/1":
+            raise ValueError("its schema is not bayesgrasp.poses/1")
+    except (ValueError, KeyError, TypeError) as exc:
+        raise typer.BadParameter(
+            f"{key}: not a bayesgrasp.poses/1 document ({exc})", param_hint="--pose-prior"
+        ) from None
+    return _match(normals, probs, study, key)
+
+
+def _match(
+    normals: Any, probs: Any, study: PoseStudy, what: str, strict: bool = True
+) -> list[float]:
+    """The weights of ``study``'s poses from poses given by their normals (0 where absent).
+
+    ``strict``: a given pose that is not one of ``study``'s is refused (else left out).
+    """
+    import numpy as np
+
+    out = np.zeros(len(study.poses))
+    for n, p in zip(normals, probs, strict=True):
+        d = np.linalg.norm(study.normals - n, axis=1)
+        k = int(np.argmin(d))
+        if d[k] > 1e-6:
+            if not strict:
+                continue
+            raise typer.BadParameter(
+                f"{what}: a pose with normal {np.round(n, 6).tolist()} is not a stable pose of "
+                "this mesh",
+                param_hint="--pose-prior",
+            )
+        out[k] += p
+    if not np.all(np.isfinite(out)) or np.any(out < 0) or out.sum() <= 0:
+        raise typer.BadParameter(f"{what}: probabilities must be >= 0", param_hint="--pose-prior")
+    return [float(x) for x in out]
+
+
+def pose_sensing(
+    part: PartSpec,
+    sensing: SenseSpec,
+    spec: ProblemSpec,
+    goal_pose: str | None,
+    pose_prior: str | None,
+) -> tuple[PoseSense, PoseProblems]:
+    """The --sense options of ``plan MESH``: the poses as candidates, the goal pose's problems."""
+    from ..solid.parts import pose_parts
+
+    solid = load_solid(part)
+    study = _study(solid)
+    n = len(study.poses)
+    goal = goal_pose_index(goal_pose, n) if goal_pose is not None else 0
+    weights = pose_prior_weights(pose_prior, solid, study)
+    footprints = tuple(pose_parts(study, solid.units))
+    undeclared = frozenset(f"pose-{k}" for k in range(n) if goal is not None and k != goal)
+    values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(ProblemSpec)}
+    problems = PoseProblems(**values, undeclared=undeclared)
+    prior = ",".join(repr(w) for w in weights)
+    sense = PoseSense(
+        sensing.sense,
+        (),
+        prior,
+        sensing.max_actions,
+        sensing.max_memory_mb,
+        footprints=footprints,
+    )
+    return sense, problems
+
+
+def mesh_sensing(
+    part: PartSpec, sensing: SenseSpec, spec: ProblemSpec, candidates: bool
+) -> tuple[SenseSpec, ProblemSpec]:
+    """``simulate`` and ``plot`` with --sense: a mesh PART's policy is over its poses.
+
+    As ``plan MESH --sense`` with its defaults (goal pose 0, the quasi-static pose prior);
+    any other PART is returned as it came.
+    """
+    if not is_mesh_part(part):
+        return sensing, spec
+    mesh_options(part, sensing.sense, None, None, None, candidates, None)
+    return pose_sensing(part, sensing, spec, None, None)
