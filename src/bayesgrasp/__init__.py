@@ -54,10 +54,9 @@ if TYPE_CHECKING:  # pragma: no cover
         plan_exact,
         plan_guaranteed,
     )
+    from ._version import __version__
     from .tolerance import DEFAULT_TOLERANCE, Tolerance
 
-
-__version__ = "0.1.0"
 
 # Names are imported on first use: ``bayesgrasp --help`` and light scripts do not pay for
 # numpy and every layer up front.
@@ -96,6 +95,8 @@ _LAZY = {
     "squeeze_function": "geometry.transfer",
     "von_mises": "model.prior",
     "shapes": "",
+    # pyproject.toml's version, from the installed metadata (read on first use)
+    "__version__": "_version",
 }
 
 
