@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).parent / "_ext"))
 
 project = "bayesgrasp"
 author = "the bayesgrasp authors"
-copyright = "the bayesgrasp authors"  # noqa: A001 (Sphinx reads this name)
+copyright = "the bayesgrasp authors"
 release = _version("bayesgrasp")
 version = release
 

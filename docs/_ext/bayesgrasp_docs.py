@@ -120,6 +120,7 @@ class CliDirective(SphinxDirective):
         return section
 
     def run(self) -> list[nodes.Node]:
+        """The nodes of the reference."""
         import click
         import typer
 
@@ -133,8 +134,12 @@ class CliDirective(SphinxDirective):
         out.append(nodes.literal_block(text=group.get_usage(root)))
         records = [p.get_help_record(root) for p in group.get_params(root)]
         out.append(_table([r for r in records if r], ("option", "meaning")))
-        out.append(_table([(f"bayesgrasp {n}", s) for n, (_, s) in COMMANDS.items()],
-                          ("command", "what it does")))
+        out.append(
+            _table(
+                [(f"bayesgrasp {n}", s) for n, (_, s) in COMMANDS.items()],
+                ("command", "what it does"),
+            )
+        )
         for name in group.list_commands(root):
             cmd = group.get_command(root, name)
             if cmd is None or cmd.hidden:
@@ -171,7 +176,7 @@ def _compact_json(value: Any, indent: int = 0) -> str:
         if not value:
             return "{}"
         items = [
-            f'{pad}  {json.dumps(k)}: {_compact_json(v, indent + 1)}' for k, v in value.items()
+            f"{pad}  {json.dumps(k)}: {_compact_json(v, indent + 1)}" for k, v in value.items()
         ]
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
     if isinstance(value, list):
@@ -204,6 +209,7 @@ class SweepColumnsDirective(SphinxDirective):
     """``bayesgrasp-sweep-columns``: the columns of a sweep's rows, in order, with types."""
 
     def run(self) -> list[nodes.Node]:
+        """The table of columns."""
         from bayesgrasp.sweep.tasks import ROW_COLUMNS
 
         rows = [(name, kind.__name__) for name, kind in ROW_COLUMNS]
@@ -240,6 +246,7 @@ class RunDirective(SphinxDirective):
     }
 
     def run(self) -> list[nodes.Node]:
+        """Run the command; its output as a literal block."""
         with tempfile.TemporaryDirectory(prefix="bayesgrasp-docs-") as tmp:
             command = self.arguments[0]
             args = shlex.split(command.replace("{tmp}", tmp))
@@ -291,6 +298,7 @@ class FieldsDirective(SphinxDirective):
     required_arguments = 1
 
     def run(self) -> list[nodes.Node]:
+        """The literal block, or a warning when the docstring has none."""
         import importlib
         import textwrap
 
@@ -361,8 +369,9 @@ def api_page() -> str:
         summary = _first_line(module)
         if summary:
             lines.extend([summary, ""])
-        lines.extend([f".. currentmodule:: {modname}", "", ".. autosummary::",
-                      "   :toctree: generated", ""])
+        lines.extend(
+            [f".. currentmodule:: {modname}", "", ".. autosummary::", "   :toctree: generated", ""]
+        )
         lines.extend(f"   {name}" for name in rows)
         lines.append("")
 
@@ -392,7 +401,5 @@ def setup(app: Sphinx) -> dict[str, Any]:
     app.add_directive("bayesgrasp-run", RunDirective)
     app.add_directive("bayesgrasp-fields", FieldsDirective)
     app.add_directive("bayesgrasp-sweep-columns", SweepColumnsDirective)
-    app.add_html_math_renderer(
-        "mathml", (_visit_inline_math, None), (_visit_block_math, None)
-    )
+    app.add_html_math_renderer("mathml", (_visit_inline_math, None), (_visit_block_math, None))
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

@@ -28,6 +28,7 @@ from .errors import (
 
 if TYPE_CHECKING:  # pragma: no cover
     from . import shapes
+    from ._version import __version__ as __version__
     from .geometry.diameter import DiameterFunction, diameter_function
     from .geometry.polygon import ConvexPolygon, Part
     from .geometry.push import RadiusFunction, push_function, push_grasp_function, radius_function
@@ -54,7 +55,6 @@ if TYPE_CHECKING:  # pragma: no cover
         plan_exact,
         plan_guaranteed,
     )
-    from ._version import __version__
     from .tolerance import DEFAULT_TOLERANCE, Tolerance
 
 

@@ -40,6 +40,7 @@ import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import pytest
 
@@ -159,11 +160,12 @@ def output_matches(expected: list[str], actual: list[str]) -> bool:
 
 def transcripts() -> list[Transcript]:
     """Every ``console`` block of README.md and docs/**/*.md."""
-    paths = [REPO / "README.md"] + sorted(
+    pages = sorted(
         p
         for p in DOCS.rglob("*.md")
         if not {"_build", "auto_tutorials"} & set(p.relative_to(DOCS).parts)
     )
+    paths = [REPO / "README.md", *pages]
     found = []
     for path in paths:
         if not path.exists():
@@ -263,8 +265,9 @@ def test_transcript_that_matches_passes_and_one_that_drifts_fails() -> None:
 
 def test_ellipsis_and_volatile_figures() -> None:
     actual = normalise(["sweep: 5 rows in 0.8 s", "x", "y", "wrote /tmp/abc123/plan.json"])
-    assert output_matches(normalise(["sweep: 5 rows in 12.5 s", "...", "wrote /tmp/q/plan.json"]),
-                          actual)
+    assert output_matches(
+        normalise(["sweep: 5 rows in 12.5 s", "...", "wrote /tmp/q/plan.json"]), actual
+    )
     assert output_matches(normalise(["...", "y", "..."]), actual)
     assert not output_matches(normalise(["sweep: 6 rows in 0.8 s", "..."]), actual)
     assert not output_matches(normalise(["...", "z", "..."]), actual)
@@ -296,8 +299,21 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
     env = dict(os.environ)
     env["PATH"] = f"{VENV_BIN}{os.pathsep}{env.get('PATH', '')}"
     proc = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-b", "html", "-E", "-W", "--keep-going", "-q",
-         "-d", str(out / "doctrees"), str(DOCS), str(out / "html")],
+        [
+            sys.executable,
+            "-m",
+            "sphinx",
+            "-b",
+            "html",
+            "-E",
+            "-W",
+            "--keep-going",
+            "-q",
+            "-d",
+            str(out / "doctrees"),
+            str(DOCS),
+            str(out / "html"),
+        ],
         cwd=REPO,
         env=env,
         capture_output=True,
@@ -313,7 +329,7 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
 class _Assets(html.parser.HTMLParser):
     """Every URL an HTML page loads (not the links a reader may follow)."""
 
-    LOADS = {
+    LOADS: ClassVar[dict[str, tuple[str, ...]]] = {
         "script": ("src",),
         "img": ("src", "srcset"),
         "iframe": ("src",),
@@ -364,7 +380,7 @@ def test_the_asset_check_finds_remote_assets(tmp_path: Path) -> None:
     (tmp_path / "b.css").write_text('@import "https://fonts.example.org/f.css"; a{}')
     found = _remote_assets(tmp_path)
     assert len(found) == 4
-    assert not any("a plain link" in f or "example.org/\"" in f for f in found)
+    assert not any("a plain link" in f or 'example.org/"' in f for f in found)
 
 
 @pytest.mark.slow
