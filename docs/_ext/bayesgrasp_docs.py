@@ -189,6 +189,18 @@ def _compact_json(value: Any, indent: int = 0) -> str:
     return json.dumps(value)
 
 
+def _compact_json_text(text: str) -> str | None:
+    """A JSON document (or JSON lines) compacted; ``None`` when it is not JSON."""
+    try:
+        return _compact_json(json.loads(text))
+    except json.JSONDecodeError:
+        pass
+    try:
+        return "\n".join(_compact_json(json.loads(line)) for line in text.splitlines() if line)
+    except json.JSONDecodeError:
+        return None
+
+
 def _csv_row(text: str, index: int, width: int = 72) -> str:
     """Row ``index`` of a CSV text as ``column: value`` lines (long values cut)."""
     import csv
@@ -263,7 +275,14 @@ class RunDirective(SphinxDirective):
                 )
             if "file" in self.options:
                 path = Path(tmp) / self.options["file"]
-                text = path.read_text() if path.exists() else f"(no file {path.name})"
+                if not path.exists():
+                    logger.warning(
+                        "bayesgrasp %s wrote no %s",
+                        command,
+                        path.name,
+                        location=self.get_location(),
+                    )
+                text = path.read_text() if path.exists() else ""
             elif "stderr" in self.options:
                 text = proc.stderr
             else:
@@ -272,10 +291,11 @@ class RunDirective(SphinxDirective):
         if "csv-row" in self.options:
             text = _csv_row(text, self.options["csv-row"])
         if language == "json":
-            try:
-                text = "\n".join(_compact_json(json.loads(line)) for line in text.splitlines())
-            except json.JSONDecodeError:
+            compact = _compact_json_text(text)
+            if compact is None:
                 language = "text"
+            else:
+                text = compact
         lines = text.rstrip("\n").splitlines()
         limit = self.options.get("max-lines")
         if limit and len(lines) > limit:

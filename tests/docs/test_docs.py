@@ -505,3 +505,14 @@ def test_csv_row_shows_one_row_by_column() -> None:
     ext = _extension()
     text = ext._csv_row("a,bb\n1," + "x" * 100 + "\n", 0, width=20)
     assert text.splitlines() == ["a   1", "bb  " + "x" * 15 + " ..."]
+
+
+def test_compact_json_text_takes_a_document_or_json_lines() -> None:
+    ext = _extension()
+    doc = {"ci95": [0.25, 0.26], "rows": [{"a": 1}]}
+    pretty = json.dumps(doc, indent=2)
+    assert json.loads(ext._compact_json_text(pretty)) == doc
+    assert '"ci95": [0.25, 0.26]' in ext._compact_json_text(pretty)
+    lines = ext._compact_json_text(json.dumps({"b": [1]}) + "\n" + json.dumps({"c": 2}) + "\n")
+    assert lines == '{\n  "b": [1]\n}\n{\n  "c": 2\n}'
+    assert ext._compact_json_text("not json") is None
