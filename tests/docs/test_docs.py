@@ -23,9 +23,10 @@ comparison is exact after normalising, on both sides:
 - a line that is exactly ``...`` in the expected output stands for any number of lines.
 
 Blocks of language ``text``, ``sh`` or anything else are not run. A command that writes into
-the repository root leaves nothing behind: new top-level files and folders are removed after
-each transcript. Transcripts that run MuJoCo (``--engine mujoco``) are marked ``physics``,
-those that start Dask (``bayesgrasp sweep``) ``dask``.
+the repository root leaves nothing behind: new top-level files and folders (but hidden ones,
+such as tool caches) are removed after each transcript. Transcripts that run MuJoCo
+(``--engine mujoco``) are marked ``physics``, those that start Dask (``bayesgrasp sweep``)
+``dask``.
 """
 
 from __future__ import annotations
@@ -224,7 +225,7 @@ def test_documented_commands_print_what_the_docs_show(transcript: Transcript) ->
             )
     finally:
         for p in REPO.iterdir():
-            if p.name not in before:
+            if p.name not in before and not p.name.startswith("."):
                 shutil.rmtree(p) if p.is_dir() else p.unlink()
 
 
@@ -516,3 +517,64 @@ def test_compact_json_text_takes_a_document_or_json_lines() -> None:
     lines = ext._compact_json_text(json.dumps({"b": [1]}) + "\n" + json.dumps({"c": 2}) + "\n")
     assert lines == '{\n  "b": [1]\n}\n{\n  "c": 2\n}'
     assert ext._compact_json_text("not json") is None
+
+
+# --------------------------------------------------------------------------- written for users
+
+#: What user documentation does not say: the paper is "the paper", and no page tells the
+#: history of its making (issue numbers, commits, session times). What a command prints in a
+#: ``console`` transcript is the program's text, checked against the program: not here.
+NOT_FOR_USERS = (
+    (
+        re.compile(
+            r"\bseed's\b|\bthe seed (paper|\(|calls|says|lists|uses|searched|sketches)",
+            re.IGNORECASE,
+        ),
+        'call the paper "the paper"',
+    ),
+    (re.compile(r"\bissue \d+|\bissue #\d+", re.IGNORECASE), "an issue number"),
+    (re.compile(r"\bcommit [0-9a-f]{7,40}\b"), "a commit"),
+    (re.compile(r"\b\d{2}:\d{2}(-\d{2}:\d{2})? UTC\b"), "a time of day"),
+)
+
+
+def _user_pages() -> list[Path]:
+    pages = [REPO / "README.md", *(t for t in (DOCS / "tutorials").glob("*.py"))]
+    pages += [
+        p
+        for p in DOCS.rglob("*.md")
+        if not {"_build", "auto_tutorials"} & set(p.relative_to(DOCS).parts)
+    ]
+    return sorted(p for p in pages if p.exists())
+
+
+def _transcript_lines(text: str) -> set[int]:
+    """Line numbers of what the commands of ``console`` blocks print (the program's words)."""
+    out = set()
+    for start, body in fenced_blocks(text, "console"):
+        out.update(start + i for i, line in enumerate(body, 1) if not line.startswith("$ "))
+    return out
+
+
+def test_pages_are_written_for_users() -> None:
+    problems = []
+    for page in _user_pages():
+        text = page.read_text(encoding="utf-8")
+        skip = _transcript_lines(text) if page.suffix == ".md" else set()
+        for number, line in enumerate(text.splitlines(), 1):
+            if number in skip:
+                continue
+            for pattern, what in NOT_FOR_USERS:
+                if pattern.search(line):
+                    problems.append(f"{page.relative_to(REPO)}:{number}: {what}: {line.strip()}")
+    assert not problems, "\n".join(problems)
+
+
+def test_only_transcript_output_is_exempt() -> None:
+    text = "x\n```console\n$ bayesgrasp table1\nThe seed's Table 1\n```\nthe seed\n"
+    assert _transcript_lines(text) == {4}
+    paper = NOT_FOR_USERS[0][0]
+    assert paper.search("The seed's Table 1") and paper.search("the seed (section 4.2)")
+    assert not paper.search("the seed of the random polygons, the versions")
+    assert NOT_FOR_USERS[1][0].search("(issue 12)") and NOT_FOR_USERS[2][0].search("commit 373822f")
+    assert NOT_FOR_USERS[3][0].search("at 04:39-04:45 UTC on")
