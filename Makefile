@@ -38,7 +38,7 @@ demo: $(STAMP_RUN)
 # The Sphinx site (docs/): the tutorials run, the reference generated from the code, no
 # network. -E: every page read again, so that no warning hides in a cached page.
 docs: $(STAMP_DEV)
-	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/sphinx-build -b html -E -W --keep-going -q \
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/sphinx-build -j auto -b html -E -W --keep-going -q \
 		-d docs/_build/doctrees $(SPHINXOPTS) docs $(DOCS_HTML)
 	@echo "bayesgrasp: the documentation is in $(DOCS_HTML)/index.html"
 

@@ -304,6 +304,8 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
             sys.executable,
             "-m",
             "sphinx",
+            "-j",
+            "auto",
             "-b",
             "html",
             "-E",
