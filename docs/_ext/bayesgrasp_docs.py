@@ -13,7 +13,8 @@ Four pieces, so that the reference cannot drift from the program it documents:
     builds the docs, from the repository root) and shows what it printed, or a file it wrote,
     as a literal block. JSON is re-indented with lists of numbers on one line. A command whose
     exit code differs from ``:exit-code:`` (default 0) is a build warning, so an example that
-    stops working fails ``make docs``. ``{tmp}`` in the command is a fresh temporary folder.
+    stops working fails ``make docs``. ``{tmp}`` in the command is a fresh temporary folder
+    (left out where the command is shown: ``{tmp}/robot.csv`` shows as ``robot.csv``).
 
 The API page
     ``reference/api.rst`` is written when the configuration is read (before the sources are found)
@@ -302,7 +303,8 @@ class RunDirective(SphinxDirective):
             lines = [*lines[:limit], f"... ({len(lines) - limit} more lines)"]
             language = "text"
         if "show-command" in self.options:
-            lines = [f"$ bayesgrasp {command}", *lines]
+            shown = self.arguments[0].replace("{tmp}/", "")
+            lines = [f"$ bayesgrasp {shown}", *lines]
             language = "console"
         block = nodes.literal_block(text="\n".join(lines), language=language)
         return [block]
