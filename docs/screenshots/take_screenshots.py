@@ -42,8 +42,12 @@ def main(site: Path) -> None:
         browser = pw.chromium.launch(executable_path=CHROMIUM, args=FLAGS, headless=True)
         page = browser.new_page(viewport={"width": 1280, "height": 1000})
         # No request leaves the machine: anything that is not a local file fails the run.
-        page.route("**/*", lambda route: route.continue_() if route.request.url.startswith(
-            "file://") else route.abort())
+        page.route(
+            "**/*",
+            lambda route: (
+                route.continue_() if route.request.url.startswith("file://") else route.abort()
+            ),
+        )
         for name, path in pages(site).items():
             page.goto(path.as_uri())
             page.wait_for_load_state("load")
