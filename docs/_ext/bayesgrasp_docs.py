@@ -82,19 +82,30 @@ def _paragraphs(text: str) -> list[nodes.Node]:
     return out
 
 
-def _table(rows: list[tuple[str, str]], header: tuple[str, str]) -> nodes.table:
+def _table(
+    rows: list[tuple[str, str]],
+    header: tuple[str, str],
+    targets: list[str] | None = None,
+) -> nodes.table:
     table = nodes.table(classes=["bayesgrasp-cli-options"])
     group = nodes.tgroup(cols=2)
     table += group
     group += nodes.colspec(colwidth=30)
     group += nodes.colspec(colwidth=70)
 
-    def row(cells: tuple[str, str], literal_first: bool) -> nodes.row:
+    def row(cells: tuple[str, str], literal_first: bool, target: str | None = None) -> nodes.row:
         r = nodes.row()
         for i, cell in enumerate(cells):
             entry = nodes.entry()
             para = nodes.paragraph()
-            para += nodes.literal(text=cell) if (i == 0 and literal_first) else nodes.Text(cell)
+            content: nodes.Node = (
+                nodes.literal(text=cell) if (i == 0 and literal_first) else nodes.Text(cell)
+            )
+            if i == 0 and target:
+                ref = nodes.reference("", "", internal=True, refid=target)
+                ref += content
+                content = ref
+            para += content
             entry += para
             r += entry
         return r
@@ -103,8 +114,8 @@ def _table(rows: list[tuple[str, str]], header: tuple[str, str]) -> nodes.table:
     thead += row(header, literal_first=False)
     group += thead
     tbody = nodes.tbody()
-    for cells in rows:
-        tbody += row(cells, literal_first=True)
+    for k, cells in enumerate(rows):
+        tbody += row(cells, literal_first=True, target=targets[k] if targets else None)
     group += tbody
     return table
 
@@ -139,6 +150,7 @@ class CliDirective(SphinxDirective):
             _table(
                 [(f"bayesgrasp {n}", s) for n, (_, s) in COMMANDS.items()],
                 ("command", "what it does"),
+                targets=[f"cli-{n}" for n in COMMANDS],
             )
         )
         for name in group.list_commands(root):

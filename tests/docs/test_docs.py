@@ -229,6 +229,50 @@ def test_documented_commands_print_what_the_docs_show(transcript: Transcript) ->
                 shutil.rmtree(p) if p.is_dir() else p.unlink()
 
 
+# Python examples: a ``python`` block, a line "prints", a ``text`` block with its output.
+
+
+def python_examples(text: str) -> list[tuple[int, str, list[str]]]:
+    """(line, code, expected output) of each python block followed by "prints" and a text block.
+
+    >>> python_examples("```python\\nprint(1)\\n```\\n\\nprints\\n\\n```text\\n1\\n```\\n")
+    [(1, 'print(1)', ['1'])]
+    """
+    lines = text.splitlines()
+    blocks = {line: body for line, body in fenced_blocks(text, "python")}
+    outputs = {line: body for line, body in fenced_blocks(text, "text")}
+    found = []
+    for line, body in blocks.items():
+        after = line + len(body) + 1  # the closing fence's line number
+        rest = [(n, lines[n - 1].strip()) for n in range(after + 1, min(after + 5, len(lines)) + 1)]
+        rest = [(n, t) for n, t in rest if t]
+        if len(rest) >= 2 and rest[0][1] == "prints" and rest[1][0] in outputs:
+            found.append((line, "\n".join(body), outputs[rest[1][0]]))
+    return found
+
+
+_EXAMPLES = [
+    pytest.param(code, expected, id=f"{path.relative_to(REPO)}:{line}")
+    for path in sorted(DOCS.rglob("*.md"))
+    if not {"_build", "auto_tutorials"} & set(path.relative_to(DOCS).parts)
+    for line, code, expected in python_examples(path.read_text(encoding="utf-8"))
+]
+
+
+@pytest.mark.parametrize(("code", "expected"), _EXAMPLES)
+def test_python_examples_print_what_the_docs_show(code: str, expected: list[str]) -> None:
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert normalise(proc.stdout.splitlines()) == normalise(expected)
+
+
 # The checker itself: it must pass what matches and fail what does not.
 
 
