@@ -568,8 +568,8 @@ def test_compact_json_text_takes_a_document_or_json_lines() -> None:
 # --------------------------------------------------------------------------- written for users
 
 #: What user documentation does not say: the paper is "the paper", and no page tells the
-#: history of its making (issue numbers, commits, session times). What a command prints in a
-#: ``console`` transcript is the program's text, checked against the program: not here.
+#: history of its making (issue numbers, commits, session times). What a command prints (the
+#: output in a ``console`` transcript, a ``text`` block) is the program's text: not here.
 NOT_FOR_USERS = (
     (
         re.compile(
@@ -595,10 +595,12 @@ def _user_pages() -> list[Path]:
 
 
 def _transcript_lines(text: str) -> set[int]:
-    """Line numbers of what the commands of ``console`` blocks print (the program's words)."""
+    """Line numbers of what programs print: output in ``console`` blocks, ``text`` blocks."""
     out = set()
     for start, body in fenced_blocks(text, "console"):
         out.update(start + i for i, line in enumerate(body, 1) if not line.startswith("$ "))
+    for start, body in fenced_blocks(text, "text"):
+        out.update(start + i for i in range(1, len(body) + 1))
     return out
 
 
@@ -619,6 +621,8 @@ def test_pages_are_written_for_users() -> None:
 def test_only_transcript_output_is_exempt() -> None:
     text = "x\n```console\n$ bayesgrasp table1\nThe seed's Table 1\n```\nthe seed\n"
     assert _transcript_lines(text) == {4}
+    text = "```text\nThe seed's Table 1\n```\n```python\n# the seed's problem\n```\n"
+    assert _transcript_lines(text) == {2}
     paper = NOT_FOR_USERS[0][0]
     assert paper.search("The seed's Table 1") and paper.search("the seed (section 4.2)")
     assert not paper.search("the seed of the random polygons, the versions")
