@@ -8,7 +8,11 @@ STAMP_DEV := $(VENV)/.installed-dev
 CHROMIUM := /usr/bin/chromium
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: demo test quick lint bench clean browser-deps
+# The documentation site: built offline, warnings are errors.
+DOCS_HTML := docs/_build/html
+SPHINXOPTS ?=
+
+.PHONY: demo test quick lint bench clean browser-deps docs
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,6 +29,18 @@ $(STAMP_DEV): pyproject.toml | $(BIN)/python
 demo: $(STAMP_RUN)
 	$(BIN)/bayesgrasp demo
 	@echo "The web page: $(BIN)/bayesgrasp serve, then open http://127.0.0.1:8000/"
+	@if [ -f $(DOCS_HTML)/index.html ]; then \
+		echo "The documentation: $(CURDIR)/$(DOCS_HTML)/index.html (rebuild it with: make docs)"; \
+	else \
+		echo "The documentation: build it with 'make docs', then open $(CURDIR)/$(DOCS_HTML)/index.html"; \
+	fi
+
+# The Sphinx site (docs/): the tutorials run, the reference generated from the code, no
+# network. -E: every page read again, so that no warning hides in a cached page.
+docs: $(STAMP_DEV)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/sphinx-build -j auto -b html -E -W --keep-going -q \
+		-d docs/_build/doctrees $(SPHINXOPTS) docs $(DOCS_HTML)
+	@echo "bayesgrasp: the documentation is in $(DOCS_HTML)/index.html"
 
 lint: $(STAMP_DEV)
 	$(BIN)/ruff check src tests benchmarks
@@ -36,8 +52,9 @@ lint: $(STAMP_DEV)
 browser-deps:
 	@test -x $(CHROMIUM) || { command -v apt-get >/dev/null && $(SUDO) apt-get update -qq && $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; } || echo "bayesgrasp: could not install chromium; the browser tests will be skipped"
 
-test: lint browser-deps
-	$(BIN)/python -m pytest -q
+# The docs are built once here; tests/docs/test_docs.py checks that build (BAYESGRASP_DOCS_HTML).
+test: lint browser-deps docs
+	BAYESGRASP_DOCS_HTML=$(CURDIR)/$(DOCS_HTML) $(BIN)/python -m pytest -q
 
 # The quick run while working: no MuJoCo, Dask, browser or long statistical tests (CI runs
 # `make test`, which runs them all).
@@ -49,3 +66,4 @@ bench: $(STAMP_RUN)
 
 clean:
 	rm -rf $(VENV) build dist *.egg-info src/*.egg-info .pytest_cache .mypy_cache .ruff_cache
+	rm -rf docs/_build docs/auto_tutorials docs/reference/generated docs/reference/api.rst

@@ -28,6 +28,7 @@ from .errors import (
 
 if TYPE_CHECKING:  # pragma: no cover
     from . import shapes
+    from ._version import __version__ as __version__
     from .geometry.diameter import DiameterFunction, diameter_function
     from .geometry.polygon import ConvexPolygon, Part
     from .geometry.push import RadiusFunction, push_function, push_grasp_function, radius_function
@@ -56,8 +57,6 @@ if TYPE_CHECKING:  # pragma: no cover
     )
     from .tolerance import DEFAULT_TOLERANCE, Tolerance
 
-
-__version__ = "0.1.0"
 
 # Names are imported on first use: ``bayesgrasp --help`` and light scripts do not pay for
 # numpy and every layer up front.
@@ -96,6 +95,8 @@ _LAZY = {
     "squeeze_function": "geometry.transfer",
     "von_mises": "model.prior",
     "shapes": "",
+    # pyproject.toml's version, from the installed metadata (read on first use)
+    "__version__": "_version",
 }
 
 

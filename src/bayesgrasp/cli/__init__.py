@@ -32,8 +32,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "simulate": ("simulate", "Execute a plan many times; compare with the prediction."),
     "sweep": ("sweep", "Plan every part of a catalogue on Dask; one row a part."),
     "serve": ("serve", "The web page and the JSON API on localhost (extra `web`)."),
-    "table1": ("paper", "The seed's Table 1 beside our expected costs."),
-    "study": ("paper", "The seed's study: random polygons planned and counted."),
+    "table1": ("paper", "The paper's Table 1 beside our expected costs."),
+    "study": ("paper", "The paper's study: random polygons planned and counted."),
     "demo": ("paper", "The main job: Table 1, then the example part planned."),
 }
 """Each command: the module that defines it, and its line in the command list."""

@@ -297,7 +297,7 @@ def _problem_params(
         _opt("goal", GoalKind | None, None, help=GOAL_HELP + from_file.format("single")),
         _opt("actions", str, "squeeze", metavar="KINDS", help=kinds),
         _opt("accuracy", float, 0.0, callback=accuracy_value, metavar="DEG", help=ACCURACY_HELP),
-        _opt("method", Method, Method.exact, help="exact planner or the seed's search."),
+        _opt("method", Method, Method.exact, help="exact planner or the paper's search."),
         _opt("max_actions", int | None, None, "--max-actions", min=1, help=longest),
         _opt("max_squeezes", int | None, None, min=1, hidden=True, help=old_longest),
     ]

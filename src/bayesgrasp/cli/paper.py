@@ -1,4 +1,4 @@
-"""The seed's reproductions: ``table1``, ``study``, and the ``demo`` of the main job."""
+"""The paper's reproductions: ``table1``, ``study``, and the ``demo`` of the main job."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from .specs import Method
 
 app = command_app()
 
-PolygonsOpt = Annotated[int, typer.Option(min=1, help="How many random polygons (the seed: 2000).")]
+PolygonsOpt = Annotated[int, typer.Option(min=1, help="How many random polygons (the paper: 2000).")]
 SeedOpt = Annotated[int, typer.Option(min=0, help="Seed of the random generator (>= 0).")]
 MethodOpt = Annotated[Method, typer.Option(help="Planner whose plans give the figures.")]
 StudySenseOpt = Annotated[
@@ -39,7 +39,7 @@ BfsStatsOpt = Annotated[
 
 @app.command()
 def table1(as_json: JsonOpt = False) -> None:
-    """The seed's Table 1: our expected cost per plan length beside the printed numbers."""
+    """The paper's Table 1: our expected cost per plan length beside the printed numbers."""
     from ..paper.table1 import table1_json, table1_rows, table1_text
 
     rows = table1_rows()
@@ -59,7 +59,7 @@ def study(
     sense: StudySenseOpt = None,
     max_actions: StudyDepthOpt = 2,
 ) -> None:
-    """The seed's study: hulls of 10 random points in the unit square, planned and counted."""
+    """The paper's study: hulls of 10 random points in the unit square, planned and counted."""
     if sense is not None:
         from ..paper.sensing import run_sensing_study, sensing_json, sensing_table
 
