@@ -133,3 +133,36 @@ def test_an_over_long_output_name_is_one_line(
     assert code == 2 and out == ""
     assert "cannot write" in err and "File name too long" in err
     assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    ("text", "says"),
+    [
+        ("[" * 100_000 + "]" * 100_000, "nested deeper than the limit"),
+        ('{"first_squeeze_rad": 1' + "0" * 400 + ', "final_orientation_rad": 0}', "too large"),
+        (
+            '{"squeezes": 1' + "0" * 400 + ', "first_squeeze_rad": 0, "final_orientation_rad": 0}',
+            "too large",
+        ),
+        (
+            '{"steps": '
+            + '[{"type": "squeeze", "alpha_rad": 0.1}, ' * 20_001
+            + '{"type": "squeeze", "alpha_rad": 0.1}], "final_orientation_rad": 0}',
+            "at most 10,000",
+        ),
+    ],
+    ids=["deep", "huge angle", "huge field", "too many steps"],
+)
+def test_a_plan_file_out_of_bounds_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path, text: str, says: str
+) -> None:
+    f = tmp_path / "plan.json"
+    f.write_text(text, encoding="utf-8")
+    code, out, err = run(capsys, "simulate", "house", "--plan", str(f), "--trials", "5")
+    assert code == 2 and out == ""
+    assert says in err and "plan.json" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_folder_given_as_part_says_so(capsys: pytest.CaptureFixture[str], tmp_path) -> None:
+    code, out, err = run(capsys, "plan", str(tmp_path))
+    assert code == 2 and "is a folder, not a part file" in err

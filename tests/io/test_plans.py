@@ -154,11 +154,11 @@ def test_bad_which_and_bad_files(tmp_path: Path) -> None:
         read_plan_document(tmp_path / "missing.json")
     broken = tmp_path / "broken.json"
     broken.write_text('{"steps": [', encoding="utf-8")
-    with pytest.raises(SimulationError, match=r"broken\.json' is not valid JSON"):
+    with pytest.raises(SimulationError, match=r"broken\.json': not valid JSON"):
         read_plan_document(broken)
     binary = tmp_path / "binary.json"
     binary.write_bytes(b"\xff\xfe\x00")
-    with pytest.raises(SimulationError, match="not valid JSON"):
+    with pytest.raises(SimulationError, match="not UTF-8"):
         read_plan_document(binary)
     empty = tmp_path / "empty-plan.json"
     empty.write_text('{"x": 1}', encoding="utf-8")

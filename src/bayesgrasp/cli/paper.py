@@ -12,7 +12,9 @@ from .specs import Method
 
 app = command_app()
 
-PolygonsOpt = Annotated[int, typer.Option(min=1, help="How many random polygons (the paper: 2000).")]
+PolygonsOpt = Annotated[
+    int, typer.Option(min=1, help="How many random polygons (the paper: 2000).")
+]
 SeedOpt = Annotated[int, typer.Option(min=0, help="Seed of the random generator (>= 0).")]
 MethodOpt = Annotated[Method, typer.Option(help="Planner whose plans give the figures.")]
 StudySenseOpt = Annotated[

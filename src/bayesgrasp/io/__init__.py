@@ -154,6 +154,8 @@ def _format(fmt: Any, path: Path | None) -> str:
     suffix = path.suffix.lstrip(".") if path is not None else ""
     kind = (fmt or EXTENSIONS.get(suffix.lower(), suffix)).lower()
     if kind not in FORMATS:
+        if path is not None and fmt is None and path.is_dir():
+            raise fail(path, "is a folder, not a part file (sweep takes folders of parts)")
         shown = quote(kind) if kind else "(no extension)"
         message = f"unknown part format {shown}; expected one of {', '.join(FORMATS)}"
         raise fail(path, message) if path is not None else PartFileError(f"`fmt`: {message}")
@@ -293,8 +295,8 @@ def _read_stdin(fmt: str | None, **options: Any) -> Part:
     """A part from standard input (at most :data:`MAX_BYTES` bytes)."""
     if fmt is None:
         raise PartFileError(
-            f"reading a part from standard input ({STDIN!r}) needs its format: give fmt "
-            f"(--format), one of {', '.join(FORMATS)}"
+            f"reading a part from standard input ({STDIN!r}) needs its format, one of "
+            f"{', '.join(FORMATS)} (--format on the command line, `fmt` in the library)"
         )
     stream = getattr(sys.stdin, "buffer", None)
     if stream is None:

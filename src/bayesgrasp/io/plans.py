@@ -718,6 +718,10 @@ def _read(doc: Any, which: str) -> PlanOption:
     return _read_option(opts[pick])
 
 
+#: Most steps a plan file may hold (planners make plans of tens of actions).
+MAX_PLAN_STEPS = 10_000
+
+
 def _read_option(doc: Any) -> PlanOption:
     """One option object: ``steps`` (plan/2) or ``first_squeeze_rad`` and ``actions_rad``."""
     from ..planning.result import PlanOption, PlanStep
@@ -729,6 +733,10 @@ def _read_option(doc: Any) -> PlanOption:
         raw = doc["steps"]
         if not isinstance(raw, list) or not raw:
             raise SimulationError("`steps` must be a non-empty list")
+        if len(raw) > MAX_PLAN_STEPS:
+            raise SimulationError(
+                f"a plan of {len(raw):,} steps; a plan file holds at most {MAX_PLAN_STEPS:,}"
+            )
         for i, st in enumerate(raw, start=1):
             kind = st.get("type", SQUEEZE.name) if isinstance(st, Mapping) else None
             alpha = st.get("alpha_rad") if isinstance(st, Mapping) else None
@@ -740,10 +748,15 @@ def _read_option(doc: Any) -> PlanOption:
                 )
             steps.append(PlanStep(str(kind), float(alpha)))
     elif "first_squeeze_rad" in doc:
+        raw = doc.get("actions_rad", [])
+        if isinstance(raw, list) and len(raw) >= MAX_PLAN_STEPS:
+            raise SimulationError(
+                f"a plan of {len(raw) + 1:,} steps; a plan file holds at most {MAX_PLAN_STEPS:,}"
+            )
         try:
             angles = [float(doc["first_squeeze_rad"])]
-            angles += [float(a) for a in doc.get("actions_rad", [])]
-        except (TypeError, ValueError):
+            angles += [float(a) for a in raw]
+        except (TypeError, ValueError, OverflowError):
             raise SimulationError("`first_squeeze_rad` and `actions_rad` must be numbers") from None
         steps = [PlanStep(SQUEEZE.name, a) for a in angles]
     else:
@@ -1053,16 +1066,20 @@ def read_strategy(
 
 
 def _load(source: Any, what: str) -> Any:
-    """A parsed document, or the JSON of the file ``source`` names."""
+    """A parsed document, or the JSON of the file ``source`` names (read within bounds).
+
+    The file is read as :mod:`bayesgrasp.files` reads every input: a regular file of at most
+    ``MAX_BYTES``, UTF-8, numbers within a float's range and nesting within ``MAX_NESTING``.
+    """
     if not isinstance(source, str | os.PathLike):
         return source
+    from ..files import decode_text, load_json, read_bytes
+
     path = Path(source)
+    label = f"{what} {str(path)!r}"
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise SimulationError(
-            f"{what} {str(path)!r} cannot be read ({exc.strerror or exc})"
-        ) from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        why = exc.msg if isinstance(exc, json.JSONDecodeError) else "not UTF-8"
-        raise SimulationError(f"{what} {str(path)!r} is not valid JSON ({why})") from None
+        data = read_bytes(path, SimulationError, what)
+    except SimulationError as exc:  # "<path>: <reason>": say which file it is
+        reason = str(exc).removeprefix(f"{path}: ")
+        raise SimulationError(f"{label} cannot be read ({reason})") from None
+    return load_json(label, decode_text(label, data, SimulationError), SimulationError)

@@ -195,7 +195,8 @@ def _prescan(path: Path, data: bytes, options: ReadOptions) -> None:
         raise fail(
             path,
             f"the paths and shapes have {count} segments in all; the limit is max_points = "
-            f"{options.max_points} (remove other drawings from the file, or raise max_points)",
+            f"{options.max_points} (remove other drawings from the file; `max_points` in "
+            "the library)",
         )
 
 
