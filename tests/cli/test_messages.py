@@ -165,4 +165,4 @@ def test_a_plan_file_out_of_bounds_is_one_line(
 
 def test_a_folder_given_as_part_says_so(capsys: pytest.CaptureFixture[str], tmp_path) -> None:
     code, out, err = run(capsys, "plan", str(tmp_path))
-    assert code == 2 and "is a folder, not a part file" in err
+    assert (code, out) == (2, "") and "is a folder, not a part file" in err
