@@ -145,8 +145,8 @@ def test_an_over_long_output_name_is_one_line(
             "too large",
         ),
         (
-            '{"steps": '
-            + '[{"type": "squeeze", "alpha_rad": 0.1}, ' * 20_001
+            '{"steps": ['
+            + '{"type": "squeeze", "alpha_rad": 0.1}, ' * 20_001
             + '{"type": "squeeze", "alpha_rad": 0.1}], "final_orientation_rad": 0}',
             "at most 10,000",
         ),
