@@ -166,3 +166,29 @@ def test_a_plan_file_out_of_bounds_is_one_line(
 def test_a_folder_given_as_part_says_so(capsys: pytest.CaptureFixture[str], tmp_path) -> None:
     code, out, err = run(capsys, "plan", str(tmp_path))
     assert (code, out) == (2, "") and "is a folder, not a part file" in err
+
+
+def test_a_huge_part_reports_only_what_a_user_reads(
+    capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:
+    import json
+
+    from bayesgrasp.cli.plan import HUGE_STATES
+
+    t = np.sort(np.random.default_rng(3).uniform(0, 2 * np.pi, 1200))
+    f = tmp_path / "ring.json"
+    f.write_text(json.dumps({"vertices": np.c_[50 * np.cos(t), 50 * np.sin(t)].tolist()}))
+    code, out, err = run(capsys, "plan", str(f), "--json")
+    doc = json.loads(out)
+    assert code == 0 and "stable orientations: only the Bayes and the most certain" in err
+    from bayesgrasp.io import read_part
+
+    assert Problem.build(read_part(f)).n_states > HUGE_STATES
+    short = len(doc["options"])
+    assert short <= 2
+    code, out, err = run(capsys, "plan", str(f), "--json", "--only", "all")
+    assert code == 0 and err == ""
+    full = json.loads(out)
+    assert len(full["options"]) > short
+    best = full["options"][full["bayes"]]
+    assert doc["options"][doc["bayes"]]["expected_cost"] == pytest.approx(best["expected_cost"])

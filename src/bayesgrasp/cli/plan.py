@@ -53,6 +53,11 @@ def _given(ctx: typer.Context, *names: str) -> list[str]:
     ]
 
 
+#: Above this many stable orientations a plain ``plan PART`` reports only the Bayes and the
+#: most certain plans: a table of every length would have thousands of rows nobody reads.
+HUGE_STATES = 1000
+
+
 class Only(enum.StrEnum):
     """Which plans ``plan`` reports."""
 
@@ -117,11 +122,12 @@ MorePartsArg = Annotated[
     ),
 ]
 OnlyOpt = Annotated[
-    Only,
+    Only | None,
     typer.Option(
         "--only",
         help="all: the best plan of every length; best: only the Bayes and the most certain "
-        "plans (for parts of thousands of states).",
+        f"plans (default: all, or best for a part of more than {HUGE_STATES:,} stable "
+        "orientations, saying so).",
     ),
 ]
 BatchOpt = Annotated[
@@ -159,7 +165,7 @@ def plan(
     payoff: PayoffOpt = None,
     force: ForceOpt = False,
     export: ExportOpt = None,
-    only: OnlyOpt = Only.all,
+    only: OnlyOpt = None,
     batch: BatchOpt = None,
     max_opening: MaxOpeningOpt = None,
     min_opening: MinOpeningOpt = None,
@@ -255,7 +261,15 @@ def plan(
     loaded = part.load()
     if outputs is not None:
         outputs.check(loaded.name, 1)
-    result = run.solve(spec.build(loaded))
+    problem = spec.build(loaded)
+    if only is None and problem.n_states > HUGE_STATES and not run.best_only:
+        typer.echo(
+            f"bayesgrasp: note: {loaded.name} has {problem.n_states:,} stable orientations: "
+            "only the Bayes and the most certain plans (--only all: the best of every length)",
+            err=True,
+        )
+        run = dataclasses.replace(run, best_only=True)
+    result = run.solve(problem)
     check_stroke(result, stroke)
     if as_json:
         emit_json(document(result, run_inputs(part, spec)))
