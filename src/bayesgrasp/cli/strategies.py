@@ -168,8 +168,8 @@ def _policy_text(pol: Any, units: str | None, fold_below: float) -> str:
     if not pol.complete:
         lines.append(
             f"search stopped: {pol.stopped}. This is the best policy of at most "
-            f"{pol.max_actions} actions (the deepest search that finished); no policy of "
-            f"{pol.requested_actions} actions costs less than {pol.lower_bound:.4f}"
+            f"{_actions(pol.max_actions)} (the deepest search that finished); no policy of "
+            f"{_actions(pol.requested_actions)} costs less than {pol.lower_bound:.4f}"
         )
     if pol.payoff is not None:
         lines.append("payoff: success is the expected payoff earned, the cost is per unit payoff")
@@ -179,6 +179,10 @@ def _policy_text(pol: Any, units: str | None, fold_below: float) -> str:
             f"lowers the cost's value by more than {pol.refinement_bound:.2g}"
         )
     return "\n".join(lines)
+
+
+def _actions(n: int) -> str:
+    return f"{n} action" if n == 1 else f"{n} actions"
 
 
 def exit_code(result: StrategyResult) -> int:
