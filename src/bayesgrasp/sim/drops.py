@@ -167,7 +167,10 @@ class DropStudy:
 
 def _drop_xml(body: MeshBody, s: dict[str, float]) -> str:
     zeta = _damping_ratio(s["restitution"])
-    asset, part = body.geom_xml("part", 'contype="1" conaffinity="1"')
+    # MuJoCo combines two geoms' frictions by taking the larger: the part must carry the
+    # table's friction too, or its default of 1 wins.
+    friction = f'friction="{s["friction"]} 0.001 0.0001"'
+    asset, part = body.geom_xml("part", f'contype="1" conaffinity="1" {friction}')
     return f"""<mujoco model="drop">
   <option timestep="{s["timestep"]}" integrator="implicitfast" solver="Newton" cone="elliptic"/>
   <default><geom solref="{s["contact_time"]} {zeta:.6f}" solimp="0.95 0.99 0.0001"/></default>
@@ -401,14 +404,17 @@ def static_topples(
 
 
 def _squeeze_xml(body: MeshBody, s: dict[str, float], pad: dict[str, float]) -> str:
-    asset, part = body.geom_xml("part", 'contype="1" conaffinity="1"')
+    # MuJoCo combines two geoms' frictions by taking the larger: the part must carry the
+    # table's friction too, or its default of 1 wins.
+    friction = f'friction="{s["friction"]} 0.001 0.0001"'
+    asset, part = body.geom_xml("part", f'contype="1" conaffinity="1" {friction}')
     jaws = ""
     for side in ("lo", "hi"):
         jaws += (
             f'<body name="jaw_{side}" pos="0 0 {pad["z"]:.9g}">'
             f'<joint name="{side}" type="slide" axis="1 0 0" damping="{pad["damping"]:.6g}"/>'
             f'<geom type="box" size="{pad["t"]:.6g} {pad["l"]:.6g} {pad["hz"]:.6g}" mass="{pad["mass"]:.6g}"'
-            ' contype="2" conaffinity="2" condim="1" priority="1"/></body>'
+            ' contype="2" conaffinity="2" condim="1" priority="1" solref="0.02 1"/></body>'
         )
     act = "".join(
         f'<position joint="{side}" kp="{pad["kp"]:.6g}" forcerange="{-pad["force"]:.6g} {pad["force"]:.6g}"'
@@ -512,7 +518,7 @@ def squeeze_topples(
         "t": 0.002,
         "l": float(np.ptp(p[:, :2], axis=0).max()) + 0.01,
         "hz": min(0.0015, 0.5 * jaw_h * height),
-        "mass": 0.05,
+        "mass": 0.01,
         "damping": 2.0,
         "kp": 200.0,
         "force": 3.0 * weight,
@@ -531,9 +537,9 @@ def squeeze_topples(
     data.qpos[jlo], data.qpos[jhi] = lo0, hi0
     mujoco.mj_forward(model, data)
     down = np.array([0.0, 0.0, -1.0])
-    speed, dt = 0.02, s["timestep"]
+    speed, dt = 0.01, s["timestep"]
     chunk = 10
-    steps = math.ceil(5.0 / (chunk * dt))
+    steps = math.ceil(10.0 / (chunk * dt))
     hold = math.ceil(0.1 / (chunk * dt))
     still = 0
     settled = False
