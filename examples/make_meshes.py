@@ -31,7 +31,7 @@ IntArray = NDArray[np.int64]
 
 
 def hull_mesh(points: FloatArray) -> tuple[FloatArray, IntArray]:
-    """The convex hull of points as outward-facing triangles."""
+    """Return the convex hull of points as outward-facing triangles."""
     hull = ConvexHull(points)
     faces = hull.simplices.copy()
     for k, (a, b, c) in enumerate(faces):
@@ -73,7 +73,7 @@ def ear_clip(poly: FloatArray) -> list[tuple[int, int, int]]:
 
 
 def extrude(poly: FloatArray, depth: float) -> tuple[FloatArray, IntArray]:
-    """A counter-clockwise polygon in the xz-plane... extruded along +y from 0 to ``depth``.
+    """Extrude a counter-clockwise polygon of the xz-plane along +y, from 0 to ``depth``.
 
     The polygon is given as (x, z) pairs; the solid spans y in [0, depth].
     """
@@ -94,7 +94,7 @@ def extrude(poly: FloatArray, depth: float) -> tuple[FloatArray, IntArray]:
 
 
 def ring(outer: FloatArray, inner: FloatArray, height: float) -> tuple[FloatArray, IntArray]:
-    """The solid between two counter-clockwise rings of equal length, z from 0 to height."""
+    """Return the solid between two counter-clockwise rings of equal length, z in [0, height]."""
     n = len(outer)
     o0, o1 = np.c_[outer, np.zeros(n)], np.c_[outer, np.full(n, height)]
     i0, i1 = np.c_[inner, np.zeros(n)], np.c_[inner, np.full(n, height)]
@@ -122,6 +122,7 @@ def oriented(verts: FloatArray, faces: IntArray) -> IntArray:
 
 
 def centroid(verts: FloatArray, faces: IntArray) -> FloatArray:
+    """Return the centroid of a closed, outward solid (signed tetrahedra from the origin)."""
     tri = verts[faces]
     det = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))
     return (det[:, None] * tri.sum(axis=1)).sum(axis=0) / (4.0 * det.sum())
@@ -132,9 +133,7 @@ def write_stl(path: Path, verts: FloatArray, faces: IntArray, name: str) -> None
     tri = verts[faces]
     normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normal /= np.linalg.norm(normal, axis=1)[:, None]
-    rec = np.zeros(
-        len(faces), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]
-    )
+    rec = np.zeros(len(faces), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
     rec["n"], rec["v"] = normal, tri
     header = f"bayesgrasp example {name}, millimetres".encode().ljust(80, b" ")
     path.write_bytes(header + np.uint32(len(faces)).tobytes() + rec.tobytes())
@@ -159,9 +158,15 @@ def meshes() -> dict[str, tuple[FloatArray, IntArray, FloatArray]]:
     v, f = extrude(np.array([(0, 0), (40, 0), (0, 15)], dtype=float), 20.0)
     out["wedge"] = (v, f, centroid(v, f))
     per_side, r_out, r_in = 4, 10.0 / math.cos(math.pi / 6), 5.0
-    corners = np.array([(r_out * math.cos(k * math.pi / 3), r_out * math.sin(k * math.pi / 3)) for k in range(7)])
+    corners = np.array(
+        [(r_out * math.cos(k * math.pi / 3), r_out * math.sin(k * math.pi / 3)) for k in range(7)]
+    )
     outer = np.vstack(
-        [corners[k] + (corners[k + 1] - corners[k]) * t / per_side for k in range(6) for t in range(per_side)]
+        [
+            corners[k] + (corners[k + 1] - corners[k]) * t / per_side
+            for k in range(6)
+            for t in range(per_side)
+        ]
     )
     angles = np.arctan2(outer[:, 1], outer[:, 0])
     inner = r_in * np.c_[np.cos(angles), np.sin(angles)]
@@ -171,6 +176,7 @@ def meshes() -> dict[str, tuple[FloatArray, IntArray, FloatArray]]:
 
 
 def main() -> None:
+    """Write every example mesh and its sidecar."""
     OUT.mkdir(exist_ok=True)
     for name, (v, f, com) in meshes().items():
         f = oriented(v, f)

@@ -148,7 +148,7 @@ def test_quasi_static_closed_forms() -> None:
     """Cube 6 x 1/6; a 1 x 2 x 4 box from the rectangle's solid angle on its axis."""
     _, p = quasi_static(box(1, 1, 1)[0], np.array([0.5, 0.5, 0.5]))
     assert_allclose(p, [1 / 6] * 6, atol=1e-12)
-    n, p = quasi_static(box(1, 2, 4)[0], np.array([0.5, 1.0, 2.0]))
+    _, p = quasi_static(box(1, 2, 4)[0], np.array([0.5, 1.0, 2.0]))
 
     def omega(a: float, b: float, d: float) -> float:  # rectangle 2a x 2b at distance d
         return 4 * math.atan(a * b / (d * math.sqrt(a * a + b * b + d * d)))
@@ -247,7 +247,7 @@ def test_drops_are_deterministic_and_scale_free() -> None:
     c = drop_poses(v / 1000, f, v.mean(axis=0) / 1000, n, 12, seed=3)
     assert a.counts.tolist() == b.counts.tolist() == c.counts.tolist()
     assert a.counts.sum() + a.unmatched == 12 and a.unsettled == 0
-    assert a.settings["height"] == 0.1 and a.settings["restitution"] == 0.0
+    assert a.settings["height"] == 0.02 and a.settings["restitution"] == 0.0
 
 
 @pytest.mark.physics
@@ -255,9 +255,9 @@ def test_drops_are_deterministic_and_scale_free() -> None:
 def test_settled_part_rests_on_the_table() -> None:
     """An off-centre centre of mass is where MuJoCo puts it: the loaded face lands down more."""
     v, f = read_stl(MESHES / "hex_nut.stl")
-    study = drop_poses(v, f, [1.5, 0.0, 2.5], [[0, 0, -1], [0, 0, 1]], 40, seed=0)
-    assert study.counts.sum() >= 30  # a nut lands flat nearly always
-    assert study.counts[0] > 1.5 * study.counts[1]
+    study = drop_poses(v, f, [1.5, 0.0, 2.5], [[0, 0, -1], [0, 0, 1]], 100, seed=0)
+    assert study.counts.sum() >= 75  # a nut lands flat nearly always
+    assert study.counts[0] > study.counts[1]  # quasi-static: 38% and 27%; 1,000 drops: 59%, 25%
 
 
 @pytest.mark.physics
@@ -269,12 +269,12 @@ def test_box_drops_agree_with_solid_angles_quick() -> None:
     assert total_variation(study, p) < 0.15  # 60 drops: sampling alone gives about 0.07
 
 
-AGREEMENT = [  # solid, centre of mass, largest total variation allowed over 300 drops
-    ("box 1x2x4", lambda: box(10, 20, 40), 0.06),
+AGREEMENT = [  # solid, centre of mass, largest total variation allowed over 400 drops
+    ("box 1x2x4", lambda: box(10, 20, 40), 0.05),
     (
         "square pyramid",
         lambda: hull_solid([(0, 0, 0), (4, 0, 0), (0, 4, 0), (4, 4, 0), (2, 2, 3)]),
-        0.06,
+        0.05,
     ),
 ]
 
@@ -286,7 +286,7 @@ def test_drops_agree_with_quasi_static_on_simple_solids(name: str, solid, bound:
     v, f = solid()
     com = mass_properties(v, f)[1]
     n, p = quasi_static(v, com)
-    study = drop_poses(v, f, com, n, 300, seed=7)
+    study = drop_poses(v, f, com, n, 400, seed=7)
     assert total_variation(study, p) < bound
 
 
@@ -308,12 +308,16 @@ DIFFERENT = [  # the model is known to miss these by 0.08 to 0.26: the test reco
 
 @pytest.mark.physics
 @pytest.mark.slow
-@pytest.mark.parametrize(("name", "solid", "com", "bound"), DIFFERENT, ids=[d[0] for d in DIFFERENT])
+@pytest.mark.parametrize(
+    ("name", "solid", "com", "bound"), DIFFERENT, ids=[d[0] for d in DIFFERENT]
+)
 def test_drops_against_quasi_static_on_harder_shapes(name, solid, com, bound) -> None:
     v, f = solid()
     c = mass_properties(v, f)[1] if com is None else np.asarray(com, dtype=float)
     n, p = quasi_static(v, c)
-    study = drop_poses(v, f, c, n, 300, seed=7)
+    study = drop_poses(v, f, c, n, 400, seed=7)
     tv = total_variation(study, p)
-    print(f"{name}: total variation {tv:.3f}")  # noqa: T201
+    print(f"{name}: total variation {tv:.3f}")
     assert tv < bound
+    if name == "hex nut":  # a flat part lands flat more often than solid angles say
+        assert study.frequencies()[:2].sum() > p[:2].sum() + 0.1

@@ -124,7 +124,9 @@ def test_box_on_its_broad_face_never_topples(angle: float) -> None:
 
 @pytest.mark.physics
 @needs_mujoco
-@pytest.mark.parametrize(("height", "topples"), [(0.05, False), (0.1, False), (0.3, True), (0.5, True), (0.9, True)])
+@pytest.mark.parametrize(
+    ("height", "topples"), [(0.05, False), (0.1, False), (0.3, True), (0.5, True), (0.9, True)]
+)
 def test_tall_prism_topples_when_pushed_high(height: float, topples: bool) -> None:
     """Away from the static threshold (1/6 of its height) MuJoCo agrees with statics."""
     v, f = TALL

@@ -39,7 +39,9 @@ def _finite_array(value: ArrayLike, name: str, shape: tuple[int | None, ...]) ->
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
         raise SimulationError(f"`{name}` must be an array of numbers") from None
-    if arr.ndim != len(shape) or any(s is not None and a != s for a, s in zip(arr.shape, shape)):
+    if arr.ndim != len(shape) or any(
+        s is not None and a != s for a, s in zip(arr.shape, shape, strict=True)
+    ):
         want = "(" + ", ".join("N" if s is None else str(s) for s in shape) + ")"
         raise SimulationError(f"`{name}` must have shape {want}; got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
@@ -103,17 +105,19 @@ def rotation_between(a: ArrayLike, b: ArrayLike) -> FloatArray:
     >>> np.round(rotation_between([0, 0, 1], [0, 0, -1]) @ [0, 0, 1], 12).tolist()
     [0.0, 0.0, -1.0]
     """
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
-    v = np.cross(a, b)
-    c = float(a @ b)
+    u = np.asarray(a, dtype=np.float64)
+    w = np.asarray(b, dtype=np.float64)
+    u, w = u / np.linalg.norm(u), w / np.linalg.norm(w)
+    v = np.cross(u, w)
+    c = float(u @ w)
     if c < -1.0 + 1e-12:
-        axis = np.cross(a, np.eye(3)[int(np.argmin(np.abs(a)))])
+        axis = np.cross(u, np.eye(3)[int(np.argmin(np.abs(u)))])
         axis /= np.linalg.norm(axis)
-        return 2.0 * np.outer(axis, axis) - np.eye(3)
+        flip: FloatArray = 2.0 * np.outer(axis, axis) - np.eye(3)
+        return flip
     vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return np.eye(3) + vx + vx @ vx / (1.0 + c)
+    rot: FloatArray = np.eye(3) + vx + vx @ vx / (1.0 + c)
+    return rot
 
 
 def pose_frame(normal: ArrayLike) -> FloatArray:
