@@ -185,6 +185,23 @@ def test_mass_properties_against_sampling() -> None:
     assert_allclose(inertia, sampled, rtol=0.02, atol=0.01 * np.abs(sampled).max())
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_mass_properties_follow_rigid_motions_and_flips(seed: int) -> None:
+    """Rotated and moved: the volume stays, the centroid moves, the inertia turns;
+    faces listed inward give the same answer."""
+    from scipy.spatial.transform import Rotation
+
+    v, f = read_stl(MESHES / "hex_nut.stl")
+    vol, c, inertia = mass_properties(v, f)
+    r = Rotation.random(random_state=seed).as_matrix()
+    shift = np.array([3.0, -7.0, 11.0])
+    vol2, c2, inertia2 = mass_properties(v @ r.T + shift, f[:, ::-1])
+    assert_allclose(vol2, vol, rtol=1e-10)
+    assert_allclose(c2, r @ c + shift, atol=1e-9)
+    assert_allclose(inertia2, r @ inertia @ r.T, atol=1e-8 * np.abs(inertia).max())
+    assert_allclose(c, [0, 0, 4], atol=1e-9)  # the nut's solid is symmetric
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
