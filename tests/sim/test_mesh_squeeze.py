@@ -14,38 +14,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull
 
 from bayesgrasp.errors import SimulationError
 from bayesgrasp.sim.drops import squeeze_topples, static_topples
 from bayesgrasp.sim.mesh_scene import mass_properties, pose_frame, rotation_between
+from sim.test_drops import box, read_stl  # the solids the drop tests use
 
 HAVE_MUJOCO = importlib.util.find_spec("mujoco") is not None
 needs_mujoco = pytest.mark.skipif(not HAVE_MUJOCO, reason="MuJoCo is not installed")
 MESHES = Path(__file__).resolve().parents[2] / "examples" / "meshes"
 DOWN = (0.0, 0.0, -1.0)
-
-
-def hull_solid(points) -> tuple[np.ndarray, np.ndarray]:
-    p = np.asarray(points, dtype=float)
-    hull = ConvexHull(p)
-    faces = hull.simplices.copy()
-    for k, (a, b, c) in enumerate(faces):
-        if np.cross(p[b] - p[a], p[c] - p[a]) @ hull.equations[k, :3] < 0:
-            faces[k] = (a, c, b)
-    return p, faces
-
-
-def box(a: float, b: float, c: float) -> tuple[np.ndarray, np.ndarray]:
-    return hull_solid([(x, y, z) for x in (0, a) for y in (0, b) for z in (0, c)])
-
-
-def read_stl(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    raw = path.read_bytes()
-    n = int(np.frombuffer(raw, "<u4", 1, 80)[0])
-    rec = np.frombuffer(raw, [("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")], n, 84)
-    verts, inv = np.unique(rec["v"].reshape(-1, 3).astype(float), axis=0, return_inverse=True)
-    return verts, inv.reshape(-1, 3)
 
 
 TALL = box(10, 10, 60)  # a tall thin prism standing on its 10 x 10 end

@@ -349,7 +349,7 @@ class SqueezeCheck:
         return self.toppled
 
 
-def _placed(body: MeshBody, normal: FloatArray, gripper_angle: float) -> FloatArray:
+def _placed(normal: FloatArray, gripper_angle: float) -> FloatArray:
     """Rotation (body to world) of the part resting on ``normal``, turned by ``-angle``."""
     c, s = math.cos(gripper_angle), math.sin(gripper_angle)
     yaw = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # turn by -gripper_angle
@@ -408,7 +408,7 @@ def static_topples(
     nrm = _unit_normals(normal, "normal")[0]
     if push == 0:
         return False
-    rot = _placed(MeshBody(v, 0.0, np.zeros((3, 3)), 1.0), nrm, float(gripper_angle))
+    rot = _placed(nrm, float(gripper_angle))
     p = (v - c) @ rot.T  # (N, 3) about the centre of mass, world axes
     base = float(p[:, 2].min())
     height = float(p[:, 2].max()) - base
@@ -528,7 +528,7 @@ def squeeze_topples(
     mujoco = require_mujoco()
     from scipy.spatial.transform import Rotation
 
-    rot = _placed(body, nrm, angle)
+    rot = _placed(nrm, angle)
     p = body.points @ rot.T  # (H, 3) hull about the centre of mass, world axes
     height = float(np.ptp(p[:, 2]))
     width = float(np.ptp(p[:, 0]))
