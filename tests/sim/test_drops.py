@@ -236,6 +236,15 @@ def test_flat_mesh_is_refused() -> None:
         mesh_body(v, f, (0.5, 0.5, 0))
 
 
+def test_drop_study_is_read_only_and_adds_up() -> None:
+    counts = np.array([2, 1])
+    study = DropStudy(counts, 1, 4)
+    counts[0] = 9  # the caller's array stays theirs
+    assert study.counts.tolist() == [2, 1] and not study.counts.flags.writeable
+    with pytest.raises(SimulationError, match=r"must add up to trials \(5\); got 4"):
+        DropStudy(np.array([2, 1]), 1, 5)
+
+
 def test_intervals_are_clopper_pearson() -> None:
     """Against the binomial tails they are defined by (each tail exactly 2.5%)."""
     from scipy.stats import binom

@@ -135,6 +135,19 @@ class DropStudy:
     settings: dict[str, float] = field(default_factory=dict)
     unsettled: int = 0
 
+    def __post_init__(self) -> None:
+        """Keep a read-only copy of the counts; check they add up to the trials."""
+        counts = np.array(self.counts, dtype=np.int64)
+        if counts.ndim != 1 or np.any(counts < 0) or self.trials < 1:
+            raise SimulationError("`counts` must be non-negative integers and `trials` >= 1")
+        if int(counts.sum()) + self.unmatched != self.trials:
+            total = int(counts.sum()) + self.unmatched
+            raise SimulationError(
+                f"counts and unmatched must add up to trials ({self.trials}); got {total}"
+            )
+        counts.flags.writeable = False
+        object.__setattr__(self, "counts", counts)
+
     def frequencies(self) -> FloatArray:
         """Each face's share of all drops, ``counts / trials``.
 
