@@ -14,7 +14,18 @@ from bayesgrasp.web.gallery import Gallery, default_data_dir
 def test_serve_help_names_the_options() -> None:
     result = CliRunner().invoke(app, ["--help"])
     assert result.exit_code == 0
-    for option in ("--host", "--port", "--data", "--gallery-rows", "--time-limit"):
+    for option in (
+        "--host",
+        "--port",
+        "--data",
+        "--gallery-rows",
+        "--timeout",
+        "--workers",
+        "--quick-workers",
+        "--worker-memory",
+        "--queue",
+        "--job-timeout",
+    ):
         assert option in result.output
     assert "127.0.0.1" in result.output
 
