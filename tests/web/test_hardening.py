@@ -187,7 +187,6 @@ def test_too_many_trials_is_422(make_client: Any) -> None:
 def test_a_long_plan_is_503_and_the_server_keeps_serving(make_client: Any) -> None:
     client = make_client(time_limit=0.5, workers=1)
     slow = {"part": {"catalogue": "hand"}, "trials": 10**6}  # about a second of work
-    client.post("/api/v1/simulate", json={**slow, "trials": 10})  # the heavy worker starts
     t0 = time.perf_counter()
     r = client.post("/api/v1/simulate", json=slow)
     assert r.status_code == 503, r.text
@@ -200,8 +199,12 @@ def test_a_long_plan_is_503_and_the_server_keeps_serving(make_client: Any) -> No
     assert health["lanes"]["heavy"]["killed"] >= 1
     assert client.post("/api/v1/squeeze", json={"part": {"catalogue": "key"}}).status_code == 200
     # the killed worker is replaced: the next simulation is answered
+    client = make_client(time_limit=30.0, workers=1)
+    r = client.post("/api/v1/simulate?timeout=0.5", json=slow)
+    assert r.status_code == 503, r.text
     r = client.post("/api/v1/simulate", json={**slow, "trials": 1000})
     assert r.status_code == 200, r.text
+    assert client.get("/api/v1/health").json()["lanes"]["heavy"]["live"] == 1
 
 
 def test_a_request_may_ask_for_a_shorter_time_limit(make_client: Any) -> None:
