@@ -897,7 +897,10 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     @app.get(
         f"{API}/simulate/jobs/{{job_id}}",
         tags=["plans"],
-        responses={404: {"model": ErrorBody, "description": "No such job (or no longer kept)."}},
+        responses={
+            404: {"model": ErrorBody, "description": "No such job (or no longer kept)."},
+            422: ERRORS[422],
+        },
     )
     async def simulate_job_status(job_id: str) -> dict[str, Any]:
         """A simulation job: status, progress (trials done) and, when done, the document."""
