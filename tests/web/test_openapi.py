@@ -17,7 +17,6 @@ from bayesgrasp.web.app import Limits, create_app
 schemathesis = pytest.importorskip("schemathesis")
 uvicorn = pytest.importorskip("uvicorn")
 
-from schemathesis.checks import not_a_server_error  # noqa: E402
 from schemathesis.specs.openapi.checks import (  # noqa: E402
     content_type_conformance,
     response_headers_conformance,
@@ -110,12 +109,13 @@ def live_schema(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Any]:
 
 def test_the_server_does_what_its_schema_says(live_schema: Any) -> None:
     checks = [
-        not_a_server_error,
         status_code_conformance,
         content_type_conformance,
         response_headers_conformance,
         response_schema_conformance,
     ]
+    # not_a_server_error counts the declared 503 (queue full, time limit) as a failure:
+    # statuses other than 503 are checked below instead
     operations = [result.ok() for result in live_schema.get_all_operations()]
     assert len(operations) >= 12
     statuses: dict[str, set[int]] = {}
@@ -131,7 +131,8 @@ def test_the_server_does_what_its_schema_says(live_schema: Any) -> None:
         )
         def check(case: Any) -> None:
             response = case.call_and_validate(timeout=30, checks=checks)
-            statuses.setdefault(operation.label, set()).add(response.status_code)
+            assert response.status_code < 500 or response.status_code == 503, response.text
+            statuses.setdefault(case.operation.label, set()).add(response.status_code)
 
         check()
     assert len(statuses) == len(operations)  # every operation was called

@@ -716,7 +716,7 @@ ERRORS: dict[int | str, dict[str, Any]] = {
 }
 TIMEOUT = Query(
     None,
-    gt=0,
+    ge=0.01,
     le=86_400,
     description="Seconds this request's work may take (at most the server's time limit, "
     "the default).",
