@@ -218,7 +218,7 @@ class Service:
             lim = self.limits
             size = lim.workers if heavy else lim.quick_workers
             # the heavy lane's workers are niced: the quick lane keeps the processor
-            self._lanes[name] = Lane(name, size, lim.queue, lim.worker_memory, 10 if heavy else 0)
+            self._lanes[name] = Lane(name, size, lim.queue, lim.worker_memory, 19 if heavy else 0)
         return self._lanes[name]
 
     def timeout(self, asked: float | None) -> float:
@@ -239,6 +239,15 @@ class Service:
         """The work ``name`` (a key of :data:`WORK`) on ``req`` in a worker of a lane."""
         lane = self.lane(heavy)
         return await lane.run(_work, (name, self.limits, req, *extra), self.timeout(timeout))
+
+    async def answer(self, name: str, req: Any, timeout: float | None = None) -> Response:
+        """The JSON answer of the work ``name`` on ``req`` (a plan is added to the gallery)."""
+        lane = self.lane(_heavy(name, req))
+        args = (name, self.limits, req)
+        body, entry = await lane.run(_work_json, args, self.timeout(timeout))
+        if entry is not None and self.gallery is not None:
+            await asyncio.to_thread(self.gallery.add, *entry)  # off the event loop
+        return Response(body, media_type="application/json")
 
     def lanes_status(self) -> dict[str, Any]:
         """Each started lane's workers and queue."""
@@ -465,9 +474,14 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
 
 def remember_plan(gallery: Gallery, req: PlanRequest, doc: dict[str, Any]) -> None:
     """Add a planned part to the gallery (its name, outline, options and Bayes plan)."""
+    gallery.add(*gallery_entry(req, doc))
+
+
+def gallery_entry(req: PlanRequest, doc: dict[str, Any]) -> tuple[Any, ...]:
+    """The arguments of :meth:`Gallery.add` for a plan: name, outline, options, Bayes plan."""
     options = req.model_dump(exclude={"part"}, exclude_defaults=True)
     bayes = doc["options"][doc["bayes"]] if doc.get("options") else {}
-    gallery.add(doc["part"]["name"], doc["part"]["vertices"], options, bayes)
+    return doc["part"]["name"], doc["part"]["vertices"], options, bayes
 
 
 def noisy_plan_document(
@@ -691,6 +705,17 @@ def _work(name: str, limits: Limits, req: Any, *extra: Any, **kwargs: Any) -> An
     return WORK[name](Service(limits, None), req, *extra, **kwargs)
 
 
+def _work_json(name: str, limits: Limits, req: Any) -> tuple[bytes, tuple[Any, ...] | None]:
+    """``WORK[name]``'s document as JSON bytes, and for a plan its gallery entry.
+
+    The document is encoded in the worker, as the server's JSON answers are encoded, so that
+    the server's event loop only passes the bytes on.
+    """
+    doc = _work(name, limits, req)
+    body = json.dumps(doc, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode()
+    return body, (gallery_entry(req, doc) if name == "plan" else None)
+
+
 def _heavy(name: str, req: Any) -> bool:
     """Whether the work goes to the heavy lane (policies, noise, simulations, bfs)."""
     if name in ("policy", "simulate"):
@@ -803,11 +828,8 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
         status, kind, reason = failure_of(exc)
         return _error(status, reason, kind)
 
-    async def answer(name: str, req: Any, timeout: float | None) -> JSONResponse:
-        doc = await service.run(name, req, heavy=_heavy(name, req), timeout=timeout)
-        if name == "plan" and gallery is not None:
-            remember_plan(gallery, req, doc)
-        return JSONResponse(doc)
+    async def answer(name: str, req: Any, timeout: float | None) -> Response:
+        return await service.answer(name, req, timeout)
 
     @app.get(f"{API}/health", tags=["server"])
     async def health() -> dict[str, Any]:
@@ -830,17 +852,17 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
         return JSONResponse(await asyncio.to_thread(_catalogue))
 
     @app.post(f"{API}/squeeze", tags=["parts"], responses=ERRORS)
-    async def squeeze(req: PartRequest, timeout: float | None = TIMEOUT) -> JSONResponse:
+    async def squeeze(req: PartRequest, timeout: float | None = TIMEOUT) -> Response:
         """Stable orientations of a squeeze (``bayesgrasp squeeze --json``)."""
         return await answer("squeeze", req, timeout)
 
     @app.post(f"{API}/push", tags=["parts"], responses=ERRORS)
-    async def push(req: PartRequest, timeout: float | None = TIMEOUT) -> JSONResponse:
+    async def push(req: PartRequest, timeout: float | None = TIMEOUT) -> Response:
         """Stable orientations of a push and a push-grasp (``bayesgrasp push --json``)."""
         return await answer("push", req, timeout)
 
     @app.post(f"{API}/plan", tags=["plans"], responses=ERRORS)
-    async def plan(req: PlanRequest, timeout: float | None = TIMEOUT) -> JSONResponse:
+    async def plan(req: PlanRequest, timeout: float | None = TIMEOUT) -> Response:
         """The best plan of every length, Bayes and most certain (``bayesgrasp plan --json``).
 
         With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
@@ -849,12 +871,12 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
         return await answer("plan", req, timeout)
 
     @app.post(f"{API}/policy", tags=["plans"], responses=ERRORS)
-    async def policy(req: PolicyRequest, timeout: float | None = TIMEOUT) -> JSONResponse:
+    async def policy(req: PolicyRequest, timeout: float | None = TIMEOUT) -> Response:
         """The Bayes policy that branches on jaw widths (``plan --sense ... --json``)."""
         return await answer("policy", req, timeout)
 
     @app.post(f"{API}/simulate", tags=["plans"], responses=ERRORS)
-    async def simulate(req: SimulateRequest, timeout: float | None = TIMEOUT) -> JSONResponse:
+    async def simulate(req: SimulateRequest, timeout: float | None = TIMEOUT) -> Response:
         """Kinematic executions of a plan (``bayesgrasp simulate --engine kinematic --json``)."""
         return await answer("simulate", req, timeout)
 
@@ -934,7 +956,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
         format: str = Form(description="json, csv, wkt, geojson, svg or dxf."),
         options: str = Form("{}", description="The other members of the command's body, JSON."),
         timeout: float | None = TIMEOUT,
-    ) -> JSONResponse:
+    ) -> Response:
         """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``."""
         data = await file.read(lim.max_body_bytes + 1)
         try:
