@@ -10,9 +10,11 @@ heavy requests' statuses, and the server's memory (the proportional set size of 
 and its worker processes) before, during (peak) and ``--settle`` seconds after the load.
 
 With ``--baseline-rev REV`` the same load runs first against the server of git revision
-``REV`` (its ``src`` unpacked into a temporary folder), side by side with this one.
+``REV`` (its ``src`` unpacked into a temporary folder), side by side with this one; with
+``--light-only`` this server runs the light clients alone too (what the machine gives light
+requests without the heavy ones).
 
-    python benchmarks/bench_web.py [--seconds 30] [--baseline-rev REV]
+    python benchmarks/bench_web.py [--seconds 30] [--baseline-rev REV] [--light-only]
 """
 
 from __future__ import annotations
@@ -148,7 +150,12 @@ def post(url: str, body: dict[str, Any], timeout: float) -> tuple[int, Any]:
 
 
 def load(
-    label: str, src: Path, server_args: list[str], args: argparse.Namespace, cases: list[Any]
+    label: str,
+    src: Path,
+    server_args: list[str],
+    args: argparse.Namespace,
+    cases: list[Any],
+    heavy_clients: int | None = None,
 ) -> Run:
     """Start the server of ``src``, run the load, stop it."""
     port = free_port()
@@ -167,6 +174,7 @@ def load(
     proc = subprocess.Popen(cmd, cwd=data, env=env, stderr=subprocess.DEVNULL)
     url = f"http://127.0.0.1:{port}/api/v1"
     run = Run(label)
+    n_heavy = args.heavy_clients if heavy_clients is None else heavy_clients
     try:
         for _ in range(600):
             try:
@@ -215,8 +223,8 @@ def load(
                 peak[0] = max(peak[0], tree_memory(proc.pid))
                 time.sleep(0.5)
 
-        with ThreadPoolExecutor(args.light_clients + args.heavy_clients + 1) as pool:
-            jobs = [pool.submit(heavy_client, c) for c in range(args.heavy_clients)]
+        with ThreadPoolExecutor(args.light_clients + n_heavy + 1) as pool:
+            jobs = [pool.submit(heavy_client, c) for c in range(n_heavy)]
             jobs += [pool.submit(light_client, c) for c in range(args.light_clients)]
             jobs.append(pool.submit(sample))
             for j in jobs:
@@ -292,6 +300,11 @@ def main() -> int:
     ap.add_argument("--settle", type=float, default=10.0, help="seconds before 'after'")
     ap.add_argument("--baseline-rev", help="git revision of a server to compare with")
     ap.add_argument("--server-args", default="", help="options of this server (e.g. '--workers 2')")
+    ap.add_argument(
+        "--light-only",
+        action="store_true",
+        help="also run this server with the light clients alone (the machine's own latency)",
+    )
     args = ap.parse_args()
 
     bodies = light_bodies()
@@ -307,6 +320,9 @@ def main() -> int:
         subprocess.run(["tar", "-x", "-C", str(base)], input=archive, check=True)
         runs.append(load(f"server at {args.baseline_rev[:10]}", base / "src", [], args, cases))
     runs.append(load("this server", ROOT / "src", args.server_args.split(), args, cases))
+    if args.light_only:
+        here = ROOT / "src"
+        runs.append(load("this, light only", here, args.server_args.split(), args, cases, 0))
     print(report(runs, args))
     return 1 if any(r.wrong for r in runs) else 0
 
