@@ -2,13 +2,18 @@
 
 Every API answer is the document the command line prints with ``--json``, built by the same
 library calls (:class:`~bayesgrasp.cli.specs.ProblemSpec`,
-:func:`bayesgrasp.io.plans.plan_document`, :mod:`bayesgrasp.report`). Bad input is a 422
-whose ``detail`` is the command line's one-line message; a body over
+:func:`bayesgrasp.io.plans.plan_document`, :mod:`bayesgrasp.report`). Every error is a JSON
+body ``{detail, error, status}`` (:class:`~bayesgrasp.web.models.ErrorBody`): bad input is a
+422 whose ``detail`` is the command line's one-line message; a body over
 :attr:`Limits.max_body_bytes` is a 413 and a part over :attr:`Limits.max_vertices` vertices
-a 422, each naming the limit; work runs in a pool of threads under :attr:`Limits.time_limit`
-seconds (then a 503; the server keeps serving). Noise-aware plans, which can take minutes,
-run in threads of their own (:attr:`Limits.noisy_workers`), so that they never hold the
-threads of the light requests.
+a 422, each naming the limit.
+
+The work runs in worker processes (:mod:`bayesgrasp.web.workers`), never on the server's
+event loop: a quick lane (squeeze and push functions, plans, figures) and a heavy lane
+(policies, noise-aware plans, simulations and simulation jobs), each with a bounded queue.
+Work past its time limit (:attr:`Limits.time_limit`, or less if the request asks) is stopped
+and its worker replaced; a full queue, a time limit or a worker's memory cap is a 503 that
+says which, with a ``Retry-After`` header.
 """
 
 from __future__ import annotations
