@@ -154,3 +154,27 @@ def test_errors_of_the_work_come_back_with_their_status() -> None:
 
     err = run(go())
     assert err.status == 500 and "math domain error" in str(err)
+
+
+def test_closing_a_lane_stops_busy_workers() -> None:
+    async def go() -> int:
+        lane = Lane("t", size=1, queue=1)
+        pid = await lane.run(os.getpid, (), timeout=30)
+        task = asyncio.ensure_future(lane.run(time.sleep, (60,), timeout=120))
+        await asyncio.sleep(0.3)
+        lane.close()
+        task.cancel()
+        with pytest.raises((asyncio.CancelledError, LimitError)):
+            await task
+        return pid
+
+    pid = run(go())
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.05)
+    else:
+        pytest.fail("the busy worker still runs after the lane was closed")

@@ -245,6 +245,7 @@ class Lane:
         # threads that wait on the workers' pipes and reap killed workers, off the event loop
         self._threads = ThreadPoolExecutor(2 * self.size + 2, thread_name_prefix=f"bg-{self.name}")
         self._lock = threading.Lock()
+        self._workers: set[_Worker] = set()  # every worker started and not yet forgotten
 
     # -- state ---------------------------------------------------------------------------
 
@@ -426,7 +427,10 @@ class Lane:
         )
         process.start()
         theirs.close()
-        return _Worker(process, ours, _resident(process.pid))
+        worker = _Worker(process, ours, _resident(process.pid))
+        with self._lock:
+            self._workers.add(worker)
+        return worker
 
     def _release(self, worker: _Worker) -> None:
         """Hand ``worker`` to the first request waiting, or keep it idle."""
@@ -448,6 +452,8 @@ class Lane:
         self._forget(worker, replaced)
 
     def _forget(self, worker: _Worker, replaced: bool = False) -> None:
+        with self._lock:
+            self._workers.discard(worker)
         self.live -= 1
         self.replaced += replaced
         try:
@@ -472,13 +478,21 @@ class Lane:
             spawned.add_done_callback(hand_over)
 
     def close(self) -> None:
-        """Stop every worker (idle ones at once, busy ones as their work ends or is killed)."""
+        """Stop every worker: idle ones are told to end, busy ones are killed."""
         self.closed = True
-        for w in self.idle:
+        idle = list(self.idle)
+        self.idle.clear()
+        with self._lock:
+            busy = [w for w in self._workers if w not in idle]
+            self._workers.clear()
+        for w in idle:
             with contextlib.suppress(Exception):
                 w.conn.send(None)
+        for w in busy:
+            with contextlib.suppress(Exception):
+                w.process.kill()
+        for w in idle + busy:
             _reap(w)
-        self.idle.clear()
         self._threads.shutdown(wait=False, cancel_futures=True)
 
 
