@@ -497,10 +497,11 @@ class Lane:
 
 
 def _reap(worker: _Worker) -> None:
-    worker.process.join(2)
-    if worker.process.is_alive():
-        worker.process.kill()
+    with contextlib.suppress(ValueError):  # reaped already: the process object is closed
         worker.process.join(2)
+        if worker.process.is_alive():
+            worker.process.kill()
+            worker.process.join(2)
     with contextlib.suppress(Exception):
         worker.conn.close()
     with contextlib.suppress(Exception):
