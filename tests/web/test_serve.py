@@ -35,6 +35,15 @@ def test_serve_refuses_a_bad_port() -> None:
     assert result.exit_code == 2
 
 
+@pytest.mark.parametrize(
+    "args",
+    [["--workers", "0"], ["--quick-workers", "0"], ["--queue", "-1"], ["--timeout", "0"]],
+)
+def test_serve_refuses_bad_worker_options(args: list[str]) -> None:
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2, result.output
+
+
 def test_default_data_dir(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))
     assert default_data_dir().name == "bayesgrasp"
