@@ -22,6 +22,7 @@ def test_serve_help_names_the_options() -> None:
         "--timeout",
         "--workers",
         "--quick-workers",
+        "--figure-workers",
         "--worker-memory",
         "--queue",
         "--job-timeout",

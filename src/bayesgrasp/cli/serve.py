@@ -51,10 +51,11 @@ def serve(
     ] = 2,
     quick_workers: Annotated[
         int,
-        typer.Option(
-            min=1, metavar="N", help="Worker processes for squeeze, push, plans and figures."
-        ),
+        typer.Option(min=1, metavar="N", help="Worker processes for squeeze, push and plans."),
     ] = 2,
+    figure_workers: Annotated[
+        int, typer.Option(min=1, metavar="N", help="Worker processes drawing figures.")
+    ] = 1,
     worker_memory: Annotated[
         int,
         typer.Option(
@@ -77,9 +78,9 @@ def serve(
 ) -> None:
     """Serve the page (draw or upload a part, see its plans) and the JSON API at /api/v1.
 
-    Planning runs in worker processes: a quick lane (squeeze, push, plans, figures) and a
-    heavy lane (policies, noise-aware plans, simulations), each with a bounded queue, so a
-    slow request never delays a light one. Work past its time limit is stopped and its
+    Planning runs in worker processes: a quick lane (squeeze, push, plans), a lane drawing
+    figures and a heavy lane (policies, noise-aware plans, simulations), each with a bounded
+    queue, so a slow request never delays a light one. Work past its time limit is stopped and its
     worker replaced. The API's reference is at /docs and /redoc.
     """
     try:
@@ -97,6 +98,7 @@ def serve(
         gallery_rows=gallery_rows,
         workers=workers,
         quick_workers=quick_workers,
+        figure_workers=figure_workers,
         worker_memory=worker_memory or None,
         queue=queue,
         job_time_limit=job_timeout,
@@ -104,8 +106,8 @@ def serve(
     web = create_app(folder, limits)
     typer.echo(
         f"bayesgrasp: serving http://{host}:{port}/ (API /api/v1, reference /docs; gallery in "
-        f"{folder}); {quick_workers} quick and {workers} heavy workers, time limit {timeout:g} s, "
-        f"queue {queue}; Ctrl-C stops",
+        f"{folder}); {quick_workers} quick, {figure_workers} figure and {workers} heavy workers, "
+        f"time limit {timeout:g} s, queue {queue}; Ctrl-C stops",
         err=True,
     )
     uvicorn.run(web, host=host, port=port, log_level="warning")

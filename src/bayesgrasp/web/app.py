@@ -9,8 +9,9 @@ body ``{detail, error, status}`` (:class:`~bayesgrasp.web.models.ErrorBody`): ba
 a 422, each naming the limit.
 
 The work runs in worker processes (:mod:`bayesgrasp.web.workers`), never on the server's
-event loop: a quick lane (squeeze and push functions, plans, figures) and a heavy lane
-(policies, noise-aware plans, simulations and simulation jobs), each with a bounded queue.
+event loop: a quick lane (squeeze and push functions, plans), a lane for figures and a
+heavy lane (policies, noise-aware plans, simulations and simulation jobs), each with a
+bounded queue.
 Work past its time limit (:attr:`Limits.time_limit`, or less if the request asks) is stopped
 and its worker replaced; a full queue, a time limit or a worker's memory cap is a 503 that
 says which, with a ``Retry-After`` header.
@@ -77,6 +78,7 @@ __all__ = ["API", "Limits", "create_app"]
 API = "/api/v1"
 FigureName = Literal["part", "diameter", "transfer", "plan"]
 FigureFormat = Literal["png", "svg"]
+LaneName = Literal["quick", "figures", "heavy"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,7 +100,10 @@ class Limits:
         Worker processes of the heavy lane: policies, noise-aware plans, simulations and
         simulation jobs.
     quick_workers : int
-        Worker processes of the quick lane: squeeze and push functions, plans, figures.
+        Worker processes of the quick lane: squeeze and push functions, plans.
+    figure_workers : int
+        Worker processes drawing figures (about a second each; apart, so that the quick
+        lane stays quick).
     queue : int
         Requests that may wait for a worker, in each lane (more: 503 at once).
     worker_memory : int or None
@@ -120,6 +125,7 @@ class Limits:
     max_trials: int = 1_000_000
     workers: int = 2
     quick_workers: int = 2
+    figure_workers: int = 1
     queue: int = 16
     worker_memory: int | None = 2048
     gallery_rows: int = 500
@@ -216,14 +222,16 @@ class Service:
         self.figure_lock = threading.Lock()
         self._lanes: dict[str, Lane] = {}
 
-    def lane(self, heavy: bool) -> Lane:
-        """The heavy lane (``heavy``) or the quick one, started on first use."""
-        name = "heavy" if heavy else "quick"
+    def lane(self, name: LaneName) -> Lane:
+        """The lane ``name`` (``quick``, ``figures`` or ``heavy``), started on first use."""
         if name not in self._lanes:
             lim = self.limits
-            size = lim.workers if heavy else lim.quick_workers
-            # the heavy lane's workers are niced: the quick lane keeps the processor
-            self._lanes[name] = Lane(name, size, lim.queue, lim.worker_memory, 19 if heavy else 0)
+            size = {"quick": lim.quick_workers, "figures": lim.figure_workers}.get(
+                name, lim.workers
+            )
+            # the other lanes' workers are niced: the quick lane keeps the processor
+            nice = {"quick": 0, "figures": 5}.get(name, 19)
+            self._lanes[name] = Lane(name, size, lim.queue, lim.worker_memory, nice)
         return self._lanes[name]
 
     def timeout(self, asked: float | None) -> float:
@@ -238,16 +246,14 @@ class Service:
             )
         return asked
 
-    async def run(
-        self, name: str, req: Any, *extra: Any, heavy: bool = False, timeout: float | None = None
-    ) -> Any:
-        """The work ``name`` (a key of :data:`WORK`) on ``req`` in a worker of a lane."""
-        lane = self.lane(heavy)
+    async def run(self, name: str, req: Any, *extra: Any, timeout: float | None = None) -> Any:
+        """The work ``name`` (a key of :data:`WORK`) on ``req`` in a worker of its lane."""
+        lane = self.lane(lane_of(name, req))
         return await lane.run(_work, (name, self.limits, req, *extra), self.timeout(timeout))
 
     async def answer(self, name: str, req: Any, timeout: float | None = None) -> Response:
         """The JSON answer of the work ``name`` on ``req`` (a plan is added to the gallery)."""
-        lane = self.lane(_heavy(name, req))
+        lane = self.lane(lane_of(name, req))
         args = (name, self.limits, req)
         body, entry = await lane.run(_work_json, args, self.timeout(timeout))
         if entry is not None and self.gallery is not None:
@@ -721,11 +727,17 @@ def _work_json(name: str, limits: Limits, req: Any) -> tuple[bytes, tuple[Any, .
     return body, (gallery_entry(req, doc) if name == "plan" else None)
 
 
-def _heavy(name: str, req: Any) -> bool:
-    """Whether the work goes to the heavy lane (policies, noise, simulations, bfs)."""
+def lane_of(name: str, req: Any) -> LaneName:
+    """The lane of the work ``name`` on ``req``.
+
+    ``heavy``: policies, simulations, noise-aware plans and the ``bfs`` method; ``figures``:
+    figures (about a second of drawing each); ``quick``: the rest.
+    """
     if name in ("policy", "simulate"):
-        return True
-    return bool(getattr(req, "noisy", False)) or getattr(req, "method", "exact") != "exact"
+        return "heavy"
+    if bool(getattr(req, "noisy", False)) or getattr(req, "method", "exact") != "exact":
+        return "heavy"
+    return "figures" if name == "figure" else "quick"
 
 
 ERRORS: dict[int | str, dict[str, Any]] = {
@@ -760,7 +772,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     """The application: API under ``/api/v1``, OpenAPI at ``/openapi.json``, the page at ``/``.
 
     Planning runs in worker processes (:mod:`bayesgrasp.web.workers`): a quick lane (squeeze
-    and push functions, plans, figures) and a heavy lane (policies, noise-aware plans,
+    and push functions, plans), a figures lane and a heavy lane (policies, noise-aware plans,
     simulations), each with a bounded queue; work past its time limit is stopped.
 
     Parameters
@@ -786,7 +798,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
 
     @asynccontextmanager
     async def lifespan(_: FastAPI) -> AsyncIterator[None]:
-        await service.lane(False).prestart()  # the quick lane is ready for the first request
+        await service.lane("quick").prestart()  # the quick lane is ready for the first request
         yield
         jobs.cancel_all()
         service.close()
@@ -801,8 +813,9 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "`{detail, error, status}`. Limits: request bodies up to "
             f"{lim.max_body_bytes} bytes, parts up to {lim.max_vertices} vertices, "
             f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials; "
-            f"{lim.quick_workers} quick and {lim.workers} heavy worker processes ({memory} "
-            f"each), {lim.queue} requests waiting in each lane."
+            f"worker processes: {lim.quick_workers} quick (squeeze, push, plans), "
+            f"{lim.figure_workers} for figures, {lim.workers} heavy (policies, noise, "
+            f"simulations), {memory} each; {lim.queue} requests waiting in each lane."
         ),
         docs_url=None,
         redoc_url=None,
@@ -896,7 +909,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     )
     async def simulate_job(req: SimulateJobRequest) -> JSONResponse:
         """Start a simulation job (``simulate --engine mujoco|kinematic --json``); poll it."""
-        lane = service.lane(True)
+        lane = service.lane("heavy")
         if lane.full():
             raise LimitError(
                 503,
@@ -1047,6 +1060,7 @@ def _limits(lim: Limits) -> dict[str, Any]:
         "max_trials": lim.max_trials,
         "workers": lim.workers,
         "quick_workers": lim.quick_workers,
+        "figure_workers": lim.figure_workers,
         "queue": lim.queue,
         "worker_memory_mb": lim.worker_memory,
         "job_time_limit_s": lim.job_time_limit,
