@@ -178,3 +178,19 @@ def test_closing_a_lane_stops_busy_workers() -> None:
         time.sleep(0.05)
     else:
         pytest.fail("the busy worker still runs after the lane was closed")
+
+
+@pytest.mark.parametrize(
+    ("limits", "match"),
+    [
+        ({"workers": 0}, "workers must be at least 1"),
+        ({"queue": -1}, "queue must be at least 0"),
+        ({"time_limit": 0}, "must be positive"),
+        ({"worker_memory": 0}, "worker_memory"),
+    ],
+)
+def test_bad_limits_are_refused(limits: dict[str, Any], match: str) -> None:
+    from bayesgrasp.web.app import Limits
+
+    with pytest.raises(ValueError, match=match):
+        Limits(**limits)

@@ -133,6 +133,25 @@ class Limits:
     max_jobs: int = 100
     max_mujoco_trials: int = 2000
 
+    def __post_init__(self) -> None:
+        counts = {
+            "workers": self.workers,
+            "quick_workers": self.quick_workers,
+            "figure_workers": self.figure_workers,
+            "max_jobs": self.max_jobs,
+        }
+        for name, value in counts.items():
+            if value < 1:
+                raise ValueError(f"Limits.{name} must be at least 1; got {value}")
+        if self.queue < 0:
+            raise ValueError(f"Limits.queue must be at least 0; got {self.queue}")
+        if not (self.time_limit > 0 and self.job_time_limit > 0):
+            raise ValueError("Limits.time_limit and Limits.job_time_limit must be positive")
+        if self.worker_memory is not None and self.worker_memory < 1:
+            raise ValueError(
+                f"Limits.worker_memory must be at least 1 MB or None; got {self.worker_memory}"
+            )
+
 
 def _error(status: int, detail: str, kind: str, retry_after: int | None = None) -> JSONResponse:
     headers = {"Retry-After": str(retry_after)} if retry_after is not None else None
