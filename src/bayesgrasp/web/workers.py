@@ -460,18 +460,20 @@ class Lane:
             self._threads.submit(_reap, worker)
         except RuntimeError:  # closed: reap here (the worker was killed or told to stop)
             _reap(worker)
-        if self.waiting and not self.closed:  # someone waits: start a worker for them
+        if not self.closed:  # a replacement starts now (off the loop), ready for the next work
             self.live += 1
             loop = asyncio.get_running_loop()
             spawned = loop.run_in_executor(self._threads, self._spawn)
 
             def hand_over(f: asyncio.Future[_Worker]) -> None:
-                if f.exception() is not None:
+                if f.cancelled() or f.exception() is not None:
                     self.live -= 1
                     while self.waiting:
                         wait = self.waiting.popleft()
                         if not wait.done():
-                            wait.set_exception(f.exception())  # type: ignore[arg-type]
+                            wait.set_exception(
+                                LimitError(503, "no worker could be started", "worker-stopped")
+                            )
                     return
                 self._release(f.result())
 
