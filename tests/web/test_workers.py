@@ -194,3 +194,21 @@ def test_bad_limits_are_refused(limits: dict[str, Any], match: str) -> None:
 
     with pytest.raises(ValueError, match=match):
         Limits(**limits)
+
+
+def test_a_worker_that_dies_is_a_503_and_is_replaced() -> None:
+    async def go() -> tuple[LimitError, int, int]:
+        lane = Lane("t", size=1, queue=1, memory_mb=None)
+        try:
+            first = await lane.run(os.getpid, (), timeout=30)
+            with pytest.raises(LimitError) as err:
+                await lane.run(os._exit, (7,), timeout=30)
+            second = await lane.run(os.getpid, (), timeout=30)
+            return err.value, first, second
+        finally:
+            lane.close()
+
+    err, first, second = run(go())
+    assert err.status == 503 and err.kind == "worker-stopped"
+    assert "exit code 7" in str(err)
+    assert first != second

@@ -303,8 +303,8 @@ class Lane:
             worker's memory cap was reached; or the status of the work's own error.
         """
         loop = asyncio.get_running_loop()
-        t0 = loop.time()
-        deadline = t0 + timeout
+        deadline = loop.time() + timeout
+        code: int | None = None
         worker = await self._acquire(deadline, timeout)
         if on_start is not None:
             on_start()
@@ -342,8 +342,9 @@ class Lane:
             self._release(worker)
             raise LimitError(status, reason, kind)
         # the worker died without an answer (a crash, or its memory cap hit in C code)
+        with contextlib.suppress(ValueError):
+            code = worker.process.exitcode  # before the reaper closes the process object
         self._forget(worker, replaced=True)
-        code = worker.process.exitcode
         raise LimitError(
             503,
             f"the worker stopped during the work (exit code {code}); it may have reached its "
