@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import base64
 import json
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -184,22 +185,63 @@ def test_too_many_trials_is_422(make_client: Any) -> None:
 
 
 def test_a_long_plan_is_503_and_the_server_keeps_serving(make_client: Any) -> None:
-    client = make_client(time_limit=0.2, workers=2)
+    client = make_client(time_limit=0.5, workers=1)
     slow = {"part": {"catalogue": "hand"}, "trials": 10**6}  # about a second of work
     t0 = time.perf_counter()
     r = client.post("/api/v1/simulate", json=slow)
     assert r.status_code == 503, r.text
-    assert "time limit of 0.2 s" in r.json()["detail"]
+    assert r.json()["error"] == "timeout"
+    assert "time limit of 0.5 s" in r.json()["detail"]
+    assert int(r.headers["retry-after"]) >= 1
     assert time.perf_counter() - t0 < 5
-    assert client.get("/api/v1/health").json()["status"] == "ok"
+    health = client.get("/api/v1/health").json()
+    assert health["status"] == "ok"
+    assert health["lanes"]["heavy"]["killed"] >= 1
     assert client.post("/api/v1/squeeze", json={"part": {"catalogue": "key"}}).status_code == 200
+    # the killed worker is replaced: the next simulation is answered
+    client = make_client(time_limit=30.0, workers=1)
+    r = client.post("/api/v1/simulate?timeout=0.5", json=slow)
+    assert r.status_code == 503, r.text
+    r = client.post("/api/v1/simulate", json={**slow, "trials": 1000})
+    assert r.status_code == 200, r.text
+    assert client.get("/api/v1/health").json()["lanes"]["heavy"]["live"] == 1
 
 
-def test_busy_server_is_503(make_client: Any) -> None:
-    client = make_client(max_pending=0)
-    r = client.post("/api/v1/squeeze", json={"part": {"catalogue": "key"}})
+def test_a_request_may_ask_for_a_shorter_time_limit(make_client: Any) -> None:
+    client = make_client(time_limit=5.0)
+    slow = {"part": {"catalogue": "hand"}, "trials": 10**6}
+    r = client.post("/api/v1/simulate?timeout=0.3", json=slow)
+    assert r.status_code == 503, r.text
+    assert "time limit of 0.3 s" in r.json()["detail"]
+    r = client.post("/api/v1/simulate?timeout=6", json=slow)
+    assert r.status_code == 422
+    assert r.json()["detail"] == "`timeout` is 6 s; the server's time limit is 5 s"
+
+
+def test_a_full_queue_is_503_at_once(make_client: Any) -> None:
+    client = make_client(queue=0, workers=1, time_limit=5.0)
+    slow = {"part": {"catalogue": "hand"}, "trials": 10**6}
+    answers: list[Any] = []
+    thread = threading.Thread(
+        target=lambda: answers.append(client.post("/api/v1/simulate?timeout=2", json=slow))
+    )
+    thread.start()
+    deadline = time.monotonic() + 10
+    while client.get("/api/v1/health").json()["lanes"].get("heavy", {}).get("idle", 1) != 0:
+        assert time.monotonic() < deadline
+        time.sleep(0.05)  # the first simulation has the only heavy worker
+    while client.get("/api/v1/health").json()["lanes"]["heavy"]["live"] != 1:
+        time.sleep(0.05)
+    t0 = time.perf_counter()
+    r = client.post("/api/v1/simulate", json=slow)
+    assert time.perf_counter() - t0 < 1.0
     assert r.status_code == 503
-    assert "busy" in r.json()["detail"]
+    assert r.json()["error"] == "queue-full"
+    assert "the queue is full" in r.json()["detail"]
+    assert "retry-after" in r.headers
+    # light work has its own lane
+    assert client.post("/api/v1/plan", json={"part": {"catalogue": "key"}}).status_code == 200
+    thread.join(30)
 
 
 # -- fuzz: the plan endpoint never answers 500 ------------------------------------------------

@@ -14,7 +14,19 @@ from bayesgrasp.web.gallery import Gallery, default_data_dir
 def test_serve_help_names_the_options() -> None:
     result = CliRunner().invoke(app, ["--help"])
     assert result.exit_code == 0
-    for option in ("--host", "--port", "--data", "--gallery-rows", "--time-limit"):
+    for option in (
+        "--host",
+        "--port",
+        "--data",
+        "--gallery-rows",
+        "--timeout",
+        "--workers",
+        "--quick-workers",
+        "--figure-workers",
+        "--worker-memory",
+        "--queue",
+        "--job-timeout",
+    ):
         assert option in result.output
     assert "127.0.0.1" in result.output
 
@@ -22,6 +34,15 @@ def test_serve_help_names_the_options() -> None:
 def test_serve_refuses_a_bad_port() -> None:
     result = CliRunner().invoke(app, ["--port", "70000"])
     assert result.exit_code == 2
+
+
+@pytest.mark.parametrize(
+    "args",
+    [["--workers", "0"], ["--quick-workers", "0"], ["--queue", "-1"], ["--timeout", "0"]],
+)
+def test_serve_refuses_bad_worker_options(args: list[str]) -> None:
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2, result.output
 
 
 def test_default_data_dir(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:

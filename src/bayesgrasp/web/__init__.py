@@ -2,8 +2,10 @@
 
 :func:`create_app` builds the FastAPI application: the JSON API under ``/api/v1`` (every
 answer the same document the command line prints with ``--json``), its OpenAPI schema at
-``/openapi.json``, the page at ``/`` and the gallery of planned parts (SQLite). Nothing here
-is imported by the library's core.
+``/openapi.json`` (Swagger UI at ``/docs``, ReDoc at ``/redoc``, served from local files),
+the page at ``/`` and the gallery of planned parts (SQLite). The planning runs in worker
+processes (:mod:`bayesgrasp.web.workers`) stopped at a time limit; simulations can run as
+jobs (:mod:`bayesgrasp.web.jobs`). Nothing here is imported by the library's core.
 """
 
 from __future__ import annotations

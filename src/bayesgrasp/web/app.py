@@ -2,13 +2,19 @@
 
 Every API answer is the document the command line prints with ``--json``, built by the same
 library calls (:class:`~bayesgrasp.cli.specs.ProblemSpec`,
-:func:`bayesgrasp.io.plans.plan_document`, :mod:`bayesgrasp.report`). Bad input is a 422
-whose ``detail`` is the command line's one-line message; a body over
+:func:`bayesgrasp.io.plans.plan_document`, :mod:`bayesgrasp.report`). Every error is a JSON
+body ``{detail, error, status}`` (:class:`~bayesgrasp.web.models.ErrorBody`): bad input is a
+422 whose ``detail`` is the command line's one-line message; a body over
 :attr:`Limits.max_body_bytes` is a 413 and a part over :attr:`Limits.max_vertices` vertices
-a 422, each naming the limit; work runs in a pool of threads under :attr:`Limits.time_limit`
-seconds (then a 503; the server keeps serving). Noise-aware plans, which can take minutes,
-run in threads of their own (:attr:`Limits.noisy_workers`), so that they never hold the
-threads of the light requests.
+a 422, each naming the limit.
+
+The work runs in worker processes (:mod:`bayesgrasp.web.workers`), never on the server's
+event loop: a quick lane (squeeze and push functions, plans), a lane for figures and a
+heavy lane (policies, noise-aware plans, simulations and simulation jobs), each with a
+bounded queue.
+Work past its time limit (:attr:`Limits.time_limit`, or less if the request asks) is stopped
+and its worker replaced; a full queue, a time limit or a worker's memory cap is a 503 that
+says which, with a ``Retry-After`` header.
 """
 
 from __future__ import annotations
@@ -16,21 +22,29 @@ from __future__ import annotations
 import asyncio
 import base64
 import binascii
+import functools
 import io
 import json
 import math
 import threading
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import AsyncIterator, Callable
+from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal, TypeVar
+from typing import TYPE_CHECKING, Any, Literal
 
 try:
     from fastapi import FastAPI, File, Form, Query, Request, UploadFile
     from fastapi.exceptions import RequestValidationError
-    from fastapi.responses import FileResponse, JSONResponse, RedirectResponse, Response
+    from fastapi.openapi.docs import get_redoc_html, get_swagger_ui_html
+    from fastapi.responses import (
+        FileResponse,
+        HTMLResponse,
+        JSONResponse,
+        RedirectResponse,
+        Response,
+    )
     from fastapi.staticfiles import StaticFiles
     from pydantic import BaseModel, ValidationError
     from starlette.exceptions import HTTPException as StarletteHTTPException
@@ -42,14 +56,17 @@ except ImportError as exc:  # pragma: no cover - the extra is missing
 from ..errors import BayesGraspError, NoPlanError
 from .gallery import Gallery
 from .models import (
+    ErrorBody,
     FigureRequest,
     PartIn,
     PartRequest,
     PlanRequest,
     PolicyRequest,
     ProblemOptions,
+    SimulateJobRequest,
     SimulateRequest,
 )
+from .workers import Lane, LimitError, failure_of
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
@@ -59,14 +76,14 @@ if TYPE_CHECKING:
 __all__ = ["API", "Limits", "create_app"]
 
 API = "/api/v1"
-T = TypeVar("T")
 FigureName = Literal["part", "diameter", "transfer", "plan"]
 FigureFormat = Literal["png", "svg"]
+LaneName = Literal["quick", "figures", "heavy"]
 
 
 @dataclass(frozen=True, slots=True)
 class Limits:
-    """What one request may ask of the server.
+    """What one request may ask of the server, and the server's workers.
 
     Attributes
     ----------
@@ -75,42 +92,72 @@ class Limits:
     max_vertices : int
         Most vertices (or outline points) of a part (more: 422).
     time_limit : float
-        Seconds a request's work may take (longer: 503).
+        Seconds a request's work may take, waiting in the queue included (then its worker
+        is killed and the answer is a 503). A request may ask for less (``?timeout=S``).
     max_trials : int
-        Most simulation trials a request may ask for (more: 422).
+        Most kinematic simulation trials a request may ask for (more: 422).
     workers : int
-        Threads doing the work.
-    max_pending : int
-        Requests at work or waiting for a thread (more: 503 at once).
+        Worker processes of the heavy lane: policies, noise-aware plans, simulations and
+        simulation jobs.
+    quick_workers : int
+        Worker processes of the quick lane: squeeze and push functions, plans.
+    figure_workers : int
+        Worker processes drawing figures (about a second each; apart, so that the quick
+        lane stays quick).
+    queue : int
+        Requests that may wait for a worker, in each lane (more: 503 at once).
+    worker_memory : int or None
+        Memory a worker may take beyond its libraries, MB (``RLIMIT_AS``; more: 503 and the
+        worker is replaced). ``None``: no cap.
     gallery_rows : int
         Rows the gallery keeps.
-    noisy_workers : int
-        Threads for noise-aware plans (``turn_noise``, ``contact_noise``, ``payoff``), apart
-        from the others: such a plan can take minutes, and a thread past its time limit
-        cannot be stopped, so these requests may hold only these threads (more at once: 503
-        at once) and never keep the light requests waiting.
+    job_time_limit : float
+        Seconds a simulation job may take (then it is stopped and marked failed).
+    max_jobs : int
+        Simulation jobs kept (queued, running or finished; the oldest finished go first).
+    max_mujoco_trials : int
+        Most MuJoCo trials a job may ask for (more: 422).
     """
 
     max_body_bytes: int = 1_000_000
     max_vertices: int = 2000
     time_limit: float = 10.0
     max_trials: int = 1_000_000
-    workers: int = 4
-    max_pending: int = 64
+    workers: int = 2
+    quick_workers: int = 2
+    figure_workers: int = 1
+    queue: int = 16
+    worker_memory: int | None = 2048
     gallery_rows: int = 500
-    noisy_workers: int = 1
+    job_time_limit: float = 600.0
+    max_jobs: int = 100
+    max_mujoco_trials: int = 2000
+
+    def __post_init__(self) -> None:
+        counts = {
+            "workers": self.workers,
+            "quick_workers": self.quick_workers,
+            "figure_workers": self.figure_workers,
+            "max_jobs": self.max_jobs,
+        }
+        for name, value in counts.items():
+            if value < 1:
+                raise ValueError(f"Limits.{name} must be at least 1; got {value}")
+        if self.queue < 0:
+            raise ValueError(f"Limits.queue must be at least 0; got {self.queue}")
+        if not (self.time_limit > 0 and self.job_time_limit > 0):
+            raise ValueError("Limits.time_limit and Limits.job_time_limit must be positive")
+        if self.worker_memory is not None and self.worker_memory < 1:
+            raise ValueError(
+                f"Limits.worker_memory must be at least 1 MB or None; got {self.worker_memory}"
+            )
 
 
-class LimitError(Exception):
-    """A request over one of the server's limits."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-
-
-def _error(status: int, detail: str, kind: str) -> JSONResponse:
-    return JSONResponse({"detail": detail, "error": kind, "status": status}, status_code=status)
+def _error(status: int, detail: str, kind: str, retry_after: int | None = None) -> JSONResponse:
+    headers = {"Retry-After": str(retry_after)} if retry_after is not None else None
+    return JSONResponse(
+        {"detail": detail, "error": kind, "status": status}, status_code=status, headers=headers
+    )
 
 
 class BodyLimit:
@@ -182,62 +229,65 @@ def _one_line(exc: RequestValidationError | ValidationError) -> str:
 
 
 class Service:
-    """What the endpoints share: limits, the worker threads, the gallery."""
+    """What the endpoints share: limits, the gallery, the lanes of worker processes.
+
+    The lanes (:class:`~bayesgrasp.web.workers.Lane`) start when first used; a worker builds
+    its own ``Service(limits, None)`` to read parts.
+    """
 
     def __init__(self, limits: Limits, gallery: Gallery | None) -> None:
         self.limits = limits
         self.gallery = gallery
-        self.pool = ThreadPoolExecutor(max_workers=limits.workers, thread_name_prefix="bg-web")
-        self.noisy_pool = ThreadPoolExecutor(
-            max_workers=limits.noisy_workers, thread_name_prefix="bg-web-noisy"
-        )
-        self.pending = 0
-        self.noisy = 0  # noise-aware plans at work (a timed-out one until its thread ends)
-        self.lock = threading.Lock()
         self.figure_lock = threading.Lock()
+        self._lanes: dict[str, Lane] = {}
 
-    async def run(self, work: Callable[[], T], noisy: bool = False) -> T:
-        """Run ``work`` in a worker thread under the time limit (503 when over or busy).
+    def lane(self, name: LaneName) -> Lane:
+        """The lane ``name`` (``quick``, ``figures`` or ``heavy``), started on first use."""
+        if name not in self._lanes:
+            lim = self.limits
+            size = {"quick": lim.quick_workers, "figures": lim.figure_workers}.get(
+                name, lim.workers
+            )
+            # the other lanes' workers are niced: the quick lane keeps the processor
+            nice = {"quick": 0, "figures": 5}.get(name, 19)
+            self._lanes[name] = Lane(name, size, lim.queue, lim.worker_memory, nice)
+        return self._lanes[name]
 
-        ``noisy``: a noise-aware plan, run in its own threads (:attr:`Limits.noisy_workers`).
-        """
-        with self.lock:
-            if self.pending >= self.limits.max_pending:
-                raise LimitError(
-                    503, f"the server is busy ({self.limits.max_pending} requests at work)"
-                )
-            if noisy and self.noisy >= self.limits.noisy_workers:
-                raise LimitError(
-                    503,
-                    f"the server is busy with noise-aware plans ({self.noisy} at work, the "
-                    f"limit is {self.limits.noisy_workers}); try again later or ask for less "
-                    "(a smaller max_actions)",
-                )
-            self.pending += 1
-            self.noisy += noisy
-        pool = self.noisy_pool if noisy else self.pool
-        future = asyncio.get_running_loop().run_in_executor(pool, work)
-        if noisy:
-            future.add_done_callback(lambda _: self._noisy_done())
-        try:
-            return await asyncio.wait_for(asyncio.shield(future), self.limits.time_limit)
-        except TimeoutError:
+    def timeout(self, asked: float | None) -> float:
+        """The time limit of a request that asks for ``asked`` seconds (at most the server's)."""
+        if asked is None:
+            return self.limits.time_limit
+        if asked > self.limits.time_limit:
             raise LimitError(
-                503,
-                f"the request took longer than the time limit of {self.limits.time_limit:g} s; "
-                "ask for less (a smaller max_actions, method exact, fewer trials)",
-            ) from None
-        finally:
-            # a timed-out thread cannot be stopped: it counts as pending until it ends
-            future.add_done_callback(lambda _: self._done())
+                422,
+                f"`timeout` is {asked:g} s; the server's time limit is "
+                f"{self.limits.time_limit:g} s",
+            )
+        return asked
 
-    def _done(self) -> None:
-        with self.lock:
-            self.pending -= 1
+    async def run(self, name: str, req: Any, *extra: Any, timeout: float | None = None) -> Any:
+        """The work ``name`` (a key of :data:`WORK`) on ``req`` in a worker of its lane."""
+        lane = self.lane(lane_of(name, req))
+        return await lane.run(_work, (name, self.limits, req, *extra), self.timeout(timeout))
 
-    def _noisy_done(self) -> None:
-        with self.lock:
-            self.noisy -= 1
+    async def answer(self, name: str, req: Any, timeout: float | None = None) -> Response:
+        """The JSON answer of the work ``name`` on ``req`` (a plan is added to the gallery)."""
+        lane = self.lane(lane_of(name, req))
+        args = (name, self.limits, req)
+        body, entry = await lane.run(_work_json, args, self.timeout(timeout))
+        if entry is not None and self.gallery is not None:
+            await asyncio.to_thread(self.gallery.add, *entry)  # off the event loop
+        return Response(body, media_type="application/json")
+
+    def lanes_status(self) -> dict[str, Any]:
+        """Each started lane's workers and queue."""
+        return {name: lane.status() for name, lane in self._lanes.items()}
+
+    def close(self) -> None:
+        """Stop the workers."""
+        for lane in self._lanes.values():
+            lane.close()
+        self._lanes.clear()
 
     # -- parts and problems ----------------------------------------------------------------
 
@@ -448,10 +498,20 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
         inputs = run_inputs(None, spec)  # the provenance the command line writes
         doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
     if service.gallery is not None:
-        options = req.model_dump(exclude={"part"}, exclude_defaults=True)
-        bayes = doc["options"][doc["bayes"]] if doc["options"] else {}
-        service.gallery.add(part.name, doc["part"]["vertices"], options, bayes)
+        remember_plan(service.gallery, req, doc)
     return doc
+
+
+def remember_plan(gallery: Gallery, req: PlanRequest, doc: dict[str, Any]) -> None:
+    """Add a planned part to the gallery (its name, outline, options and Bayes plan)."""
+    gallery.add(*gallery_entry(req, doc))
+
+
+def gallery_entry(req: PlanRequest, doc: dict[str, Any]) -> tuple[Any, ...]:
+    """The arguments of :meth:`Gallery.add` for a plan: name, outline, options, Bayes plan."""
+    options = req.model_dump(exclude={"part"}, exclude_defaults=True)
+    bayes = doc["options"][doc["bayes"]] if doc.get("options") else {}
+    return doc["part"]["name"], doc["part"]["vertices"], options, bayes
 
 
 def noisy_plan_document(
@@ -511,20 +571,37 @@ def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
     return policy_document(pol)
 
 
-def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
-    """``bayesgrasp simulate PART [options] --engine kinematic --json``."""
+def simulate_document(
+    service: Service,
+    req: SimulateRequest,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict[str, Any]:
+    """``bayesgrasp simulate PART [options] --engine ENGINE --json``.
+
+    A :class:`~bayesgrasp.web.models.SimulateJobRequest` may ask for ``engine`` ``mujoco``
+    (and an ``offset_mm``); ``progress(done, total)`` is called as trials end.
+    """
     from .. import report
     from ..model.noise import NoiseModel, TurnNoise
     from ..model.payoff import as_vector
-    from ..sim.kinematic import simulate_kinematic
 
-    if req.trials > service.limits.max_trials:
-        raise LimitError(422, f"`trials` is {req.trials}; the limit is {service.limits.max_trials}")
+    engine = getattr(req, "engine", "kinematic")
+    offset_mm = float(getattr(req, "offset_mm", 0.0))
+    trials = req.trials if req.trials is not None else (200 if engine == "mujoco" else 100_000)
+    most = service.limits.max_mujoco_trials if engine == "mujoco" else service.limits.max_trials
+    if trials > most:
+        raise LimitError(422, f"`trials` is {trials}; the limit is {most}")
     spec = problem_spec(req)
     p = service.part(req.part)
     if req.turn_noise is not None and (req.noise > 0 or req.noise_kind != "normal"):
         raise LimitError(
             422, "`noise`, `noise_kind`: the older spelling of `turn_noise`; give one of them"
+        )
+    if engine == "mujoco" and req.contact_noise is not None:
+        raise LimitError(
+            422,
+            "`contact_noise`: applies to the kinematic engine only (in MuJoCo the jaws' "
+            "contacts are the physics' own)",
         )
     noise = req.noise_model()
     deg, kind = req.noise, req.noise_kind
@@ -543,17 +620,59 @@ def simulate_document(service: Service, req: SimulateRequest) -> dict[str, Any]:
     else:
         pb, option, _ = _chosen(req.plan, req, p, spec)
     u = None if pay is None else as_vector(pay, pb.states)
-    res = simulate_kinematic(pb, option, req.trials, noise, rng=req.seed, payoff=u)
+    if engine == "mujoco":
+        res = _mujoco(pb, option, trials, noise, req.seed, offset_mm, u, progress)
+    else:
+        from ..sim.kinematic import simulate_kinematic
+
+        res = simulate_kinematic(
+            pb, option, trials, noise, rng=req.seed, payoff=u, progress=progress
+        )
     from ..cli.common import simulate_inputs
     from ..cli.specs import run_inputs
     from ..io.plans import provenance
 
     doc = report.simulate_json(res, p)  # with the provenance the command line writes
-    how = simulate_inputs("kinematic", req.plan, req.seed, req.trials, deg, kind)
+    how = simulate_inputs(engine, req.plan, req.seed, trials, deg, kind, offset_mm)
     how["contact_noise"] = req.contact_noise
     how["payoff"] = None if req.payoff is None else "request"
     doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec))
     return doc
+
+
+def _mujoco(
+    pb: Problem,
+    option: PlanOption,
+    trials: int,
+    noise: Any,
+    seed: int,
+    offset_mm: float,
+    payoff: Any,
+    progress: Callable[[int, int], None] | None,
+) -> Any:
+    """The MuJoCo trials of ``simulate --engine mujoco`` (one process: the job's worker)."""
+    from ..sim import simulate_mujoco
+    from ..sim.noise import GripperNoise
+    from ..sim.result import with_prediction
+
+    if offset_mm > 0 and offset_mm / 1000.0 >= pb.part.hull.size:
+        raise LimitError(
+            422,
+            f"`offset_mm`: {offset_mm:g} mm is not less than the part's size "
+            f"({pb.part.hull.size * 1000:.4g} mm from its centroid to its farthest vertex)",
+        )
+    res = simulate_mujoco(
+        pb,
+        option,
+        trials,
+        offset=offset_mm / 1000.0,
+        noise=GripperNoise.of(noise.turn),
+        rng=seed,
+        workers=1,
+        progress=progress,
+    )
+    exact = noise.exact and payoff is None
+    return res if exact else with_prediction(res, pb, noise, payoff)
 
 
 def figure_bytes(service: Service, req: FigureRequest, name: str, fmt: str) -> bytes:
@@ -598,11 +717,82 @@ def catalogue_document() -> dict[str, Any]:
     return {"schema": "bayesgrasp.catalogue/1", "parts": parts}
 
 
+# -- the work the workers do ------------------------------------------------------------------
+
+#: The work a worker may be asked for, by name: ``f(service, request, *extra)``.
+WORK: dict[str, Callable[..., Any]] = {
+    "squeeze": squeeze_document,
+    "push": push_document,
+    "plan": plan_result_document,
+    "policy": policy_document_of,
+    "simulate": simulate_document,
+    "figure": figure_bytes,
+}
+
+
+def _work(name: str, limits: Limits, req: Any, *extra: Any, **kwargs: Any) -> Any:
+    """Run ``WORK[name]`` in a worker process (with a service of its own, no gallery)."""
+    return WORK[name](Service(limits, None), req, *extra, **kwargs)
+
+
+def _work_json(name: str, limits: Limits, req: Any) -> tuple[bytes, tuple[Any, ...] | None]:
+    """``WORK[name]``'s document as JSON bytes, and for a plan its gallery entry.
+
+    The document is encoded in the worker, as the server's JSON answers are encoded, so that
+    the server's event loop only passes the bytes on.
+    """
+    doc = _work(name, limits, req)
+    body = json.dumps(doc, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode()
+    return body, (gallery_entry(req, doc) if name == "plan" else None)
+
+
+def lane_of(name: str, req: Any) -> LaneName:
+    """The lane of the work ``name`` on ``req``.
+
+    ``heavy``: policies, simulations, noise-aware plans and the ``bfs`` method; ``figures``:
+    figures (about a second of drawing each); ``quick``: the rest.
+    """
+    if name in ("policy", "simulate"):
+        return "heavy"
+    if bool(getattr(req, "noisy", False)) or getattr(req, "method", "exact") != "exact":
+        return "heavy"
+    return "figures" if name == "figure" else "quick"
+
+
+ERRORS: dict[int | str, dict[str, Any]] = {
+    413: {"model": ErrorBody, "description": "The request body is over the server's limit."},
+    422: {
+        "model": ErrorBody,
+        "description": "Bad input or over a limit of the request (vertices, trials, "
+        "timeout): `detail` is the command line's one-line message.",
+    },
+    503: {
+        "model": ErrorBody,
+        "description": "The queue is full, the work timed out (its worker was stopped) or "
+        "reached the worker's memory limit; a `Retry-After` header says when to try again.",
+        "headers": {
+            "Retry-After": {"description": "Seconds to wait.", "schema": {"type": "integer"}}
+        },
+    },
+}
+TIMEOUT = Query(
+    None,
+    ge=0.01,
+    le=86_400,
+    description="Seconds this request's work may take (at most the server's time limit, "
+    "the default).",
+)
+
+
 # -- the application --------------------------------------------------------------------------
 
 
 def create_app(data_dir: str | Path | None = None, limits: Limits | None = None) -> FastAPI:
     """The application: API under ``/api/v1``, OpenAPI at ``/openapi.json``, the page at ``/``.
+
+    Planning runs in worker processes (:mod:`bayesgrasp.web.workers`): a quick lane (squeeze
+    and push functions, plans), a figures lane and a heavy lane (policies, noise-aware plans,
+    simulations), each with a bounded queue; work past its time limit is stopped.
 
     Parameters
     ----------
@@ -618,33 +808,49 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     True
     """
     from .. import __version__
+    from .jobs import Jobs
 
     lim = limits or Limits()
     gallery = Gallery(data_dir, lim.gallery_rows) if data_dir is not None else None
     service = Service(lim, gallery)
+    jobs = Jobs(lim.max_jobs)
+
+    @asynccontextmanager
+    async def lifespan(_: FastAPI) -> AsyncIterator[None]:
+        await service.lane("quick").prestart()  # the quick lane is ready for the first request
+        yield
+        jobs.cancel_all()
+        service.close()
+
+    memory = "no memory cap" if lim.worker_memory is None else f"{lim.worker_memory} MB"
     app = FastAPI(
         title="bayesgrasp",
         version=__version__,
         description=(
             "Bayesian squeeze and push-grasp plans for planar parts. Every answer is the "
-            "JSON document `bayesgrasp COMMAND --json` prints. Limits: request bodies up to "
+            "JSON document `bayesgrasp COMMAND --json` prints; every error a JSON body "
+            "`{detail, error, status}`. Limits: request bodies up to "
             f"{lim.max_body_bytes} bytes, parts up to {lim.max_vertices} vertices, "
-            f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials, "
-            f"{lim.noisy_workers} noise-aware plan(s) at a time."
+            f"{lim.time_limit:g} s of work a request, {lim.max_trials} simulation trials; "
+            f"worker processes: {lim.quick_workers} quick (squeeze, push, plans), "
+            f"{lim.figure_workers} for figures, {lim.workers} heavy (policies, noise, "
+            f"simulations), {memory} each; {lim.queue} requests waiting in each lane."
         ),
+        docs_url=None,
+        redoc_url=None,
+        lifespan=lifespan,
     )
     app.state.service = service
+    app.state.jobs = jobs
 
     @app.exception_handler(BayesGraspError)
     async def _bad_input(request: Request, exc: BayesGraspError) -> JSONResponse:
-        if isinstance(exc, NoPlanError):
-            return _error(422, f"no plan: {exc}", "no-plan")
-        return _error(422, str(exc), type(exc).__name__)
+        status, kind, reason = failure_of(exc)
+        return _error(status, reason, kind)
 
     @app.exception_handler(LimitError)
     async def _limit(request: Request, exc: LimitError) -> JSONResponse:
-        kinds = {413: "too-large", 422: "limit", 503: "unavailable"}
-        return _error(exc.status, str(exc), kinds.get(exc.status, "limit"))
+        return _error(exc.status, str(exc), exc.kind, exc.retry_after)
 
     @app.exception_handler(StarletteHTTPException)
     async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:
@@ -654,13 +860,23 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     async def _invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
         return _error(422, _one_line(exc), "invalid-request")
 
-    async def answer(work: Callable[[], dict[str, Any]], noisy: bool = False) -> JSONResponse:
-        return JSONResponse(await service.run(work, noisy))
+    @app.exception_handler(Exception)
+    async def _internal(request: Request, exc: Exception) -> JSONResponse:
+        status, kind, reason = failure_of(exc)
+        return _error(status, reason, kind)
+
+    async def answer(name: str, req: Any, timeout: float | None) -> Response:
+        return await service.answer(name, req, timeout)
 
     @app.get(f"{API}/health", tags=["server"])
     async def health() -> dict[str, Any]:
-        """The server is up; its version and limits."""
-        return {"status": "ok", "version": __version__, "limits": _limits(lim)}
+        """The server is up; its version, limits and worker lanes."""
+        return {
+            "status": "ok",
+            "version": __version__,
+            "limits": _limits(lim),
+            "lanes": service.lanes_status(),
+        }
 
     @app.get(f"{API}/limits", tags=["server"])
     async def limits_() -> dict[str, Any]:
@@ -670,56 +886,114 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     @app.get(f"{API}/catalogue", tags=["parts"])
     async def catalogue() -> JSONResponse:
         """The catalogue parts (:func:`bayesgrasp.shapes.names`)."""
-        return await answer(catalogue_document)
+        return JSONResponse(await asyncio.to_thread(_catalogue))
 
-    @app.post(f"{API}/squeeze", tags=["parts"])
-    async def squeeze(req: PartRequest) -> JSONResponse:
+    @app.post(f"{API}/squeeze", tags=["parts"], responses=ERRORS)
+    async def squeeze(req: PartRequest, timeout: float | None = TIMEOUT) -> Response:
         """Stable orientations of a squeeze (``bayesgrasp squeeze --json``)."""
-        return await answer(lambda: squeeze_document(service, req))
+        return await answer("squeeze", req, timeout)
 
-    @app.post(f"{API}/push", tags=["parts"])
-    async def push(req: PartRequest) -> JSONResponse:
+    @app.post(f"{API}/push", tags=["parts"], responses=ERRORS)
+    async def push(req: PartRequest, timeout: float | None = TIMEOUT) -> Response:
         """Stable orientations of a push and a push-grasp (``bayesgrasp push --json``)."""
-        return await answer(lambda: push_document(service, req))
+        return await answer("push", req, timeout)
 
-    @app.post(f"{API}/plan", tags=["plans"])
-    async def plan(req: PlanRequest) -> JSONResponse:
+    @app.post(f"{API}/plan", tags=["plans"], responses=ERRORS)
+    async def plan(req: PlanRequest, timeout: float | None = TIMEOUT) -> Response:
         """The best plan of every length, Bayes and most certain (``bayesgrasp plan --json``).
 
         With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
-        (``plan --turn-noise ... --json``), in the server's threads for such plans.
+        (``plan --turn-noise ... --json``), in the heavy lane.
         """
-        return await answer(lambda: plan_result_document(service, req), req.noisy)
+        return await answer("plan", req, timeout)
 
-    @app.post(f"{API}/policy", tags=["plans"])
-    async def policy(req: PolicyRequest) -> JSONResponse:
+    @app.post(f"{API}/policy", tags=["plans"], responses=ERRORS)
+    async def policy(req: PolicyRequest, timeout: float | None = TIMEOUT) -> Response:
         """The Bayes policy that branches on jaw widths (``plan --sense ... --json``)."""
-        return await answer(lambda: policy_document_of(service, req), req.noisy)
+        return await answer("policy", req, timeout)
 
-    @app.post(f"{API}/simulate", tags=["plans"])
-    async def simulate(req: SimulateRequest) -> JSONResponse:
+    @app.post(f"{API}/simulate", tags=["plans"], responses=ERRORS)
+    async def simulate(req: SimulateRequest, timeout: float | None = TIMEOUT) -> Response:
         """Kinematic executions of a plan (``bayesgrasp simulate --engine kinematic --json``)."""
-        return await answer(lambda: simulate_document(service, req), req.noisy)
+        return await answer("simulate", req, timeout)
+
+    @app.post(
+        f"{API}/simulate/jobs",
+        tags=["plans"],
+        status_code=202,
+        responses={
+            202: {"description": "The job is queued: its id and where to read it."},
+            **ERRORS,
+        },
+    )
+    async def simulate_job(req: SimulateJobRequest) -> JSONResponse:
+        """Start a simulation job (``simulate --engine mujoco|kinematic --json``); poll it."""
+        lane = service.lane("heavy")
+        if lane.full():
+            raise LimitError(
+                503,
+                f"the queue is full ({lane.queue} requests waiting for the heavy lane); "
+                "try again later",
+                kind="queue-full",
+                retry_after=max(1, math.ceil(min(lim.time_limit, 60))),
+            )
+        total = req.trials or (200 if req.engine == "mujoco" else 100_000)
+
+        async def run(job: Any) -> dict[str, Any]:
+            return await lane.run(  # type: ignore[no-any-return]
+                _work,
+                ("simulate", lim, req),
+                lim.job_time_limit,
+                progress=job.tick,
+                on_start=job.start,
+            )
+
+        job = jobs.submit(total, run)
+        doc = job.document()
+        doc["url"] = f"{API}/simulate/jobs/{job.id}"
+        return JSONResponse(doc, status_code=202, headers={"Location": doc["url"]})
+
+    @app.get(
+        f"{API}/simulate/jobs/{{job_id}}",
+        tags=["plans"],
+        responses={
+            404: {"model": ErrorBody, "description": "No such job (or no longer kept)."},
+            422: ERRORS[422],
+        },
+    )
+    async def simulate_job_status(job_id: str) -> dict[str, Any]:
+        """A simulation job: status, progress (trials done) and, when done, the document."""
+        job = jobs.get(job_id)
+        if job is None:
+            raise LimitError(
+                404,
+                f"no job {job_id!r} (finished jobs are kept while there is room)",
+                kind="not-found",
+            )
+        return job.document()
 
     @app.post(
         f"{API}/figures/{{name}}.{{fmt}}",
         tags=["plans"],
         response_class=Response,
-        responses={200: {"content": {"image/png": {}, "image/svg+xml": {}}}},
+        responses={200: {"content": {"image/png": {}, "image/svg+xml": {}}}, **ERRORS},
     )
-    async def figures(name: FigureName, fmt: FigureFormat, req: FigureRequest) -> Response:
+    async def figures(
+        name: FigureName, fmt: FigureFormat, req: FigureRequest, timeout: float | None = TIMEOUT
+    ) -> Response:
         """A figure of ``bayesgrasp plot``: part, diameter, transfer or plan; PNG or SVG."""
-        data = await service.run(lambda: figure_bytes(service, req, name, fmt))
+        data = await service.run("figure", req, name, fmt, timeout=timeout)
         media = "image/png" if fmt == "png" else "image/svg+xml"
         return Response(data, media_type=media)
 
-    @app.post(f"{API}/{{command}}/upload", tags=["parts"])
+    @app.post(f"{API}/{{command}}/upload", tags=["parts"], responses=ERRORS)
     async def upload(
         command: Literal["squeeze", "push", "plan", "policy", "simulate"],
         file: UploadFile = File(description="A part file (read in memory)."),  # noqa: B008
         format: str = Form(description="json, csv, wkt, geojson, svg or dxf."),
         options: str = Form("{}", description="The other members of the command's body, JSON."),
-    ) -> JSONResponse:
+        timeout: float | None = TIMEOUT,
+    ) -> Response:
         """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``."""
         data = await file.read(lim.max_body_bytes + 1)
         try:
@@ -741,21 +1015,13 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
             "policy": PolicyRequest,
             "simulate": SimulateRequest,
         }
-        model = models[command]
         try:
-            req: Any = model.model_validate({**extra, "part": part})
+            req: Any = models[command].model_validate({**extra, "part": part})
         except ValidationError as exc:
             return _error(422, _one_line(exc), "invalid-request")
-        work: dict[str, Callable[[], dict[str, Any]]] = {
-            "squeeze": lambda: squeeze_document(service, req),
-            "push": lambda: push_document(service, req),
-            "plan": lambda: plan_result_document(service, req),
-            "policy": lambda: policy_document_of(service, req),
-            "simulate": lambda: simulate_document(service, req),
-        }
-        return await answer(work[command], bool(getattr(req, "noisy", False)))
+        return await answer(command, req, timeout)
 
-    @app.get(f"{API}/gallery", tags=["server"])
+    @app.get(f"{API}/gallery", tags=["server"], responses={422: {"model": ErrorBody}})
     async def gallery_rows(limit: int = Query(50, ge=1, le=10_000)) -> dict[str, Any]:
         """The parts planned on this server, newest first."""
         rows = service.gallery.rows(limit) if service.gallery is not None else []
@@ -772,9 +1038,37 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     async def page_alias() -> RedirectResponse:
         return RedirectResponse("/")
 
+    @app.get("/docs", include_in_schema=False)
+    async def swagger() -> HTMLResponse:
+        return get_swagger_ui_html(
+            openapi_url="/openapi.json",
+            title="bayesgrasp API",
+            swagger_js_url=f"{VENDOR}/swagger-ui-bundle.js",
+            swagger_css_url=f"{VENDOR}/swagger-ui.css",
+            swagger_favicon_url=f"{VENDOR}/favicon-32x32.png",
+        )
+
+    @app.get("/redoc", include_in_schema=False)
+    async def redoc() -> HTMLResponse:
+        return get_redoc_html(
+            openapi_url="/openapi.json",
+            title="bayesgrasp API",
+            redoc_js_url=f"{VENDOR}/redoc.standalone.js",
+            redoc_favicon_url=f"{VENDOR}/favicon-32x32.png",
+            with_google_fonts=False,
+        )
+
     app.mount("/static", StaticFiles(directory=str(static)), name="static")
     app.add_middleware(BodyLimit, max_bytes=lim.max_body_bytes)
     return app
+
+
+VENDOR = "/static/vendor"
+
+
+@functools.cache
+def _catalogue() -> dict[str, Any]:
+    return catalogue_document()
 
 
 def _limits(lim: Limits) -> dict[str, Any]:
@@ -783,5 +1077,12 @@ def _limits(lim: Limits) -> dict[str, Any]:
         "max_vertices": lim.max_vertices,
         "time_limit_s": lim.time_limit,
         "max_trials": lim.max_trials,
-        "noisy_workers": lim.noisy_workers,
+        "workers": lim.workers,
+        "quick_workers": lim.quick_workers,
+        "figure_workers": lim.figure_workers,
+        "queue": lim.queue,
+        "worker_memory_mb": lim.worker_memory,
+        "job_time_limit_s": lim.job_time_limit,
+        "max_jobs": lim.max_jobs,
+        "max_mujoco_trials": lim.max_mujoco_trials,
     }

@@ -15,6 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 from pydantic_core import PydanticCustomError
 
 __all__ = [
+    "ErrorBody",
     "FigureRequest",
     "FileIn",
     "PartIn",
@@ -23,6 +24,7 @@ __all__ = [
     "PlanRequest",
     "PolicyRequest",
     "ProblemOptions",
+    "SimulateJobRequest",
     "SimulateRequest",
 ]
 
@@ -49,8 +51,24 @@ class FileIn(_Strict):
     )
 
 
+def _one_way(schema: dict[str, Any], cls: type) -> None:
+    """The part's schema: exactly one of vertices, catalogue and file (``oneOf``).
+
+    ``null`` is read as "not given"; the schema states the three ways without it.
+    """
+    for key in ("vertices", "catalogue", "file"):
+        prop = schema["properties"][key]
+        kept = [x for x in prop.pop("anyOf", []) if x.get("type") != "null"]
+        prop.pop("default", None)
+        if len(kept) == 1:
+            prop.update(kept[0])
+    schema["oneOf"] = [{"required": [key]} for key in ("vertices", "catalogue", "file")]
+
+
 class PartIn(_Strict):
     """A part: give exactly one of ``vertices``, ``catalogue`` and ``file``."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, json_schema_extra=_one_way)
 
     vertices: list[tuple[float, float]] | None = Field(
         None,
@@ -296,3 +314,39 @@ class PolicyRequest(NoiseOptions):
         "most 4, and at most 4 candidate parts: a request past its time limit keeps a "
         "worker busy until it ends).",
     )
+
+
+class SimulateJobRequest(SimulateRequest):
+    """The body of ``simulate/jobs``: a simulation run as a job (``simulate --engine ...``).
+
+    As ``simulate``, with the engine to use: ``mujoco`` runs the plan in the physics engine
+    (``simulate --engine mujoco``; the ``sim`` extra), ``kinematic`` the model's transfer
+    functions.
+    """
+
+    engine: Literal["kinematic", "mujoco"] = Field(
+        "mujoco", description="kinematic: the model's transfer functions; mujoco: physics."
+    )
+    trials: int | None = Field(  # type: ignore[assignment]
+        None,
+        ge=1,
+        description="Executions (default: 200 mujoco, 100,000 kinematic; bounded by the "
+        "server's limits).",
+    )
+    offset_mm: float = Field(
+        0.0,
+        ge=0,
+        le=1e6,
+        description="mujoco: the part's centre is this far off the gripper centre (--offset).",
+    )
+
+
+class ErrorBody(BaseModel):
+    """Every error answer: the reason in one line, its kind and the HTTP status."""
+
+    detail: str = Field(description="The reason, one line (the command line's message).")
+    error: str = Field(
+        description="The kind: invalid-request, limit, no-plan, queue-full, timeout, "
+        "memory-limit, body-too-large, http, or the name of the library's error."
+    )
+    status: int = Field(description="The HTTP status again.")
