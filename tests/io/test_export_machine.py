@@ -466,3 +466,43 @@ def test_the_first_squeeze_decides_the_stroke(name: str) -> None:
         for s in m.states:
             assert s.opening_before <= first.opening_before
             assert s.width_after_min >= first.width_after_min
+
+
+def test_a_noisy_policys_widths_hold_for_parts_turned_with_error() -> None:
+    """Under a uniform turn error the file's openings and widths bound every simulated part.
+
+    Each turn errs by e ~ U[-A, A] (the noise model's relative turn error); the part's
+    orientation is followed in the current gripper frame and read by the file's own rows.
+    The noise-free reading of the same policy is too narrow: some part exceeds its opening.
+    """
+    import dataclasses
+
+    from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    from bayesgrasp.planning.noisy_policy import plan_noisy_policy
+
+    a = math.radians(6.0)
+    (pb,) = _problems(("key",), ("squeeze",), None)
+    pol = plan_noisy_policy(pb, "width:0.5,0.1", 2, NoiseModel(TurnNoise("uniform", a)))
+    noisy = read_machine_csv(machine_csv(policy_machine(pb, pol)))
+    exact = read_machine_csv(machine_csv(policy_machine(pb, dataclasses.replace(pol, noise=None))))
+    gen = np.random.default_rng(7)
+    beyond_exact = 0
+    for local in sample_prior(pb.prior, 4000, gen).tolist():
+        state, first = 1, True
+        while True:
+            rows = noisy[state]
+            turn = 0.0 if first else float(rows[0]["turn_deg"])
+            local = local - math.radians(turn) - (0.0 if first else gen.uniform(-a, a))
+            before = float(pb.diameter(local))
+            if not first:
+                assert before <= float(rows[0]["opening_before"]) * (1 + 1e-9)
+                beyond_exact += before > float(exact[state][0]["opening_before"]) * (1 + 1e-9)
+            local = float(pb.transfer("squeeze")(np.array([local]))[0])
+            width = float(pb.diameter(local))
+            lo, hi = float(rows[0]["width_after_min"]), float(rows[0]["width_after_max"])
+            assert lo * (1 - 1e-9) <= width <= hi * (1 + 1e-9)
+            row = _row_of(rows, float(pol.sensor.read(np.array([width]), gen)[0]))
+            if row["outcome"] != "next":
+                break
+            state, first = int(row["next_state"]), False
+    assert beyond_exact > 0  # the noise-free file would understate the opening

@@ -19,7 +19,11 @@ table. :func:`policy_machine` numbers the tree's action nodes depth first (the r
 "May be in" is exact on the model: each candidate part's states after the first action that
 carry prior mass, moved on through the transfer functions by the commanded turns, and kept on
 a branch when the sensor model gives them a reading in its interval with positive
-probability (every reading of a noisy sensor has some). A linear plan is the same machine
+probability (every reading of a noisy sensor has some). A policy planned under noisy
+actions (:attr:`Policy.noise`) is followed through the noise model's transition matrices
+instead: the states each action reaches with positive probability (a normal turn error cut
+at 12 sigma, as in :mod:`bayesgrasp.model.noise`), and the opening before an action the
+widest over the turn error's support. A linear plan is the same machine
 with one transition a state (:func:`plan_machine`): its angles and openings are those of
 :func:`~bayesgrasp.io.export.robot_steps`.
 
@@ -78,7 +82,8 @@ from numpy.typing import NDArray
 from scipy.special import ndtr
 
 from ..errors import ExportError
-from ..model.problem import Problem
+from ..model.noise import NoiseModel, NoisyTransitions
+from ..model.problem import Problem, nearest_state
 from ..model.sensing import WidthSensor
 from ..planning.policy import Branch, Policy, PolicyNode, Reject
 from ..planning.result import PlanOption
@@ -277,6 +282,7 @@ class _Walk:
     weights: Sequence[float]
     sensor: WidthSensor
     states: list[MachineState | None]
+    noisy: Sequence[NoisyTransitions] | None = None  # the actions' noise, if any
 
     def visit(self, node: PolicyNode, before: Support | None, gamma: float) -> int:
         """Number ``node`` and its subtree; ``before`` the support in the previous frame."""
@@ -286,13 +292,28 @@ class _Walk:
         gamma += step.alpha
         if before is None:  # the first action: every orientation
             opening = _widest(self.problems, self.weights)
-            after = _first_support(self.problems, self.weights, node)
-        else:
+            if self.noisy is None:
+                after = _first_support(self.problems, self.weights, node)
+            else:
+                after = [
+                    nt.stable[nt.initial(step.kind, step.alpha) > 0] if w > 0 else np.empty(0)
+                    for nt, w in zip(self.noisy, self.weights, strict=True)
+                ]
+        elif self.noisy is None:
             moved = [th - step.alpha for th in before]
             opening = _max_of(pb.diameter(th) for pb, th in zip(self.problems, moved, strict=True))
             after = [
                 np.mod(pb.transfer(step.kind)(th), 2 * math.pi) if len(th) else th
                 for pb, th in zip(self.problems, moved, strict=True)
+            ]
+        else:
+            opening = _max_of(
+                _widest_turned(pb, th - step.alpha, nt.noise.turn.support)
+                for pb, th, nt in zip(self.problems, before, self.noisy, strict=True)
+            )
+            after = [
+                _noisy_after(nt, th, step.kind, step.alpha)
+                for th, nt in zip(before, self.noisy, strict=True)
             ]
         widths = [pb.diameter(th) for pb, th in zip(self.problems, after, strict=True)]
         rows = tuple(self.transition(b, after, widths, gamma) for b in node.branches)
@@ -325,6 +346,38 @@ class _Walk:
             world_orientation_rad=world,
             success_probability=nxt.success_probability,
         )
+
+
+def _noisy_after(nt: NoisyTransitions, before: FloatArray, kind: str, alpha: float) -> FloatArray:
+    """The states an action under noise reaches with positive probability from ``before``.
+
+    Positive in the noise model's own transition matrix (a normal turn error is cut at 12
+    sigma, as everywhere in :mod:`bayesgrasp.model.noise`).
+    """
+    if not len(before):
+        return before
+    rows = nearest_state(nt.problem.states, before)
+    reach = nt.matrix(kind, alpha)[rows].sum(axis=0) > 0
+    return np.asarray(nt.stable[reach], dtype=np.float64)
+
+
+def _widest_turned(pb: Problem, theta: FloatArray, err: float) -> FloatArray:
+    """Each orientation's widest opening over a turn error in ``[-err, err]``.
+
+    ``d`` is largest on an interval at an end or at one of its maxima inside.
+    """
+    if not len(theta) or err <= 0:
+        return np.asarray(pb.diameter(theta), dtype=np.float64)
+    d = pb.diameter
+    best = np.maximum(d(theta - err), d(theta + err))
+    peaks = np.asarray(d.maxima, dtype=np.float64)
+    if len(peaks):
+        # A maximum m (period pi) inside [theta - err, theta + err].
+        off = np.mod(peaks[None, :] - (theta[:, None] - err), math.pi)
+        inside = off <= 2 * err
+        vals = np.where(inside, d(peaks)[None, :], -np.inf)
+        best = np.maximum(best, vals.max(axis=1))
+    return np.asarray(best, dtype=np.float64)
 
 
 def _max_of(arrays: Iterable[FloatArray]) -> float:
@@ -360,9 +413,13 @@ def _build(
     weights: Sequence[float],
     sensor: WidthSensor,
     figures: dict[str, Any],
+    noise: NoiseModel | None = None,
 ) -> RobotMachine:
     _check_kinds(pbs, root)
-    walk = _Walk(pbs, weights, sensor, [])
+    noisy = None
+    if noise is not None and not noise.exact:
+        noisy = [NoisyTransitions(pb, noise) for pb in pbs]
+    walk = _Walk(pbs, weights, sensor, [], noisy)
     walk.visit(root, None, 0.0)
     states = tuple(s for s in walk.states if s is not None)
     names = tuple(pb.part.name for pb in pbs)
@@ -408,7 +465,7 @@ def policy_machine(problems: Problem | Iterable[Problem], policy: Policy) -> Rob
         "reject_probability": json_float(policy.reject_probability),
         "expected_actions": json_float(policy.expected_actions),
     }
-    return _build(pbs, policy.root, policy.part_prior, policy.sensor, figures)
+    return _build(pbs, policy.root, policy.part_prior, policy.sensor, figures, policy.noise)
 
 
 def plan_machine(problem: Problem, option: PlanOption) -> RobotMachine:
