@@ -219,3 +219,25 @@ def test_pose_prior_perturbed_is_near_the_quasi_static(wedge_file: Path, capsys)
     qs = json.loads(capsys.readouterr().out)["part_prior"]
     assert_allclose(sum(pert), 1.0, atol=1e-12)
     assert_allclose(pert, qs, atol=0.03)
+
+
+@pytest.mark.parametrize("command", ["simulate", "plot"])
+def test_simulate_and_plot_take_the_pose_options(
+    wedge_file: Path, tmp_path: Path, capsys, command: str
+) -> None:
+    """--goal-pose and --pose-prior reach simulate and plot as they reach plan."""
+    plan = ["plan", str(wedge_file), "--sense", "width", "--goal-pose", "any", "--json"]
+    assert main(plan) == 0
+    doc = json.loads(capsys.readouterr().out)
+    argv = [command, str(wedge_file), "--sense", "width", "--goal-pose", "any", "--json"]
+    argv += ["--trials", "2000"] if command == "simulate" else ["--out", str(tmp_path / "f")]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    if command == "simulate":
+        assert out["expected_cost"]["predicted"] == pytest.approx(doc["expected_cost"], 1e-12)
+    else:
+        assert (tmp_path / "f" / "policy.png").exists()
+    assert main([command, str(wedge_file), "--goal-pose", "1"]) == 2  # no --sense
+    assert "add --sense" in capsys.readouterr().err
+    assert main([command, "house", "--sense", "width", "--pose-prior", "perturbed"]) == 2
+    assert "for a mesh PART" in capsys.readouterr().err

@@ -270,20 +270,27 @@ def pose_sensing(
         prior,
         sensing.max_actions,
         sensing.max_memory_mb,
+        sensing.time_limit_s,
         footprints=footprints,
     )
     return sense, problems
 
 
 def mesh_sensing(
-    part: PartSpec, sensing: SenseSpec, spec: ProblemSpec, candidates: bool
+    part: PartSpec,
+    sensing: SenseSpec,
+    spec: ProblemSpec,
+    candidates: bool,
+    goal_pose: str | None = None,
+    pose_prior: str | None = None,
 ) -> tuple[SenseSpec, ProblemSpec]:
     """``simulate`` and ``plot`` with --sense: a mesh PART's policy is over its poses.
 
-    As ``plan MESH --sense`` with its defaults (goal pose 0, the quasi-static pose prior);
-    any other PART is returned as it came.
+    As ``plan MESH --sense --goal-pose K --pose-prior P`` (default goal pose 0, the
+    quasi-static pose prior); any other PART is returned as it came (and the pose options
+    refused).
     """
+    mesh_options(part, sensing.sense, None, goal_pose, pose_prior, candidates, None)
     if not is_mesh_part(part):
         return sensing, spec
-    mesh_options(part, sensing.sense, None, None, None, candidates, None)
-    return pose_sensing(part, sensing, spec, None, None)
+    return pose_sensing(part, sensing, spec, goal_pose, pose_prior)

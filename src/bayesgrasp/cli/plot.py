@@ -18,11 +18,13 @@ from .common import (
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
+    GoalPoseOpt,
     JsonOpt,
     MaxMemoryOpt,
     PartPriorOpt,
     PayoffOpt,
     PlanChoiceOpt,
+    PosePriorOpt,
     SenseOpt,
     TimeLimitOpt,
     TurnNoiseOpt,
@@ -88,6 +90,8 @@ def plot(
     part_prior: PartPriorOpt = None,
     max_memory: MaxMemoryOpt = None,
     time_limit: TimeLimitOpt = None,
+    goal_pose: GoalPoseOpt = None,
+    pose_prior: PosePriorOpt = None,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
     payoff: PayoffOpt = None,
@@ -125,12 +129,18 @@ def plot(
         sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
         from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
 
-        sensing, spec = mesh_sensing(part, sensing, spec, bool(also or part_prior))
+        sensing, spec = mesh_sensing(
+            part, sensing, spec, bool(also or part_prior), goal_pose, pose_prior
+        )
         action = sense_noise(turn_noise, contact_noise, payoff)
         plot_policy_command(part, spec, sensing, out, formats, as_json, action)
         return
     if also or part_prior is not None:
         raise typer.BadParameter("--also and --part-prior need --sense")
+    if goal_pose is not None or pose_prior is not None:
+        raise typer.BadParameter(
+            "--goal-pose and --pose-prior plan a policy over poses: add --sense"
+        )
     if (max_memory, time_limit) != (None, None):
         raise typer.BadParameter(
             "--max-memory and --time-limit bound a policy search: they need --sense"

@@ -22,11 +22,13 @@ from .common import chosen_plan, emit_json, simulate_inputs, with_progress
 from .options import (
     AlsoOpt,
     ContactNoiseOpt,
+    GoalPoseOpt,
     JsonOpt,
     MaxMemoryOpt,
     PartPriorOpt,
     PayoffOpt,
     PlanChoiceOpt,
+    PosePriorOpt,
     SenseOpt,
     TimeLimitOpt,
     TurnNoiseOpt,
@@ -143,6 +145,8 @@ def simulate(
     part_prior: PartPriorOpt = None,
     max_memory: MaxMemoryOpt = None,
     time_limit: TimeLimitOpt = None,
+    goal_pose: GoalPoseOpt = None,
+    pose_prior: PosePriorOpt = None,
     sensor_error: SensorErrorOpt = False,
     jaw_lag: JawLagOpt = 0.0,
 ) -> None:
@@ -216,7 +220,9 @@ def simulate(
         sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
         from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
 
-        sensing, spec = mesh_sensing(part, sensing, spec, bool(also or part_prior))
+        sensing, spec = mesh_sensing(
+            part, sensing, spec, bool(also or part_prior), goal_pose, pose_prior
+        )
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
             sensor_error, as_json, action, jaw_lag,
@@ -224,6 +230,10 @@ def simulate(
         return
     if also or part_prior is not None or sensor_error:
         raise typer.BadParameter("--also, --part-prior and --sensor-error need --sense")
+    if goal_pose is not None or pose_prior is not None:
+        raise typer.BadParameter(
+            "--goal-pose and --pose-prior plan a policy over poses: add --sense"
+        )
     if (max_memory, time_limit) != (None, None):
         raise typer.BadParameter(
             "--max-memory and --time-limit bound a policy search: they need --sense"
