@@ -17,7 +17,9 @@ import matplotlib.pyplot as plt
 import bayesgrasp as bg
 from bayesgrasp.figures import diameter_figure, part_figure
 
-ROOT = Path(__file__).resolve().parents[2]
+# The repository's root: where this script runs from, or above it (the docs build runs it
+# from docs/tutorials).
+ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists())
 BAYESGRASP = str(Path(sys.executable).parent / "bayesgrasp")
 
 

@@ -15,7 +15,9 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-ROOT = Path(__file__).resolve().parents[2]
+# The repository's root: where this script runs from, or above it (the docs build runs it
+# from docs/tutorials).
+ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists())
 BAYESGRASP = str(Path(sys.executable).parent / "bayesgrasp")
 
 

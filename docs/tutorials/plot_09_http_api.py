@@ -11,6 +11,7 @@ command line prints with ``--json``. Here the API is called in-process with Fast
 # %%
 import io
 import json
+import logging
 import tempfile
 
 import matplotlib.image as mpimg
@@ -23,6 +24,7 @@ with warnings.catch_warnings():  # some starlette versions warn about their test
 
 from bayesgrasp.web.app import create_app
 
+logging.getLogger("httpx").setLevel(logging.WARNING)  # no line a request
 client = TestClient(create_app(data_dir=tempfile.mkdtemp()))
 print(client.get("/api/v1/health").json())
 
