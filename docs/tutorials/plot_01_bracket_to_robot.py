@@ -31,7 +31,9 @@ def show(fig):
 
 # The repository's root: where this script runs from, or above it (the docs build runs it
 # from docs/tutorials).
-ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists())
+ROOT = next(
+    p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists()
+)
 part = bg.read_part(ROOT / "examples" / "bracket.dxf")
 print(part.name, part.units, len(part.hull.vertices), "hull vertices")
 problem = bg.Problem.build(part)

@@ -35,9 +35,11 @@ for label, prior in priors.items():
     cost = [o.expected_cost for o in report.options]
     ax.plot(k, cost, marker="o", label=label)
     b = report.bayes_plan
-    print(f"{label}: Bayes plan {b.n_actions} squeeze(s), first at "
-          f"{math.degrees(b.first_angle):.2f} deg, P {b.success_probability:.4f}, "
-          f"E {b.expected_cost:.3f}")
+    print(
+        f"{label}: Bayes plan {b.n_actions} squeeze(s), first at "
+        f"{math.degrees(b.first_angle):.2f} deg, P {b.success_probability:.4f}, "
+        f"E {b.expected_cost:.3f}"
+    )
 ax.set_xlabel("squeezes in the plan")
 ax.set_ylabel("expected cost")
 ax.set_title("The key: best plan of each length under three priors")
@@ -57,8 +59,10 @@ lengths = []
 for retry in retries:
     report = bg.plan_exact(bg.Problem.build(wedge, cost=bg.CostModel(retry=float(retry))))
     lengths.append(report.bayes_plan.n_actions)
-    print(f"retry cost {retry:.1f}: Bayes plan of {report.bayes_plan.n_actions} squeezes, "
-          f"E {report.bayes_plan.expected_cost:.3f}")
+    print(
+        f"retry cost {retry:.1f}: Bayes plan of {report.bayes_plan.n_actions} squeezes, "
+        f"E {report.bayes_plan.expected_cost:.3f}"
+    )
 fig, ax = plt.subplots(figsize=(6, 3))
 ax.step(retries, lengths, where="mid")
 ax.set_xlabel("retry cost")

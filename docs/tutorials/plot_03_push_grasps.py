@@ -12,6 +12,7 @@ start.
 import math
 
 import matplotlib.pyplot as plt
+import numpy as np
 
 import bayesgrasp as bg
 from bayesgrasp.figures import transfer_figure
@@ -44,8 +45,10 @@ for label, problem in [("squeezes only", squeezes), ("squeezes and push-grasps",
     ks = [o.n_actions for o in report.options]
     ax.plot(ks, [o.success_probability for o in report.options], marker="o", label=label)
     b = report.bayes_plan
-    print(f"{label}: Bayes plan {[s.kind for s in b.steps]}, "
-          f"P {b.success_probability:.4f}, E {b.expected_cost:.3f}")
+    print(
+        f"{label}: Bayes plan {[s.kind for s in b.steps]}, "
+        f"P {b.success_probability:.4f}, E {b.expected_cost:.3f}"
+    )
 ax.set_xlabel("actions in the plan")
 ax.set_ylabel("P(success)")
 ax.set_title("The house")
@@ -60,14 +63,16 @@ ax.legend()
 for label, problem in [("squeezes only", squeezes), ("squeezes and push-grasps", mixed)]:
     o = bg.plan_guaranteed(problem).option
     steps = ", ".join(f"{s.kind} {math.degrees(s.alpha):+.2f}" for s in o.steps)
-    print(f"{label}: {o.n_actions} actions ({steps}); from every start to "
-          f"{math.degrees(o.final_orientation):.2f} deg, tolerance {math.degrees(o.tolerance):.3f} deg")
+    print(
+        f"{label}: {o.n_actions} actions ({steps}); from every start to "
+        f"{math.degrees(o.final_orientation):.2f} deg, tolerance {math.degrees(o.tolerance):.3f} deg"
+    )
 
 # %%
 # Replay the mixed guaranteed plan (its first action at any gripper angle) from 3600 starts: every one ends at the same orientation.
-import numpy as np
-
 g = bg.plan_guaranteed(mixed)
 starts = np.linspace(0, 2 * np.pi, 3600, endpoint=False) + 1e-3
 final = bg.execute_plan(mixed, g.option.steps, starts)
-print("distinct final orientations (deg):", sorted({round(math.degrees(f) % 360, 3) for f in final}))
+print(
+    "distinct final orientations (deg):", sorted({round(math.degrees(f) % 360, 3) for f in final})
+)

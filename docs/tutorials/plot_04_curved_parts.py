@@ -19,7 +19,9 @@ from bayesgrasp.figures import diameter_figure, part_figure
 
 # The repository's root: where this script runs from, or above it (the docs build runs it
 # from docs/tutorials).
-ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists())
+ROOT = next(
+    p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists()
+)
 BAYESGRASP = str(Path(sys.executable).parent / "bayesgrasp")
 
 

@@ -40,11 +40,16 @@ print(f"--accuracy 2 plan:     tolerance {math.degrees(robust.tolerance):.3f} de
 # boundary the error would cross.
 noise = NoiseModel(TurnNoise("uniform", math.radians(2)), 0.0)
 aware = plan_noisy(problem, noise)
-for label, steps in [("noise-free", fragile.steps), ("--accuracy 2", robust.steps),
-                     ("noise-aware", aware.bayes_plan.option.steps)]:
+for label, steps in [
+    ("noise-free", fragile.steps),
+    ("--accuracy 2", robust.steps),
+    ("noise-aware", aware.bayes_plan.option.steps),
+]:
     ev = evaluate_plan(problem, noise, steps)
-    print(f"{label:12s} turns {[round(math.degrees(s.alpha), 2) for s in steps[1:]]}: "
-          f"P(success) under the noise {ev.success_probability:.4f}")
+    print(
+        f"{label:12s} turns {[round(math.degrees(s.alpha), 2) for s in steps[1:]]}: "
+        f"P(success) under the noise {ev.success_probability:.4f}"
+    )
 show(noisy_plan_figure(aware))
 
 # %%
@@ -52,10 +57,13 @@ show(noisy_plan_figure(aware))
 # -------------------------------------
 sizes = [0.0, 0.5, 1.0, 2.0, 4.0, 8.0]
 fig, ax = plt.subplots(figsize=(6, 3.5))
-for label, steps in [("noise-free Bayes plan", fragile.steps),
-                     ("--accuracy 2 plan", robust.steps)]:
-    p = [evaluate_plan(problem, NoiseModel(TurnNoise("normal", math.radians(s)), 0.0),
-                       steps).success_probability for s in sizes]
+for label, steps in [("noise-free Bayes plan", fragile.steps), ("--accuracy 2 plan", robust.steps)]:
+    p = [
+        evaluate_plan(
+            problem, NoiseModel(TurnNoise("normal", math.radians(s)), 0.0), steps
+        ).success_probability
+        for s in sizes
+    ]
     ax.plot(sizes, p, marker="o", label=label)
 ax.set_xlabel("normal turn error, sigma (deg)")
 ax.set_ylabel("P(success), exact")
@@ -76,7 +84,11 @@ normal = NoiseModel(TurnNoise("normal", math.radians(2)), 0.0)
 result = plan_noisy(problem, normal, payoff)
 for o in result.options:
     e = o.evaluation
-    print(f"{o.option.n_actions} squeeze(s): E[payoff] {e.expected_payoff:.4f}, "
-          f"cost per unit payoff {e.expected_cost:.3f}")
+    print(
+        f"{o.option.n_actions} squeeze(s): E[payoff] {e.expected_payoff:.4f}, "
+        f"cost per unit payoff {e.expected_cost:.3f}"
+    )
 b = result.bayes_plan.option
-print(f"Bayes plan: {b.n_actions} squeeze(s), ending at {math.degrees(b.final_orientation):.2f} deg")
+print(
+    f"Bayes plan: {b.n_actions} squeeze(s), ending at {math.degrees(b.final_orientation):.2f} deg"
+)

@@ -17,7 +17,9 @@ import matplotlib.pyplot as plt
 
 # The repository's root: where this script runs from, or above it (the docs build runs it
 # from docs/tutorials).
-ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists())
+ROOT = next(
+    p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists()
+)
 BAYESGRASP = str(Path(sys.executable).parent / "bayesgrasp")
 
 

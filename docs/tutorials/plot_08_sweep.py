@@ -18,7 +18,9 @@ import matplotlib.pyplot as plt
 
 # The repository's root: where this script runs from, or above it (the docs build runs it
 # from docs/tutorials).
-ROOT = next(p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists())
+ROOT = next(
+    p for p in [Path.cwd(), *Path.cwd().parents] if (p / "examples" / "bracket.dxf").exists()
+)
 BAYESGRASP = str(Path(sys.executable).parent / "bayesgrasp")
 out_dir = Path(tempfile.mkdtemp())
 results = out_dir / "results.csv"
@@ -29,8 +31,21 @@ results = out_dir / "results.csv"
 # ``--workers 1`` starts a Dask ``LocalCluster`` of one worker for the run and closes it at
 # the end; ``--scheduler ADDRESS`` would use a cluster you started. ``--simulate kinematic``
 # adds an execution check of every part's Bayes plan.
-cmd = [BAYESGRASP, "sweep", "examples", "--out", str(results), "--workers", "1",
-       "--simulate", "kinematic", "--trials", "20000", "--seed", "1"]
+cmd = [
+    BAYESGRASP,
+    "sweep",
+    "examples",
+    "--out",
+    str(results),
+    "--workers",
+    "1",
+    "--simulate",
+    "kinematic",
+    "--trials",
+    "20000",
+    "--seed",
+    "1",
+]
 done = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
 print(done.stdout + done.stderr)
 
@@ -45,9 +60,10 @@ print(len(rows), "rows; the first columns:", ", ".join(list(rows[0])[:16]), "...
 observed = next((c for c in rows[0] if "observed" in c), None)
 for r in rows:
     check = f", observed {float(r[observed]):.4f}" if observed and r[observed] else ""
-    print(f"{r['name']:10s} {r['states']:>3s} states, Bayes plan of {r['bayes_actions']} "
-          f"action(s): P {float(r['bayes_probability']):.4f}, E {float(r['bayes_cost']):.3f}"
-          + check)
+    print(
+        f"{r['name']:10s} {r['states']:>3s} states, Bayes plan of {r['bayes_actions']} "
+        f"action(s): P {float(r['bayes_probability']):.4f}, E {float(r['bayes_cost']):.3f}" + check
+    )
 
 # %%
 fig, ax = plt.subplots(figsize=(6, 3))

@@ -13,10 +13,10 @@ import io
 import json
 import logging
 import tempfile
+import warnings
 
 import matplotlib.image as mpimg
 import matplotlib.pyplot as plt
-import warnings
 
 with warnings.catch_warnings():  # some starlette versions warn about their test client
     warnings.simplefilter("ignore", DeprecationWarning)
@@ -53,8 +53,12 @@ print(bad.status_code, json.dumps(bad.json()))
 policy = client.post("/api/v1/policy", json={"part": {"catalogue": "house"}, "sense": "width"})
 print("policy expected cost:", round(policy.json()["expected_cost"], 4))
 sim = client.post("/api/v1/simulate", json={"part": {"catalogue": "house"}, "trials": 10000})
-print("simulated success:", sim.json()["observed_success"], "predicted:",
-      round(sim.json()["predicted_success"], 4))
+print(
+    "simulated success:",
+    sim.json()["observed_success"],
+    "predicted:",
+    round(sim.json()["predicted_success"], 4),
+)
 
 # %%
 # A figure

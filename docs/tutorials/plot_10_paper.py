@@ -42,8 +42,10 @@ print(study_table(result))
 # %%
 # Plan lengths over the 200 polygons: the Bayes plan is often shorter than the most certain.
 fig, ax = plt.subplots(figsize=(6, 3.5))
-for label, hist, dx in [("most certain plan", result.plan_length_histogram, -0.2),
-                        ("Bayes plan", result.bayes_length_histogram, 0.2)]:
+for label, hist, dx in [
+    ("most certain plan", result.plan_length_histogram, -0.2),
+    ("Bayes plan", result.bayes_length_histogram, 0.2),
+]:
     ks = sorted(hist)
     ax.bar(np.array(ks) + dx, [hist[k] for k in ks], width=0.4, label=label)
 ax.set_xlabel("squeezes")
