@@ -44,6 +44,8 @@ ax.set_xlabel("squeezes in the plan")
 ax.set_ylabel("expected cost")
 ax.set_title("The key: best plan of each length under three priors")
 ax.legend()
+fig.tight_layout()
+
 
 # %%
 # The costs
@@ -69,3 +71,4 @@ ax.set_xlabel("retry cost")
 ax.set_ylabel("squeezes in the Bayes plan")
 ax.set_title("The wedge: a dear retry makes the certain plan best")
 ax.set_yticks(sorted(set(lengths)))
+fig.tight_layout()

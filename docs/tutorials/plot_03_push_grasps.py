@@ -53,6 +53,8 @@ ax.set_xlabel("actions in the plan")
 ax.set_ylabel("P(success)")
 ax.set_title("The house")
 ax.legend()
+fig.tight_layout()
+
 
 # %%
 # Guaranteed plans

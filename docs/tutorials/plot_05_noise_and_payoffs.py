@@ -69,6 +69,8 @@ ax.set_xlabel("normal turn error, sigma (deg)")
 ax.set_ylabel("P(success), exact")
 ax.set_title("The key's two-squeeze plans")
 ax.legend()
+fig.tight_layout()
+
 
 # %%
 # A payoff

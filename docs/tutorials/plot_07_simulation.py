@@ -58,6 +58,8 @@ ax.set_xlabel("final orientation (deg)")
 ax.set_ylabel("probability")
 ax.set_title("The example part's Bayes plan, kinematic model")
 ax.legend()
+fig.tight_layout()
+
 
 # %%
 # MuJoCo

@@ -68,3 +68,4 @@ png = client.post("/api/v1/figures/plan.png", json={"part": {"catalogue": "house
 fig, ax = plt.subplots(figsize=(8, 4))
 ax.imshow(mpimg.imread(io.BytesIO(png), format="png"))
 ax.set_axis_off()
+fig.tight_layout()

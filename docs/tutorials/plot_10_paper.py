@@ -30,6 +30,8 @@ ax.set_xlabel("the paper's expected cost")
 ax.set_ylabel("ours")
 ax.set_title("Table 1: best plan of k squeezes")
 ax.legend(fontsize=7, ncol=2)
+fig.tight_layout()
+
 
 # %%
 # The study, small
@@ -51,3 +53,4 @@ for label, hist, dx in [
 ax.set_xlabel("squeezes")
 ax.set_ylabel("polygons")
 ax.legend()
+fig.tight_layout()
