@@ -75,3 +75,7 @@ autodoc_member_order = "bysource"
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
+
+# A transcript's output is not always valid for its lexer (a quote in a part's name, "..."
+# standing for lines left out): it is shown unhighlighted, which is not worth a warning.
+suppress_warnings = ["misc.highlighting_failure"]

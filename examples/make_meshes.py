@@ -9,15 +9,13 @@ Run from the repository root: ``python examples/make_meshes.py``. It writes, in
 - ``wedge.stl``: a wedge, a right triangle of legs 40 mm and 15 mm extruded 20 mm;
 - ``hex_nut.stl``: a hex nut, 20 mm across flats, 8 mm thick, a 10 mm hole (24 sides),
   with its centre of mass moved off centre to ``(1.5, 0.0, 2.5)`` mm (an insert on one
-  side, below the middle): the solid's centroid is ``(0, 0, 4)``;
+  side, below the middle): the solid's centroid is ``(0, 0, 4)``; give it with ``--com``.
 
-and beside each mesh a sidecar ``NAME.json``: ``{"units": "mm", "center_of_mass": [x, y,
-z]}`` (the solid's centroid, except for the nut). The meshes are closed and outward-facing.
+The meshes are closed and outward-facing; the others' centres of mass are their solids'.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -176,14 +174,13 @@ def meshes() -> dict[str, tuple[FloatArray, IntArray, FloatArray]]:
 
 
 def main() -> None:
-    """Write every example mesh and its sidecar."""
+    """Write every example mesh (the centres of mass are in docs/guide/mesh-physics.md)."""
     OUT.mkdir(exist_ok=True)
     for name, (v, f, com) in meshes().items():
         f = oriented(v, f)
         write_stl(OUT / f"{name}.stl", v, f, name)
-        side = {"units": "mm", "center_of_mass": [round(float(x), 6) for x in com]}
-        (OUT / f"{name}.json").write_text(json.dumps(side) + "\n")
-        print(f"{name}: {len(f)} triangles, centre of mass {side['center_of_mass']} mm")  # noqa: T201
+        where = [round(float(x), 6) for x in com]
+        print(f"{name}: {len(f)} triangles, centre of mass {where} mm")  # noqa: T201
 
 
 if __name__ == "__main__":

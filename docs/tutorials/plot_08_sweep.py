@@ -55,8 +55,14 @@ print(done.stdout + done.stderr)
 # One row a part: its states, the Bayes plan's cost, probability and length, the plan
 # lengths of the most certain and guaranteed plans, and the simulation's check.
 with results.open(newline="") as f:
-    rows = list(csv.DictReader(f))
-print(len(rows), "rows; the first columns:", ", ".join(list(rows[0])[:16]), "...")
+    every = list(csv.DictReader(f))
+# A file the readers cannot plan would be a row with its error (none here).
+rows = [r for r in every if r["status"] == "ok"]
+print(len(every), "rows,", len(every) - len(rows), "with an error; the first columns:")
+print(", ".join(list(every[0])[:16]), "...")
+for r in every:
+    if r["status"] != "ok":
+        print(f"{Path(r['path']).name}: {r['status']}, {r['error_message'][:80]}")
 observed = next((c for c in rows[0] if "observed" in c), None)
 for r in rows:
     check = f", observed {float(r[observed]):.4f}" if observed and r[observed] else ""
