@@ -150,6 +150,9 @@ class SimParams:
     push_distance: float = 0.0
     jaw_lag: float = 0.0
     lead_jaw: str = "random"
+    part_speed: float = 1e-4
+    part_spin: float = 1e-2
+    chunk_time: float = 0.05
 
     def squeeze_force(self, mass: float) -> float:
         """Force limit of each jaw for a part of the given mass (kg): ``force_ratio`` weights.
