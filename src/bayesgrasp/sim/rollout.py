@@ -93,7 +93,7 @@ class BatchSqueezer:
     >>> predicted = squeeze_function(tri.hull)(np.radians([30.0, 100.0]))
     >>> out.settled.tolist()
     [True, True]
-    >>> np.round(np.degrees(out.end), 1).tolist() == np.round(np.degrees(predicted), 1).tolist()
+    >>> bool(np.degrees(np.abs(out.end - predicted)).max() < 0.2)
     True
     """
 
