@@ -277,9 +277,7 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
             cr = classes(r.end, r.settled, ref.jam_tol)  # type: ignore[attr-defined]
             cells = [f"{name} {kind}: reference jams {(cr < 0).sum()}/{n}"]
             for key, sp in cands.items():
-                t0 = time.perf_counter()
                 o = BatchSqueezer(part, sc, sp).act(th, push=push)  # type: ignore[arg-type]
-                dt = time.perf_counter() - t0
                 co = classes(o.end, o.settled, sp.jam_tol)  # type: ignore[attr-defined]
                 same = co == cr
                 totals[key][0] += int(same.sum())

@@ -434,7 +434,9 @@ def _lagged(lag: float, part: Any, units: str | None) -> Any:
     from ..sim.params import SimParams
     from ..sim.scene import units_scale
 
-    base = SimParams()
+    # The lag is in seconds of jaws closing at 1 cm/s (the push it makes is its meaning),
+    # whatever the default jaw speed.
+    base = replace(SimParams(), jaw_speed=0.01)
     push = base.jaw_speed * lag / 2.0
     size = part.hull.size * units_scale(units if units is not None else part.units)
     if push > 2.0 * size:

@@ -343,10 +343,10 @@ class SimulationResult:
         :attr:`success_p_value`, every trial counted.
         """
         unjammed = self.trials - self.final_jams
-        if self.engine != "kinematic":
-            return PHYSICS_FIT
         if self.trials and 2 * self.jams > self.trials:
             return f"{self.jams} of {self.trials} trials jammed"
+        if self.engine != "kinematic":
+            return PHYSICS_FIT
         if unjammed <= 0:
             return "no trial ended in a stable orientation"
         return None

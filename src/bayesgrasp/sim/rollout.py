@@ -240,7 +240,7 @@ class BatchSqueezer:
                 prev = np.where(ok[:, c], prev + 1, 0)
                 run[:, c] = prev
             hit = run >= need
-            done_here = hit.any(axis=1)
+            done_here: BoolArray = np.asarray(hit.any(axis=1), dtype=bool)
             first = np.argmax(hit, axis=1)
             over = tt[-1] >= t_max[active]
             idx = np.where(done_here, first, chunk - 1)
