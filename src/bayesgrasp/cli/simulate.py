@@ -67,7 +67,8 @@ TrialsOpt = Annotated[
     ),
 ]
 WorkersOpt = Annotated[
-    int, typer.Option(min=1, help="Processes for mujoco trials (kinematic uses one).")
+    int,
+    typer.Option(min=1, help="Threads for mujoco trials (kinematic uses one)."),
 ]
 OffsetOpt = Annotated[
     float,

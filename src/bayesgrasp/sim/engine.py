@@ -20,9 +20,12 @@ One action, in the gripper frame (which is the world frame of the scene):
 3. *Read and open.* The part's yaw is read from the free joint's quaternion; opening the
    jaws is the next action's placement.
 
-Trials run in parallel across processes when ``workers > 1``; every random draw (initial
+:func:`simulate_mujoco` runs a plan's trials in batches, an action at a time, through
+MuJoCo's C rollout threads (:mod:`bayesgrasp.sim.rollout`), each trial stopped when jaws and
+part have settled; ``method="stepped"`` runs them one at a time from Python
+(:class:`Squeezer`, in processes when ``workers > 1``). Every random draw (initial
 orientations, gripper errors, offset signs) is made up front from one seed, so results do
-not depend on the number of workers.
+not depend on the number of workers or threads.
 """
 
 from __future__ import annotations
