@@ -342,8 +342,122 @@ def compare(trials: int, push_trials: int) -> None:
     print(f"({load_note()})")
 
 
+def validation(trials: int, push_trials: int, policy_cycles: int) -> None:
+    """The guide's validation study: predicted against MuJoCo success, table and figure.
+
+    Prints a Markdown table (docs/guide/physics-validation.md) and draws
+    docs/figures/physics-validation.png: every catalogue part's and curved example's Bayes
+    plan, noise-aware plans under their noise, push-grasp plans and a sensing policy.
+    """
+    from pathlib import Path
+
+    from bayesgrasp.model.noise import NoiseModel, TurnNoise
+    from bayesgrasp.planning.noisy import plan_noisy
+    from bayesgrasp.planning.policy import plan_policy
+    from bayesgrasp.sim import simulate_mujoco
+    from bayesgrasp.sim.noise import GripperNoise
+    from bayesgrasp.sim.policy import mujoco_sensor, simulate_policy_mujoco
+    from bayesgrasp.sim.result import with_prediction
+    from bayesgrasp.sim.stats import wilson_interval
+
+    rows: list[tuple[str, str, str, int, float, float, float, float, int, str]] = []
+    t_all = time.perf_counter()
+
+    def add(group: str, name: str, plan: str, r: object) -> None:
+        lo, hi = r.ci95  # type: ignore[attr-defined]
+        flags = r.assumption_flags  # type: ignore[attr-defined]
+        rows.append(
+            (group, name, plan, r.trials, r.predicted_success, r.observed_success, lo, hi,  # type: ignore[attr-defined]
+             r.jams, "; ".join(flags) or "-")  # type: ignore[attr-defined]
+        )  # fmt: skip
+        print("| " + " | ".join(_cells(rows[-1])) + " |", flush=True)
+
+    print(f"Validation study, seed 1 ({load_note()})")
+    print("| group | part | plan | trials | predicted | MuJoCo | 95% interval | jams | flags |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name, part, sc in study_parts():
+        group = "catalogue" if name in {n for n in _names()} else "curved example"
+        pb = Problem.build(part)  # type: ignore[arg-type]
+        plan = plan_exact(pb).bayes_plan
+        add(group, name, _kinds(plan), simulate_mujoco(pb, plan, trials, rng=1, scale=sc))
+    turn = TurnNoise("normal", math.radians(3.0))
+    for name in ("triangle", "rectangle", "house"):
+        pb = Problem.build(load(name))
+        opt = plan_noisy(pb, NoiseModel(turn)).bayes_plan.option
+        r = simulate_mujoco(pb, opt, trials, noise=GripperNoise.of(turn), rng=1)
+        add("noise-aware, 3 deg turn error", name, _kinds(opt),
+            with_prediction(r, pb, NoiseModel(turn)))  # fmt: skip
+    for name in ("triangle", "rectangle", "house", "key"):
+        pb = Problem.build(load(name), actions=("push-grasp",))
+        plan = plan_exact(pb).bayes_plan
+        add("push-grasp", name, _kinds(plan), simulate_mujoco(pb, plan, push_trials, rng=1))
+    part = load("house")
+    pb = Problem.build(part)
+    pol = plan_policy(pb, mujoco_sensor(part, 0.001), 3)
+    sim = simulate_policy_mujoco(pb, pol, policy_cycles, rng=1)
+    lo, hi = wilson_interval(sim.successes, sim.cycles)
+    rows.append(
+        ("sensing policy", "house", "width sensor, 3 actions", sim.cycles,
+         pol.success_probability, sim.observed_success, lo, hi, sim.jams, "-")
+    )  # fmt: skip
+    print("| " + " | ".join(_cells(rows[-1])) + " |")
+    inside = sum(r[6] <= r[4] <= r[7] for r in rows)
+    print(
+        f"({inside} of {len(rows)} predictions inside the 95% interval; "
+        f"{time.perf_counter() - t_all:.0f} s; {load_note()})"
+    )
+    _figure(rows, Path(__file__).resolve().parents[1] / "docs" / "figures")
+
+
+def _names() -> list[str]:
+    from bayesgrasp.shapes import names
+
+    return list(names())
+
+
+def _kinds(plan: object) -> str:
+    kinds = plan.kinds  # type: ignore[attr-defined]
+    return "+".join("P" if k == "push-grasp" else "S" for k in kinds)
+
+
+def _cells(r: tuple[str, str, str, int, float, float, float, float, int, str]) -> list[str]:
+    g, name, plan, n, pred, obs, lo, hi, jams, flags = r
+    return [g, name, plan, str(n), f"{pred:.3f}", f"{obs:.3f}", f"[{lo:.3f}, {hi:.3f}]",
+            str(jams), flags]  # fmt: skip
+
+
+def _figure(
+    rows: list[tuple[str, str, str, int, float, float, float, float, int, str]], folder: object
+) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.5, 5.5))
+    groups = sorted({r[0] for r in rows})
+    for g, marker in zip(groups, "osD^v", strict=False):
+        sel = [r for r in rows if r[0] == g]
+        x = np.array([r[4] for r in sel])
+        y = np.array([r[5] for r in sel])
+        err = np.array([[r[5] - r[6] for r in sel], [r[7] - r[5] for r in sel]])
+        ax.errorbar(x, y, yerr=err, fmt=marker, ms=5, capsize=2, label=g)
+    ax.plot([0, 1], [0, 1], "k--", lw=0.8)
+    ax.set(xlim=(0, 1.02), ylim=(0, 1.02), xlabel="predicted success (model)",
+           ylabel="observed success (MuJoCo), 95% interval")  # fmt: skip
+    ax.set_aspect("equal")
+    ax.legend(loc="upper left", fontsize=8)
+    path = folder / "physics-validation.png"  # type: ignore[operator]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    print(f"figure: {path}")
+
+
 def main() -> None:
     quick = "--quick" in sys.argv
+    if "--validation" in sys.argv:
+        validation(100 if quick else 1000, 40 if quick else 200, 60 if quick else 300)
+        return
     if "--accuracy" in sys.argv:
         accuracy(10 if quick else 40, 5 if quick else 20)
         return

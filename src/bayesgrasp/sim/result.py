@@ -408,9 +408,11 @@ class SimulationResult:
         and that a start's basin decides it. Flagged: more than 2% of trials jammed (the
         part stopped away from every stable orientation: jaw force against table
         friction where the turning couple vanishes, at shallow minima or near maxima of
-        the width), and more than 10% of trials started an action within
-        ``boundary_margin`` of a basin boundary (a tight plan: there the outcome is a coin
-        toss in physics). Empty for the kinematic engine, which is the model.
+        the width), and, when the prediction lies outside the observed 95% interval, more
+        than 10% of trials starting an action within ``boundary_margin`` of a basin
+        boundary (a tight plan: there the outcome is a coin toss in physics; a plan whose
+        states land on boundaries by design, as push-grasps' can, and still succeed is not
+        flagged). Empty for the kinematic engine, which is the model.
         """
         if self.engine == "kinematic" or not self.trials:
             return []
@@ -420,7 +422,9 @@ class SimulationResult:
                 f"{self.jams} of {self.trials} trials jammed (stopped away from every stable "
                 "orientation: jaw force against table friction)"
             )
-        if self.near_boundary > 0.1 * self.trials:
+        lo, hi = self.ci95
+        missed = not lo - 1e-9 <= self.predicted_success <= hi + 1e-9
+        if missed and self.near_boundary > 0.1 * self.trials:
             out.append(
                 f"{self.near_boundary} of {self.trials} trials started an action within "
                 f"{math.degrees(self.boundary_margin):g} deg of a basin boundary "
