@@ -408,7 +408,8 @@ class SimulationResult:
         and that a start's basin decides it. Flagged: more than 2% of trials jammed (the
         part stopped away from every stable orientation: jaw force against table
         friction where the turning couple vanishes, at shallow minima or near maxima of
-        the width), and, when the prediction lies outside the observed 95% interval, more
+        the width), and, when the observed success strays from the prediction (outside the
+        observed 95% interval, or :attr:`success_p_value` below 0.1), more
         than 10% of trials starting an action within ``boundary_margin`` of a basin
         boundary (a tight plan: there the outcome is a coin toss in physics; a plan whose
         states land on boundaries by design, as push-grasps' can, and still succeed is not
@@ -424,6 +425,7 @@ class SimulationResult:
             )
         lo, hi = self.ci95
         missed = not lo - 1e-9 <= self.predicted_success <= hi + 1e-9
+        missed = missed or self.success_p_value < 0.1
         if missed and self.near_boundary > 0.1 * self.trials:
             out.append(
                 f"{self.near_boundary} of {self.trials} trials started an action within "
