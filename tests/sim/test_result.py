@@ -160,3 +160,23 @@ def test_prediction_interval_holds_95_percent_of_sampled_runs() -> None:
     rates = np.random.default_rng(0).binomial(300, r.predicted_success, 20_000) / 300
     inside = float(np.mean((rates >= lo) & (rates <= hi)))
     assert 0.95 <= inside <= 0.975
+
+
+def test_near_boundary_flag_only_where_the_success_strays() -> None:
+    from bayesgrasp.sim.result import summarize
+
+    pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+    stable = pb.states.stable
+    goal = stable[np.flatnonzero(pb.success_states(0.0))[0]]
+    other = stable[np.flatnonzero(~pb.success_states(0.0))[0]]
+    near = np.ones(300, bool)  # every trial started near a boundary
+
+    def run(n_goal: int) -> list[str]:
+        final = np.concatenate([np.full(n_goal, goal), np.full(300 - n_goal, other)])
+        r = summarize("mujoco", pb, opt, final, np.zeros(300, bool), near, 1.0, 1e-3)
+        return r.assumption_flags
+
+    assert run(44) == []  # 0.147 observed, 0.148 predicted: a tight plan that works
+    flags = run(25)  # 0.083: the success strays
+    assert len(flags) == 1 and "300 of 300 trials started an action within" in flags[0]
