@@ -151,6 +151,9 @@ def simulate(
     noise-aware one that plan gives with the same options; every plan is predicted exactly
     under the noise, and with --payoff judged by its expected payoff (the mean payoff of
     the final states). The verdict: each prediction within its observed interval (z = 4).
+    With --engine mujoco every trial counts (a jam did not reach the goal): the observed
+    success and its 95% interval, the range 95% of runs would give if the prediction were
+    right, an exact binomial p-value, and flags where the model's assumptions break.
 
     With --plan FILE the plan must be for PART (else exit 2, unless --force) and runs under
     the prior and goal it was made for, unless --prior or --goal says otherwise.
