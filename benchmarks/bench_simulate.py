@@ -277,7 +277,9 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
             cr = classes(r.end, r.settled, ref.jam_tol)  # type: ignore[attr-defined]
             cells = [f"{name} {kind}: reference jams {(cr < 0).sum()}/{n}"]
             for key, sp in cands.items():
-                o = BatchSqueezer(part, sc, sp).act(th, push=push)  # type: ignore[arg-type]
+                o = BatchSqueezer(part, sc, sp).act(  # type: ignore[arg-type]
+                    th, push=push, stable=pb.states.stable
+                )  # jammed actions retried with slow jaws, as simulate_mujoco does
                 co = classes(o.end, o.settled, sp.jam_tol)  # type: ignore[attr-defined]
                 same = co == cr
                 totals[key][0] += int(same.sum())

@@ -91,3 +91,31 @@ def test_rollout_and_stepped_engines_agree_on_states() -> None:
 def test_bad_thread_count_is_refused() -> None:
     with pytest.raises(SimulationError, match="`nthread` must be an integer >= 1"):
         BatchSqueezer(load("triangle"), 0.001, nthread=0)
+
+
+def test_jammed_actions_are_retried_with_slow_jaws() -> None:
+    """A 1.3 cm random 10-gon stalls under 5 cm/s jaws; at 1 cm/s it turns to its minimum."""
+    from scipy.spatial import ConvexHull
+
+    from bayesgrasp.geometry.polygon import Part
+
+    rng = np.random.default_rng(2)
+    hulls = []
+    for _ in range(3):
+        pts = rng.random((10, 2))
+        hulls.append(pts[ConvexHull(pts).vertices])
+    part = Part.from_points(hulls[2].tolist(), units="cm")
+    stable = Problem.build(part).states.stable
+    th = np.random.default_rng(0).uniform(0, 2 * math.pi, 40)
+
+    def off(ends: np.ndarray) -> np.ndarray:
+        return circle_distance(ends[:, None], stable).min(axis=1) > SimParams().jam_tol
+
+    bs = BatchSqueezer(part, 0.01)
+    fast = bs.act(th)
+    kept = bs.act(th, stable=stable)
+    slow = BatchSqueezer(part, 0.01, SimParams(jaw_speed=0.01)).act(th)
+    bad = off(fast.end)
+    assert bad.sum() >= 5 and not off(kept.end).any()
+    assert np.array_equal(kept.end[bad], slow.end[bad])  # the retried actions: slow jaws
+    assert np.array_equal(kept.end[~bad], fast.end[~bad])  # the rest untouched

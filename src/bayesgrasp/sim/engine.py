@@ -347,8 +347,13 @@ def _rollout_trials(
     trials: Sequence[_Trial],
     nthread: int,
     progress: Progress | None,
+    stable: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
-    """Start yaw, end yaw and settled flag of every action of every trial, shape (T, k)."""
+    """Start yaw, end yaw and settled flag of every action of every trial, shape (T, k).
+
+    ``stable``: the part's stable orientations; jammed actions are retried with slow jaws
+    (:meth:`~bayesgrasp.sim.rollout.BatchSqueezer.act`).
+    """
     from .rollout import BatchSqueezer
 
     n, k = len(trials), len(trials[0].angles)
@@ -362,7 +367,7 @@ def _rollout_trials(
                 ang = np.array([t.angles[j] for t in batch])
                 off = np.array([t.offsets[j] for t in batch])
                 lead = np.array([t.leads[j] for t in batch]) if batch[0].leads else None
-                res = bs.act(np.mod(yaw - ang, TWO_PI), off, batch[0].pushes[j], lead)
+                res = bs.act(np.mod(yaw - ang, TWO_PI), off, batch[0].pushes[j], lead, stable)
                 starts[lo : lo + len(batch), j] = res.start
                 ends[lo : lo + len(batch), j] = res.end
                 settled[lo : lo + len(batch), j] = res.settled
@@ -487,7 +492,9 @@ def simulate_mujoco(
         ends = np.array([[a.end for a in r] for r in outcomes])  # (T, k)
         settled = np.array([[a.settled for a in r] for r in outcomes])  # (T, k)
     else:
-        starts, ends, settled = _rollout_trials(problem.part, sc, params, tasks, workers, progress)
+        starts, ends, settled = _rollout_trials(
+            problem.part, sc, params, tasks, workers, progress, problem.states.stable
+        )
     seconds = time.perf_counter() - t0
     states = problem.states
     near = np.zeros(trials, dtype=bool)

@@ -551,8 +551,9 @@ def _run_cycles_batched(
                 lagged = bool(cycles[idx[0]].leads)
                 lead = np.array([cycles[i].leads[acts[i]] for i in idx]) if lagged else None
                 res = batchers[j].act(
-                    np.mod(start, TWO_PI), off, get_action(step.kind).pushes_first, lead
-                )
+                    np.mod(start, TWO_PI), off, get_action(step.kind).pushes_first, lead,
+                    pb.states.stable,
+                )  # fmt: skip
                 states = nearest_state(pb.states, res.end)
                 for b, i in enumerate(idx):
                     c, a = cycles[i], acts[i]

@@ -31,7 +31,7 @@ not by the threads, so the results do not depend on ``nthread``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,12 +119,17 @@ class BatchSqueezer:
         self._qvel0 = 1 + m.nq
         self._kp = float(self.sq.body.kp)
         self._runner = mjr.Rollout(nthread=self.nthread) if self.nthread > 1 else None
+        self.sq_part = part
+        self._slow: BatchSqueezer | None = None  # the same scene, jaws at retry_speed
 
     def close(self) -> None:
         """Stop the rollout threads (also done when the object is collected)."""
         if self._runner is not None:
             self._runner.close()
             self._runner = None
+        if self._slow is not None:
+            self._slow.close()
+            self._slow = None
 
     def __enter__(self) -> BatchSqueezer:
         return self
@@ -163,8 +168,15 @@ class BatchSqueezer:
         offset: FloatArray | float = 0.0,
         push: bool = False,
         lead: NDArray[np.int_] | None = None,
+        stable: FloatArray | None = None,
     ) -> BatchOutcome:
         """One squeeze (or push-grasp) from each yaw in ``theta`` (gripper frame).
+
+        With ``stable`` (the part's stable orientations), an action that jams (ends farther
+        than ``jam_tol`` from all of them, or does not settle) is run again with the jaws
+        at ``params.retry_speed``, and that outcome is kept: fast jaws can throw a small
+        part past a shallow minimum or stall it where slow ones turn it; a jam at slow jaws
+        is a jam of the physics (see ``SimParams.retry_speed``).
 
         Parameters
         ----------
@@ -191,6 +203,30 @@ class BatchSqueezer:
             ld = np.full(b, -1 if sp.lead_jaw != "+x" else 1)
         else:
             ld = np.broadcast_to(np.asarray(lead), (b,))
+        out = self._act(th, off, push, ld)
+        if stable is None or not (0 < sp.retry_speed < sp.jaw_speed):
+            return out
+        st = np.asarray(stable, dtype=np.float64)
+        err = np.abs(np.remainder(out.end[:, None] - st[None, :] + np.pi, TWO_PI) - np.pi)
+        bad = np.flatnonzero((err.min(axis=1) > sp.jam_tol) | ~out.settled)
+        if not bad.size:
+            return out
+        if self._slow is None:
+            slow = replace(sp, jaw_speed=sp.retry_speed)
+            self._slow = BatchSqueezer(self.sq_part, self.sq.scale, slow, self.nthread)
+        again = self._slow._act(th[bad], off[bad], push, ld[bad])
+        fields = [np.array(getattr(out, f)) for f in ("end", "settled", "sim_time", "width")]
+        for arr, f in zip(fields, ("end", "settled", "sim_time", "width"), strict=True):
+            arr[bad] = getattr(again, f)
+        fields[2][bad] += out.sim_time[bad]  # both runs' simulated time
+        return BatchOutcome(th, fields[0], fields[1], fields[2], fields[3])
+
+    def _act(
+        self, th: FloatArray, off: FloatArray, push: bool, ld: NDArray[np.int_]
+    ) -> BatchOutcome:
+        """:meth:`act` once, at ``params.jaw_speed``."""
+        sp = self.params
+        b = th.size
         init = [self._initial(float(th[i]), float(off[i]), push, int(ld[i])) for i in range(b)]
         state = np.array([x[0] for x in init])  # (B, nstate)
         starts = np.array([x[1] for x in init])  # (B, 2)
