@@ -200,7 +200,8 @@ def agreement(n: int) -> None:
 
 
 def legacy_params() -> object:
-    """The former engine's settings: 1 ms steps, jaws at 1 cm/s, 3 mm clearance, 0.1 s settle."""
+    """The former engine's settings: 1 ms steps, jaws at 1 cm/s, 3 mm clearance, 0.1 s settle,
+    0.1 kg jaws for every part."""
     from bayesgrasp.sim.params import SimParams
 
     return SimParams(
@@ -212,6 +213,7 @@ def legacy_params() -> object:
         check_every=10,
         part_speed=1e3,  # the former test read the jaws only
         part_spin=1e3,
+        scale_jaw_mass=False,  # 0.1 kg jaws whatever the part
     )
 
 

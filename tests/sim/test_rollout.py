@@ -94,7 +94,7 @@ def test_bad_thread_count_is_refused() -> None:
 
 
 def test_jammed_actions_are_retried_with_slow_jaws() -> None:
-    """A 1.3 cm random 10-gon stalls under 5 cm/s jaws; at 1 cm/s it turns to its minimum."""
+    """A 1.3 cm random 10-gon stalls under fast sluggish jaws; at 1 cm/s it turns."""
     from scipy.spatial import ConvexHull
 
     from bayesgrasp.geometry.polygon import Part
@@ -111,11 +111,24 @@ def test_jammed_actions_are_retried_with_slow_jaws() -> None:
     def off(ends: np.ndarray) -> np.ndarray:
         return circle_distance(ends[:, None], stable).min(axis=1) > SimParams().jam_tol
 
-    bs = BatchSqueezer(part, 0.01)
+    sluggish = SimParams(scale_jaw_mass=False)  # 0.1 kg jaws pushing with 4 mN
+    bs = BatchSqueezer(part, 0.01, sluggish)
     fast = bs.act(th)
     kept = bs.act(th, stable=stable)
-    slow = BatchSqueezer(part, 0.01, SimParams(jaw_speed=0.01)).act(th)
+    slow = BatchSqueezer(part, 0.01, SimParams(jaw_speed=0.01, scale_jaw_mass=False)).act(th)
     bad = off(fast.end)
     assert bad.sum() >= 5 and not off(kept.end).any()
     assert np.array_equal(kept.end[bad], slow.end[bad])  # the retried actions: slow jaws
     assert np.array_equal(kept.end[~bad], fast.end[~bad])  # the rest untouched
+
+
+def test_jaw_mass_scales_with_the_force() -> None:
+    """A 1 cm part's light jaws settle in a fraction of the time 0.1 kg jaws take."""
+    from bayesgrasp.geometry.polygon import Part
+
+    part = Part.from_points([(0, 0), (1, 0), (0.8, 0.6), (0.1, 0.7)], units="cm")
+    th = np.random.default_rng(1).uniform(0, 2 * math.pi, 6)
+    light = BatchSqueezer(part, 0.01).act(th)
+    heavy = BatchSqueezer(part, 0.01, SimParams(scale_jaw_mass=False)).act(th)
+    assert light.settled.all() and light.sim_time.mean() < 0.5 * heavy.sim_time.mean()
+    assert float(circle_distance(light.end, heavy.end).max()) < math.radians(1.0)

@@ -137,9 +137,16 @@ class SimParams:
     retry_speed : float
         The batched engine runs an action that jammed at ``jaw_speed`` again with jaws at
         1 cm/s (the former speed, which agreed with the fine reference in every action of
-        the accuracy study) and keeps that outcome: a 1.3 cm random 10-gon jammed in 12 of
-        40 squeezes at 5 cm/s (and 2 cm/s), in none at 1 cm/s. Jams are a few percent of
-        actions, so the retry costs little. 0 (or not below ``jaw_speed``): no retry.
+        the accuracy study) and keeps that outcome, a safeguard: with sluggish jaws (0.1 kg
+        whatever the part, ``scale_jaw_mass=False``) a 1.3 cm random 10-gon jammed in 12 of
+        40 squeezes at 5 cm/s, in none at 1 cm/s. Jams are a few percent of actions, so
+        the retry costs little. 0 (or not below ``jaw_speed``): no retry.
+    scale_jaw_mass : bool
+        The jaws' mass scales with their force, ``jaw_mass * squeeze_force / jaw_force``,
+        as gain and damping do, so every part sees the same jaw motion (time constant
+        ``jaw_mass / jaw_damping`` = 10 ms). With 0.1 kg jaws for every part, the jaws of a
+        1 cm part (a force of 4 mN) took over a second to move and settle: its squeezes
+        simulated 0.9 s instead of 0.13 s, and some stalled.
 
     Examples
     --------
@@ -179,6 +186,7 @@ class SimParams:
     part_spin: float = 1e-2
     chunk_time: float = 0.02
     retry_speed: float = 0.01
+    scale_jaw_mass: bool = True
 
     def squeeze_force(self, mass: float) -> float:
         """Force limit of each jaw for a part of the given mass (kg): ``force_ratio`` weights.
@@ -207,7 +215,13 @@ class SimParams:
             value = getattr(self, f.name)
             if isinstance(value, str):
                 continue
-            nonneg = f.name in ("push_distance", "table_friction", "jaw_lag", "retry_speed")
+            nonneg = f.name in (
+                "push_distance",
+                "table_friction",
+                "jaw_lag",
+                "retry_speed",
+                "scale_jaw_mass",
+            )
             if not math.isfinite(value) or value < 0 or (value == 0 and not nonneg):
                 want = ">= 0" if nonneg else "> 0"
                 raise SimParamsError(
