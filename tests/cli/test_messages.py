@@ -15,7 +15,7 @@ from bayesgrasp.cli import main
 from bayesgrasp.model.prior import parse_prior, von_mises
 from bayesgrasp.planning.result import PlanOption, PlanStep
 from bayesgrasp.report import simulate_json, simulate_table
-from bayesgrasp.sim.result import summarize
+from bayesgrasp.sim.result import PHYSICS_FIT, summarize, verdict_lines
 
 pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
 
@@ -73,7 +73,9 @@ def test_fit_is_not_applicable_when_most_trials_jam() -> None:
     doc = simulate_json(res)
     assert doc["p_value"] is None and doc["p_value_unavailable"] == "8 of 10 trials jammed"
     fine = summarize("mujoco", pb, opt, final, np.zeros(10, bool), np.zeros(10, bool), 1.0, 1e-6)
-    assert fine.fit_unavailable is None and "p = " in simulate_table(fine)
+    # physics: no chi-square over states; the success test counts every trial
+    assert fine.fit_unavailable == PHYSICS_FIT and "p = " not in simulate_table(fine)
+    assert "p = " in "\n".join(verdict_lines(fine))
 
 
 @pytest.mark.parametrize(

@@ -37,3 +37,13 @@ def test_sweep_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
     assert out.read_bytes() == before  # nothing the user had is lost
     assert main([*argv, "--resume", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["skipped"] == 2
+    # resumed with another seed, trial count or option: refused with the reason, rows kept
+    for extra, reason in (
+        (["--seed", "3"], "seed 0 -> 3"),
+        (["--simulate", "kinematic", "--trials", "500"], "trials None -> 500"),
+        (["--verify-cost", "2"], "verify_cost 1.0 -> 2.0"),
+    ):
+        assert main([*argv, "--resume", *extra]) == 2
+        err = capsys.readouterr().err
+        assert "cannot resume" in err and reason in err and "Traceback" not in err
+    assert out.read_bytes() == before

@@ -286,7 +286,7 @@ def test_mujoco_runs_a_policy_planned_under_turn_noise() -> None:
     not HAVE_MUJOCO, reason="MuJoCo is not installed: pip install 'bayesgrasp[sim]'"
 )
 def test_mujoco_policy_takes_the_jaw_lag(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A jaw lag of 4 s (a 20 mm push by the leading jaw) reaches every squeeze of a policy.
+    """A jaw lag that makes a 20 mm push by the leading jaw reaches every squeeze of a policy.
 
     Each squeeze gets a leading jaw (-1 or +1) drawn from the seed with the other draws, so
     one worker and two give the same cycles. The check of the physics is the push-grasp's
@@ -314,16 +314,18 @@ def test_mujoco_policy_takes_the_jaw_lag(monkeypatch: pytest.MonkeyPatch) -> Non
         return res
 
     monkeypatch.setattr(engine.Squeezer, "act", recorded)
-    lag = 4.0
+    lag = 2 * 0.020 / SimParams().jaw_speed  # the stepped engine's actions are recorded
     lagged = SimParams(jaw_lag=lag, clearance=SimParams().jaw_speed * lag / 2 + 0.001)
-    one = simulate_policy_mujoco(pb, pol, 12, params=lagged, rng=7)
+    one = simulate_policy_mujoco(pb, pol, 12, params=lagged, rng=7, method="stepped")
     lagged_acts = list(acts)
     leads = [lead for _, push, lead, _ in lagged_acts if not push]
     assert len(leads) >= 12 and set(leads) == {-1, 1}
     acts.clear()
-    plain = simulate_policy_mujoco(pb, pol, 12, params=SimParams(clearance=lagged.clearance), rng=7)
+    plain = simulate_policy_mujoco(
+        pb, pol, 12, params=SimParams(clearance=lagged.clearance), rng=7, method="stepped"
+    )
     assert {lead for _, _, lead, _ in acts} == {None}
-    two = simulate_policy_mujoco(pb, pol, 12, params=lagged, rng=7, workers=2)
+    two = simulate_policy_mujoco(pb, pol, 12, params=lagged, rng=7, workers=2, method="stepped")
     np.testing.assert_array_equal(one.success, two.success)
     np.testing.assert_array_equal(one.cycle_costs, two.cycle_costs)
     np.testing.assert_allclose(one.reading_errors, two.reading_errors, rtol=0, atol=1e-9)
@@ -388,3 +390,24 @@ def test_cli_jaw_lag_reaches_the_policy_simulation(
     assert len(seen) == n
     assert main([*args[:-4], "--trials", "20", "--jaw-lag", "1"]) == 2  # kinematic: no jaws
     assert "--engine mujoco only" in capsys.readouterr().err
+
+
+@pytest.mark.physics
+@pytest.mark.skipif(
+    not HAVE_MUJOCO, reason="MuJoCo is not installed: pip install 'bayesgrasp[sim]'"
+)
+def test_batched_policy_cycles_equal_stepped_ones_whatever_the_threads() -> None:
+    """Cycles grouped by policy node and batched in C threads follow the same branches."""
+    from bayesgrasp.sim.policy import simulate_policy_mujoco
+
+    part = shapes.load("house")
+    pb = Problem.build(part)
+    pol = plan_policy(pb, mujoco_sensor(part, 0.001), 3)
+    a = simulate_policy_mujoco(pb, pol, 16, rng=9)
+    b = simulate_policy_mujoco(pb, pol, 16, rng=9, workers=2)
+    c = simulate_policy_mujoco(pb, pol, 16, rng=9, method="stepped")
+    np.testing.assert_array_equal(a.success, b.success)
+    np.testing.assert_array_equal(a.reading_errors, b.reading_errors)
+    np.testing.assert_array_equal(a.success, c.success)
+    np.testing.assert_array_equal(a.cycle_costs, c.cycle_costs)
+    np.testing.assert_allclose(a.reading_errors, c.reading_errors, rtol=0, atol=0.02)

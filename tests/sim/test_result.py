@@ -115,3 +115,68 @@ def test_the_package_re_exports_the_names_callers_import() -> None:
     for name in ("GripperNoise", "SimulationResult", "boundary_distance", "simulate_kinematic"):
         assert getattr(kinematic, name) is getattr(sim, name)
     assert set(sim.__all__) <= set(dir(sim))
+
+
+def _physics_run(n_goal: int, n_other: int, n_jam: int, engine: str = "mujoco") -> object:
+    """A rectangle's one-squeeze plan with outcomes given: goal, another state, jammed."""
+    from bayesgrasp.sim.result import summarize
+
+    pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+    stable = pb.states.stable
+    goal = stable[np.flatnonzero(pb.success_states(0.0))[0]]
+    other = stable[np.flatnonzero(~pb.success_states(0.0))[0]]
+    off = goal + math.radians(20.0)  # away from every stable orientation: a jam
+    final = np.concatenate([np.full(n_goal, goal), np.full(n_other, other), np.full(n_jam, off)])
+    n = len(final)
+    return summarize(engine, pb, opt, final, np.zeros(n, bool), np.zeros(n, bool), 1.0, 1e-3)
+
+
+def test_physics_verdict_counts_every_trial_and_flags_jams() -> None:
+    from bayesgrasp.sim.result import PHYSICS_FIT, verdict_document, verdict_lines
+
+    r = _physics_run(40, 160, 100)  # predicted success 0.148; observed 40/300
+    assert r.fit_unavailable == PHYSICS_FIT and math.isnan(r.p_value)
+    p = r.predicted_success
+    # brute force: the exact two-sided binomial p-value, every trial (jams too) counted
+    k = np.arange(301)
+    pmf = np.array([math.comb(300, int(i)) * p**i * (1 - p) ** (300 - i) for i in k])
+    brute = float(pmf[pmf <= pmf[40] * (1 + 1e-7)].sum())
+    assert r.success_p_value == pytest.approx(brute, rel=1e-6)
+    lines = verdict_lines(r)
+    assert "every trial counted" in lines[0] and "40/300" in lines[0]
+    assert any("100 of 300 trials jammed" in s for s in lines)
+    doc = verdict_document(r)
+    assert doc["assumption_flags"] and doc["ci95"][0] < 40 / 300 < doc["ci95"][1]
+    # with no jams, no flag; the kinematic engine keeps its chi-square and its lines
+    assert _physics_run(44, 256, 0).assumption_flags == []
+    kin = _physics_run(44, 256, 0, engine="kinematic")
+    assert not math.isnan(kin.p_value) and len(verdict_lines(kin)) == 1
+
+
+def test_prediction_interval_holds_95_percent_of_sampled_runs() -> None:
+    r = _physics_run(50, 250, 0)
+    lo, hi = r.prediction_interval
+    rates = np.random.default_rng(0).binomial(300, r.predicted_success, 20_000) / 300
+    inside = float(np.mean((rates >= lo) & (rates <= hi)))
+    assert 0.95 <= inside <= 0.975
+
+
+def test_near_boundary_flag_only_where_the_success_strays() -> None:
+    from bayesgrasp.sim.result import summarize
+
+    pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+    stable = pb.states.stable
+    goal = stable[np.flatnonzero(pb.success_states(0.0))[0]]
+    other = stable[np.flatnonzero(~pb.success_states(0.0))[0]]
+    near = np.ones(300, bool)  # every trial started near a boundary
+
+    def run(n_goal: int) -> list[str]:
+        final = np.concatenate([np.full(n_goal, goal), np.full(300 - n_goal, other)])
+        r = summarize("mujoco", pb, opt, final, np.zeros(300, bool), near, 1.0, 1e-3)
+        return r.assumption_flags
+
+    assert run(44) == []  # 0.147 observed, 0.148 predicted: a tight plan that works
+    flags = run(25)  # 0.083: the success strays
+    assert len(flags) == 1 and "300 of 300 trials started an action within" in flags[0]

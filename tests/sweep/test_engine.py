@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 pytest.importorskip("distributed")
@@ -30,6 +31,7 @@ from bayesgrasp.sweep import (
     read_results,
     run_sweep,
 )
+from bayesgrasp.sweep.engine import task_parts
 
 pytestmark = pytest.mark.dask
 
@@ -285,3 +287,46 @@ def test_scheduler_and_workers_started_by_the_test(
                 os.kill(p.pid, signal.SIGKILL)
                 p.wait()
         logs.close()
+
+
+def test_forty_small_parts_use_both_workers(tmp_path: Path, cluster: str) -> None:
+    """Small parts go several to a task, but spread over every worker of the cluster."""
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    rng = np.random.default_rng(7)
+    for i in range(40):
+        pts = rng.random((6, 2)) * 30.0
+        doc = {"name": f"p{i}", "units": "mm", "vertices": pts.tolist()}
+        (folder / f"p{i:02d}.json").write_text(json.dumps(doc))
+    out = tmp_path / "r.csv"
+    s = run_sweep([folder], out, SweepOptions(), scheduler=cluster)
+    rows = read_results(out)
+    assert s.written == 40 and s.workers == 2
+    assert len({r["worker"] for r in rows}) == 2
+
+
+def test_task_parts_spreads_small_sweeps() -> None:
+    assert task_parts(40, 2, None) == 5  # 8 tasks: 4 a worker
+    assert task_parts(1, 8, None) == 1
+    assert task_parts(10**5, 2, None) == 64  # capped: task overhead stays small
+    assert task_parts(10**5, 2, "kinematic") == 2 and task_parts(10**5, 2, "mujoco") == 1
+
+
+@pytest.mark.parametrize(
+    ("other", "reason"),
+    [
+        (SweepOptions(seed=1), r"seed 0 -> 1"),
+        (SweepOptions(simulate="kinematic", trials=500), r"trials None -> 500"),
+    ],
+)
+def test_resume_with_another_seed_or_trial_count_is_refused(
+    tmp_path: Path, cluster: str, other: SweepOptions, reason: str
+) -> None:
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    (folder / "tri.json").write_text(json.dumps({"vertices": [[0, 0], [4, 0], [1, 3]]}))
+    out = tmp_path / "r.csv"
+    run_sweep([folder], out, SweepOptions(), scheduler=cluster)
+    with pytest.raises(SweepError, match=rf"cannot resume: .*{reason}"):
+        run_sweep([folder], out, other, scheduler=cluster, resume=True)
+    assert len(read_results(out)) == 1

@@ -33,10 +33,14 @@ def test_report_has_every_section(tmp_path: Path) -> None:
         "Summary",
         "Bayes plans",
         "Predicted against observed success",
-        "Parts where physics disagrees with the model",
+        "Parts where the kinematic simulation misses the prediction",
+        "Every part",
         "Parts that failed",
     ):
         assert f"<h2>{heading}</h2>" in text
+    # a kinematic mismatch is not called physics
+    assert "physics disagrees" not in text and "kinematic mismatch" in text
+    assert "<table class='sortable'>" in text and "querySelectorAll('table.sortable th')" in text
     assert text.count("<svg") >= 4  # two histograms, the scatter, one outline
     assert "missing.json: no such file" in text
     assert disagreements(rows)[0]["path"] == rows[0]["path"]
@@ -45,3 +49,20 @@ def test_report_has_every_section(tmp_path: Path) -> None:
 def test_report_without_simulation_or_rows() -> None:
     text = report_html([])
     assert "<h2>Summary</h2>" in text and "<svg" not in text
+
+
+def test_parts_table_gives_each_part_its_interval_and_verdict() -> None:
+    base = {"status": "ok", "sides": 4, "states": 4, "bayes_actions": 1, "bayes_cost": 1.0,
+            "bayes_probability": 0.5, "sim_engine": "mujoco", "sim_trials": 100,
+            "sim_p_value": 0.5, "sim_jams": 3, "outline": "[[0,0],[1,0],[0,1]]"}  # fmt: skip
+    rows = [
+        {**base, "path": "good.json", "sim_predicted": 0.5, "sim_observed": 0.48,
+         "sim_ci_low": 0.38, "sim_ci_high": 0.58},
+        {**base, "path": "jams.json", "sim_predicted": 0.5, "sim_observed": 0.2,
+         "sim_ci_low": 0.13, "sim_ci_high": 0.29},
+    ]  # fmt: skip
+    text = report_html(rows)
+    table = text[text.index("<h2>Every part</h2>") :]
+    assert "[0.38, 0.58]" in table and "agrees" in table and "observed below" in table
+    assert "<h2>Parts where physics disagrees with the model</h2>" in text
+    assert "physics disagrees (predicted outside the observed 95% interval)" in text

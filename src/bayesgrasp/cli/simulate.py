@@ -70,7 +70,8 @@ TrialsOpt = Annotated[
     ),
 ]
 WorkersOpt = Annotated[
-    int, typer.Option(min=1, help="Processes for mujoco trials (kinematic uses one).")
+    int,
+    typer.Option(min=1, help="Threads for mujoco trials (kinematic uses one)."),
 ]
 OffsetOpt = Annotated[
     float,
@@ -156,6 +157,9 @@ def simulate(
     noise-aware one that plan gives with the same options; every plan is predicted exactly
     under the noise, and with --payoff judged by its expected payoff (the mean payoff of
     the final states). The verdict: each prediction within its observed interval (z = 4).
+    With --engine mujoco every trial counts (a jam did not reach the goal): the observed
+    success and its 95% interval, the range 95% of runs would give if the prediction were
+    right, an exact binomial p-value, and flags where the model's assumptions break.
 
     With --plan FILE the plan must be for PART (else exit 2, unless --force) and runs under
     the prior and goal it was made for, unless --prior or --goal says otherwise.
@@ -451,7 +455,9 @@ def _lagged(lag: float, part: Any, units: str | None) -> Any:
     from ..sim.params import SimParams
     from ..sim.scene import units_scale
 
-    base = SimParams()
+    # The lag is in seconds of jaws closing at 1 cm/s (the push it makes is its meaning),
+    # whatever the default jaw speed.
+    base = replace(SimParams(), jaw_speed=0.01)
     push = base.jaw_speed * lag / 2.0
     size = part.hull.size * units_scale(units if units is not None else part.units)
     if push > 2.0 * size:

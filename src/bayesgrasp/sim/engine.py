@@ -20,9 +20,12 @@ One action, in the gripper frame (which is the world frame of the scene):
 3. *Read and open.* The part's yaw is read from the free joint's quaternion; opening the
    jaws is the next action's placement.
 
-Trials run in parallel across processes when ``workers > 1``; every random draw (initial
+:func:`simulate_mujoco` runs a plan's trials in batches, an action at a time, through
+MuJoCo's C rollout threads (:mod:`bayesgrasp.sim.rollout`), each trial stopped when jaws and
+part have settled; ``method="stepped"`` runs them one at a time from Python
+(:class:`Squeezer`, in processes when ``workers > 1``). Every random draw (initial
 orientations, gripper errors, offset signs) is made up front from one seed, so results do
-not depend on the number of workers.
+not depend on the number of workers or threads.
 """
 
 from __future__ import annotations
@@ -268,7 +271,12 @@ class Squeezer:
             # Blocked jaws are slow while their force still ramps up (kp * jaw_speed per
             # second): the squeeze is over only when both push with their full force.
             full = min(abs(d.actuator_force[an]), abs(d.actuator_force[ap])) >= force
-            if t > earliest and slow and full:
+            pv = self._part_v
+            still = (
+                math.hypot(d.qvel[pv], d.qvel[pv + 1]) < sp.part_speed
+                and abs(d.qvel[pv + 5]) < sp.part_spin
+            )
+            if t > earliest and slow and full and still:
                 calm += 1
                 if calm >= need:
                     return ActionOutcome(theta, self.yaw(), True, t, self.width())
@@ -328,6 +336,47 @@ def _map_trials(
         yield from pool.imap(_run_trial, trials, chunksize=chunk)
 
 
+#: Trials a rollout batch: progress is reported after each, and memory stays small.
+ROLLOUT_BATCH = 2048
+
+
+def _rollout_trials(
+    part: Part,
+    scale: float,
+    params: SimParams,
+    trials: Sequence[_Trial],
+    nthread: int,
+    progress: Progress | None,
+    stable: FloatArray | None = None,
+) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+    """Start yaw, end yaw and settled flag of every action of every trial, shape (T, k).
+
+    ``stable``: the part's stable orientations; jammed actions are retried with slow jaws
+    (:meth:`~bayesgrasp.sim.rollout.BatchSqueezer.act`).
+    """
+    from .rollout import BatchSqueezer
+
+    n, k = len(trials), len(trials[0].angles)
+    starts, ends = np.zeros((n, k)), np.zeros((n, k))
+    settled = np.zeros((n, k), dtype=bool)
+    with BatchSqueezer(part, scale, params, nthread) as bs:
+        for lo in range(0, n, ROLLOUT_BATCH):
+            batch = trials[lo : lo + ROLLOUT_BATCH]
+            yaw = np.array([t.theta0 for t in batch])
+            for j in range(k):
+                ang = np.array([t.angles[j] for t in batch])
+                off = np.array([t.offsets[j] for t in batch])
+                lead = np.array([t.leads[j] for t in batch]) if batch[0].leads else None
+                res = bs.act(np.mod(yaw - ang, TWO_PI), off, batch[0].pushes[j], lead, stable)
+                starts[lo : lo + len(batch), j] = res.start
+                ends[lo : lo + len(batch), j] = res.end
+                settled[lo : lo + len(batch), j] = res.settled
+                yaw = res.end
+            if progress is not None:
+                progress(lo + len(batch), n)
+    return starts, ends, settled
+
+
 def simulate_mujoco(
     problem: Problem,
     option: PlanOption,
@@ -340,6 +389,7 @@ def simulate_mujoco(
     scale: float | None = None,
     boundary_margin: float = DEFAULT_BOUNDARY_MARGIN,
     progress: Progress | None = None,
+    method: str = "rollout",
 ) -> SimulationResult:
     """Execute a plan ``trials`` times in MuJoCo and compare with the model.
 
@@ -358,14 +408,20 @@ def simulate_mujoco(
         Error added to every commanded gripper angle.
     rng : numpy.random.Generator or int or None
     workers : int
-        Processes (1: run here).
+        ``rollout``: C threads of MuJoCo's rollout; ``stepped``: processes (1: run here).
+        The results do not depend on it.
     scale : float, optional
         Metres per unit of the part's coordinates; default from ``part.units`` (metres when
         the part gives none).
     boundary_margin : float
         Actions starting this close (radians) to a basin boundary count as near-boundary.
     progress : callable, optional
-        ``progress(done, total)`` after each trial.
+        ``progress(done, total)`` after each trial (``stepped``) or batch of trials.
+    method : {"rollout", "stepped"}
+        ``rollout`` (default): every action of a batch of trials in one call of
+        :func:`mujoco.rollout.rollout`, stopped when each has settled
+        (:class:`~bayesgrasp.sim.rollout.BatchSqueezer`); ``stepped``: one trial at a time
+        from Python (:class:`Squeezer`). Both run the same scene and settled test.
 
     Returns
     -------
@@ -393,6 +449,8 @@ def simulate_mujoco(
     """
     require_mujoco()
     check_trials(trials)
+    if method not in ("rollout", "stepped"):
+        raise SimulationError(f"`method` must be rollout or stepped; got {method!r}")
     if not isinstance(workers, int | np.integer) or workers < 1:
         raise SimulationError(f"`workers` must be an integer >= 1; got {workers!r}")
     if not (math.isfinite(offset) and offset >= 0):
@@ -424,15 +482,20 @@ def simulate_mujoco(
         leads = np.where(gen.random((trials, k)) < 0.5, -1, 1)
         tasks = [replace(t, leads=tuple(leads[i].tolist())) for i, t in enumerate(tasks)]
     t0 = time.perf_counter()
-    outcomes: list[list[ActionOutcome]] = []
-    for res in _map_trials(problem.part, sc, params, tasks, workers):
-        outcomes.append(res)
-        if progress is not None:
-            progress(len(outcomes), trials)
+    if method == "stepped":
+        outcomes: list[list[ActionOutcome]] = []
+        for res in _map_trials(problem.part, sc, params, tasks, workers):
+            outcomes.append(res)
+            if progress is not None:
+                progress(len(outcomes), trials)
+        starts = np.array([[a.start for a in r] for r in outcomes])  # (T, k)
+        ends = np.array([[a.end for a in r] for r in outcomes])  # (T, k)
+        settled = np.array([[a.settled for a in r] for r in outcomes])  # (T, k)
+    else:
+        starts, ends, settled = _rollout_trials(
+            problem.part, sc, params, tasks, workers, progress, problem.states.stable
+        )
     seconds = time.perf_counter() - t0
-    starts = np.array([[a.start for a in r] for r in outcomes])  # (T, k)
-    ends = np.array([[a.end for a in r] for r in outcomes])  # (T, k)
-    settled = np.array([[a.settled for a in r] for r in outcomes])  # (T, k)
     states = problem.states
     near = np.zeros(trials, dtype=bool)
     jammed: NDArray[np.bool_] = np.asarray(~settled.all(axis=1), dtype=bool)

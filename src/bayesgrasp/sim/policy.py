@@ -443,6 +443,8 @@ class _CycleOut:
 
 
 _CTX: dict[str, Any] = {}
+#: Cycles a batched round: progress is reported after each.
+_BATCH = 1024
 
 
 def _init_mujoco(
@@ -505,6 +507,93 @@ def _run_cycle(c: _Cycle) -> _CycleOut:
     return _CycleOut(total, acts, ok, isinstance(node, Reject), jammed, tuple(errors), t_sim)
 
 
+def _run_cycles_batched(
+    init: tuple[Any, ...], cycles: Sequence[_Cycle], nthread: int
+) -> list[_CycleOut]:
+    """Every cycle, the actions of cycles at the same policy node batched in C threads.
+
+    A policy branches on the width read, so the next action of a cycle is known only once
+    its previous action has ended. At each round the cycles still running are grouped by
+    part and policy node (the same action, from their own yaws) and each group is one call
+    of :meth:`~bayesgrasp.sim.rollout.BatchSqueezer.act`; then each cycle reads its width and
+    follows its branch, exactly as :func:`_run_cycle` does one cycle at a time.
+    """
+    from .rollout import BatchSqueezer
+
+    problems: tuple[Problem, ...] = init[0]
+    policy: Policy = init[1]
+    scales: tuple[float, ...] = init[2]
+    params: SimParams = init[3]
+    sensor = policy.sensor
+    n = len(cycles)
+    node: list[PolicyNode | Declare | Reject] = [policy.root] * n
+    yaw = [c.theta0 for c in cycles]
+    total, acts = [0.0] * n, [0] * n
+    jammed, t_sim = [False] * n, [0.0] * n
+    errors: list[list[float]] = [[] for _ in range(n)]
+    batchers: dict[int, BatchSqueezer] = {}
+    try:
+        while True:
+            groups: dict[tuple[int, int], list[int]] = {}
+            for i in range(n):
+                nd = node[i]
+                if isinstance(nd, PolicyNode):
+                    groups.setdefault((cycles[i].part, id(nd)), []).append(i)
+            if not groups:
+                break
+            for (j, _), idx in groups.items():
+                if j not in batchers:
+                    batchers[j] = BatchSqueezer(problems[j].part, scales[j], params, nthread)
+                pb, scale = problems[j], scales[j]
+                step = node[idx[0]].step  # type: ignore[union-attr]
+                start = np.array([yaw[i] - step.alpha - cycles[i].angle_err[acts[i]] for i in idx])
+                off = np.array([cycles[i].offsets[acts[i]] for i in idx])
+                lagged = bool(cycles[idx[0]].leads)
+                lead = np.array([cycles[i].leads[acts[i]] for i in idx]) if lagged else None
+                res = batchers[j].act(
+                    np.mod(start, TWO_PI), off, get_action(step.kind).pushes_first, lead,
+                    pb.states.stable,
+                )  # fmt: skip
+                states = nearest_state(pb.states, res.end)
+                for b, i in enumerate(idx):
+                    c, a = cycles[i], acts[i]
+                    t_sim[i] += float(res.sim_time[b])
+                    total[i] += pb.cost.action_cost(step.kind, first=a == 0)
+                    yaw[i] = float(res.end[b])
+                    state = int(states[b])
+                    stuck = (not res.settled[b]) or float(
+                        circle_distance(yaw[i], pb.states.stable[state])
+                    ) > params.jam_tol
+                    jammed[i] |= stuck
+                    width = float(res.width[b]) / scale + c.reading_err[a]
+                    reading = float(WidthSensor(0.0, sensor.resolution).read(np.array([width]))[0])
+                    if not stuck:
+                        errors[i].append(reading - float(pb.widths[state]))
+                    acts[i] = a + 1
+                    node[i] = node[i].branch(reading).next  # type: ignore[union-attr]
+    finally:
+        for bs in batchers.values():
+            bs.close()
+    outs = []
+    for i, c in enumerate(cycles):
+        pb, nd, total_i = problems[c.part], node[i], total[i]
+        ok = False
+        if isinstance(nd, Declare):
+            total_i += pb.cost.verify
+            if nd.part == c.part:
+                state = int(nearest_state(pb.states, np.array([yaw[i]]))[0])
+                ok = bool(pb.success_states(nd.orientation)[state])
+        if not ok:
+            total_i += pb.cost.retry
+        outs.append(
+            _CycleOut(
+                total_i, acts[i], ok, isinstance(nd, Reject), jammed[i], tuple(errors[i]),
+                t_sim[i],
+            )
+        )  # fmt: skip
+    return outs
+
+
 def _map_cycles(
     init: tuple[Any, ...], cycles: Sequence[_Cycle], workers: int
 ) -> Iterator[_CycleOut]:
@@ -532,6 +621,7 @@ def simulate_policy_mujoco(
     scale: float | None = None,
     add_sensor_error: bool = False,
     progress: Progress | None = None,
+    method: str = "rollout",
 ) -> PolicySimulation:
     """Run ``cycles`` cycles of a policy in MuJoCo, acting on the real jaw separation.
 
@@ -556,12 +646,17 @@ def simulate_policy_mujoco(
         Error added to every commanded gripper angle.
     rng : numpy.random.Generator or int or None
     workers : int
-        Processes (1: run here).
+        ``rollout``: C threads of MuJoCo's rollout; ``stepped``: processes (1: run here).
+        The results do not depend on it.
     scale : float, optional
         Metres per unit of the parts' coordinates (default from each part's units).
     add_sensor_error : bool
         Also add ``e ~ Normal(0, SIGMA^2)`` of the policy's sensor to every reading.
     progress : callable, optional
+    method : {"rollout", "stepped"}
+        ``rollout`` (default): the cycles at the same policy node act together, batched in
+        MuJoCo's C rollout threads (:class:`~bayesgrasp.sim.rollout.BatchSqueezer`);
+        ``stepped``: one cycle at a time from Python.
 
     Returns
     -------
@@ -580,6 +675,8 @@ def simulate_policy_mujoco(
 
     require_mujoco()
     check_trials(cycles)
+    if method not in ("rollout", "stepped"):
+        raise SimulationError(f"`method` must be rollout or stepped; got {method!r}")
     if not isinstance(workers, int | np.integer) or workers < 1:
         raise SimulationError(f"`workers` must be an integer >= 1; got {workers!r}")
     if not (math.isfinite(offset) and offset >= 0):
@@ -614,10 +711,17 @@ def simulate_policy_mujoco(
         tasks = [replace(t, leads=tuple(leads[i].tolist())) for i, t in enumerate(tasks)]
     t0 = time.perf_counter()
     outs: list[_CycleOut] = []
-    for o in _map_cycles((pbs, policy, scales, params), tasks, workers):
-        outs.append(o)
-        if progress is not None:
-            progress(len(outs), cycles)
+    init = (pbs, policy, scales, params)
+    if method == "stepped":
+        for o in _map_cycles(init, tasks, workers):
+            outs.append(o)
+            if progress is not None:
+                progress(len(outs), cycles)
+    else:
+        for lo in range(0, cycles, _BATCH):
+            outs += _run_cycles_batched(init, tasks[lo : lo + _BATCH], workers)
+            if progress is not None:
+                progress(len(outs), cycles)
     ok = np.array([o.success for o in outs], dtype=bool)
     return PolicySimulation(
         "mujoco",

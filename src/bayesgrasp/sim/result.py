@@ -46,6 +46,7 @@ from .stats import goodness_of_fit, wilson_interval
 
 __all__ = [
     "DEFAULT_BOUNDARY_MARGIN",
+    "PHYSICS_FIT",
     "VERDICT_Z",
     "Progress",
     "SimulationResult",
@@ -74,6 +75,9 @@ DEFAULT_BOUNDARY_MARGIN = math.radians(2.5)
 VERDICT_Z = 4.0
 """Standard deviations of the intervals the verdict reads (as the policy simulation's)."""
 _Z95 = 1.959963984540054  # the normal quantile of a two-sided 95% interval
+
+PHYSICS_FIT = "physics: the success test below counts every trial"
+"""Why a physics run has no chi-square over final states (``fit_unavailable``)."""
 
 
 def check_trials(trials: int) -> None:
@@ -331,11 +335,18 @@ class SimulationResult:
 
         When most trials jam, the few that end in a stable orientation are not a sample of
         the plan's outcomes (the jams are not spread over the states as the prediction is),
-        and a p-value of their fit would read as agreement. So it is not given.
+        and a p-value of their fit would read as agreement. So it is not given. Nor for a
+        physics engine (:data:`PHYSICS_FIT`): its outcomes include jams, which the states'
+        chi-square leaves out (a plan whose part jams in one trial of five looked fine),
+        and starts near a basin boundary that go the other way, into a state the model
+        calls impossible (a chi-square of 0 for a plan whose success matched); its test is
+        :attr:`success_p_value`, every trial counted.
         """
         unjammed = self.trials - self.final_jams
         if self.trials and 2 * self.jams > self.trials:
             return f"{self.jams} of {self.trials} trials jammed"
+        if self.engine != "kinematic":
+            return PHYSICS_FIT
         if unjammed <= 0:
             return "no trial ended in a stable orientation"
         return None
@@ -344,11 +355,84 @@ class SimulationResult:
     def p_value(self) -> float:
         """Chi-square p-value of the final states (jammed trials left out) against prediction.
 
-        NaN when :attr:`fit_unavailable` gives a reason.
+        NaN when :attr:`fit_unavailable` gives a reason: always for a physics engine, whose
+        test is :attr:`success_p_value`.
         """
         if self.fit_unavailable is not None:
             return math.nan
         return goodness_of_fit(self.observed, self.predicted)
+
+    @property
+    def success_p_value(self) -> float:
+        """Exact two-sided binomial p-value of the successes, every trial counted.
+
+        A jammed trial did not reach the goal: it is a failure. The test asks whether
+        ``successes`` of ``trials`` is a likely count when each trial succeeds with the
+        predicted probability.
+
+        Examples
+        --------
+        >>> from bayesgrasp.geometry.polygon import Part
+        >>> pb = Problem.build(Part.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+        >>> opt = PlanOption((PlanStep("squeeze", 0.0),), 0.0, 0.25, 8.0, None, (0.0, 1.0))
+        >>> r = summarize("mujoco", pb, opt, np.zeros(10), np.zeros(10, bool),
+        ...               np.zeros(10, bool), 1.0, 1e-6)
+        >>> round(r.predicted_success, 3), r.successes, round(r.success_p_value, 4)
+        (0.148, 10, 0.0)
+        """
+        if not self.trials:
+            return math.nan
+        from scipy.stats import binomtest
+
+        p = min(max(self.predicted_success, 0.0), 1.0)
+        return float(binomtest(self.successes, self.trials, p).pvalue)
+
+    @property
+    def prediction_interval(self) -> tuple[float, float]:
+        """Where 95% of observed success rates fall if the prediction is right.
+
+        The central 95% of the binomial distribution of ``trials`` trials at the predicted
+        success probability, as rates (exact quantiles).
+        """
+        from scipy.stats import binom
+
+        p = min(max(self.predicted_success, 0.0), 1.0)
+        lo, hi = binom.ppf([0.025, 0.975], self.trials, p)
+        return float(lo) / self.trials, float(hi) / self.trials
+
+    @property
+    def assumption_flags(self) -> list[str]:
+        """Why the squeeze model's assumptions break in these trials (physics only).
+
+        The model assumes every action ends in a stable orientation of the width function
+        and that a start's basin decides it. Flagged: more than 2% of trials jammed (the
+        part stopped away from every stable orientation: jaw force against table
+        friction where the turning couple vanishes, at shallow minima or near maxima of
+        the width), and, when the observed success strays from the prediction (outside the
+        observed 95% interval, or :attr:`success_p_value` below 0.1), more
+        than 10% of trials starting an action within ``boundary_margin`` of a basin
+        boundary (a tight plan: there the outcome is a coin toss in physics; a plan whose
+        states land on boundaries by design, as push-grasps' can, and still succeed is not
+        flagged). Empty for the kinematic engine, which is the model.
+        """
+        if self.engine == "kinematic" or not self.trials:
+            return []
+        out = []
+        if self.jams > 0.02 * self.trials:
+            out.append(
+                f"{self.jams} of {self.trials} trials jammed (stopped away from every stable "
+                "orientation: jaw force against table friction)"
+            )
+        lo, hi = self.ci95
+        missed = not lo - 1e-9 <= self.predicted_success <= hi + 1e-9
+        missed = missed or self.success_p_value < 0.1
+        if missed and self.near_boundary > 0.1 * self.trials:
+            out.append(
+                f"{self.near_boundary} of {self.trials} trials started an action within "
+                f"{math.degrees(self.boundary_margin):g} deg of a basin boundary "
+                "(a tight plan: there physics may go either way)"
+            )
+        return out
 
     @property
     def executions_per_second(self) -> float:
@@ -575,6 +659,11 @@ def verdict_document(res: SimulationResult) -> dict[str, Any]:
             "observed": _finite(obs),
             "ci95": [_finite(clo), _finite(chi)],
         }
+    if res.engine != "kinematic":
+        out["ci95"] = list(res.ci95)
+        out["prediction_interval95"] = list(res.prediction_interval)
+        out["success_p_value"] = res.success_p_value
+        out["assumption_flags"] = res.assumption_flags
     out["agrees"] = res.agrees
     return out
 
@@ -609,6 +698,16 @@ def verdict_lines(res: SimulationResult) -> list[str]:
         for name, v, (lo, hi) in claims
     )
     word = "agrees" if res.agrees else "DISAGREES"
+    if res.engine != "kinematic":
+        lo, hi = res.ci95
+        plo, phi = res.prediction_interval
+        lines.append(
+            f"success, every trial counted (a jam is a failure): observed "
+            f"{res.observed_success:.4f} ({res.successes}/{res.trials}), 95% interval "
+            f"[{lo:.4f}, {hi:.4f}]; predicted {res.predicted_success:.4f}, 95% of runs of "
+            f"{res.trials} trials in [{plo:.4f}, {phi:.4f}]; p = {res.success_p_value:.3g}"
+        )
+        lines += [f"model assumptions break: {f}" for f in res.assumption_flags]
     lines.append(f"verdict: {word}: {said} (z = {VERDICT_Z:g})")
     return lines
 

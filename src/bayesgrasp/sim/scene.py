@@ -209,6 +209,9 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
     )
     tc = sp.solref_timeconst
     fr = sp.table_friction
+    # The jaws' mass scales with their force (as gain and damping do): the same motion,
+    # time constant jaw_mass / jaw_damping, for every part.
+    jaw_mass = sp.jaw_mass * (body.force / sp.jaw_force if sp.scale_jaw_mass else 1.0)
     return f"""<mujoco model="bayesgrasp-squeeze">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{sp.timestep:.9g}" integrator="{sp.integrator}" solver="{sp.solver}"
@@ -232,12 +235,12 @@ def scene_xml(part: Part, scale: float, params: SimParams | None = None) -> str:
     <body name="jaw_neg" pos="0 0 {jaw_z:.9g}">
       <joint name="jaw_neg" type="slide" axis="1 0 0" damping="{body.damping:.9g}"/>
       <geom name="jaw_neg" type="box" pos="{-t / 2:.9g} 0 0" size="{t / 2:.9g} {jaw_half:.9g} \
-{jaw_h:.9g}" mass="{sp.jaw_mass:.9g}" condim="1" priority="1" contype="2" conaffinity="2"/>
+{jaw_h:.9g}" mass="{jaw_mass:.9g}" condim="1" priority="1" contype="2" conaffinity="2"/>
     </body>
     <body name="jaw_pos" pos="0 0 {jaw_z:.9g}">
       <joint name="jaw_pos" type="slide" axis="1 0 0" damping="{body.damping:.9g}"/>
       <geom name="jaw_pos" type="box" pos="{t / 2:.9g} 0 0" size="{t / 2:.9g} {jaw_half:.9g} \
-{jaw_h:.9g}" mass="{sp.jaw_mass:.9g}" condim="1" priority="1" contype="2" conaffinity="2"/>
+{jaw_h:.9g}" mass="{jaw_mass:.9g}" condim="1" priority="1" contype="2" conaffinity="2"/>
     </body>
   </worldbody>
   <actuator>

@@ -25,6 +25,7 @@ from __future__ import annotations
 import glob
 import hashlib
 import logging
+import math
 import os
 import time
 import uuid
@@ -45,12 +46,35 @@ __all__ = [
     "SweepSummary",
     "find_parts",
     "run_sweep",
+    "task_parts",
 ]
 
 logger = logging.getLogger(__name__)
 
-#: Parts per task, by simulation engine (None: planning only, a few milliseconds a part).
+#: Most parts per task, by simulation engine (None: planning only, a few milliseconds a
+#: part). Fewer when the parts are few: :func:`task_parts`.
 CHUNK_PARTS: dict[str | None, int] = {None: 64, "kinematic": 2, "mujoco": 1}
+#: Tasks per worker :func:`task_parts` aims at: enough that every worker starts at once and
+#: a slow task at the end leaves the others little idle time. Physics tasks (seconds a part)
+#: are split finer than planning ones (milliseconds).
+TASKS_PER_WORKER: dict[str | None, int] = {None: 4, "kinematic": 8, "mujoco": 16}
+
+
+def task_parts(n_parts: int, n_workers: int, simulate: str | None) -> int:
+    """Parts per task: the parts spread over ``TASKS_PER_WORKER`` tasks per worker.
+
+    At most :data:`CHUNK_PARTS` (a task's overhead is then small next to its work), at
+    least one.
+
+    Examples
+    --------
+    >>> task_parts(40, 2, None), task_parts(10_000, 2, None), task_parts(40, 2, "mujoco")
+    (5, 64, 1)
+    """
+    want = math.ceil(n_parts / (max(1, n_workers) * TASKS_PER_WORKER[simulate]))
+    return max(1, min(CHUNK_PARTS[simulate], want))
+
+
 #: Most bytes of part files in one task (a larger file is a task of its own).
 CHUNK_BYTES = 1 << 20
 
@@ -301,7 +325,8 @@ def run_sweep(
         What the client sends: paths (the workers read the files) or the files' bytes;
         ``auto``: paths to a local cluster, bytes to a scheduler.
     chunk_parts : int, optional
-        Parts a task (default by engine: 64 planning only, 2 kinematic, 1 MuJoCo).
+        Parts a task (default :func:`task_parts`: the parts spread over 4 tasks per worker
+        planning only, 8 kinematic, 16 MuJoCo, and at most 64, 2 and 1 a task).
     batch_rows, flush_seconds : int, float
         Rows are written when ``batch_rows`` have come, or ``flush_seconds`` after the
         last write, and at the end.
@@ -373,9 +398,9 @@ def run_sweep(
 
     if not todo:
         return summary()
-    per_task = chunk_parts or CHUNK_PARTS[options.simulate]
-    queue = deque(_chunks(todo, per_task))
     client, cluster, n_workers = _connect(workers, scheduler)
+    per_task = chunk_parts or task_parts(len(todo), n_workers, options.simulate)
+    queue = deque(_chunks(todo, per_task))
     import distributed
     from distributed.client import FutureCancelledError
     from distributed.scheduler import KilledWorker

@@ -3,9 +3,12 @@
 Sections: the run (options, versions), a summary table (parts, planned, no guaranteed
 plan, errors by class, Bayes cost and plan length statistics), histograms of the Bayes
 plan's expected cost and of its length, predicted against observed success in simulation
-(with each part's 95% interval), the parts where physics disagrees with the model (the
-predicted success outside the observed 95% interval), each with its outline drawn, and the
-parts that failed, with their messages.
+(with each part's 95% interval), the parts where the simulation disagrees with the
+prediction (outside the observed 95% interval: "physics disagrees" for MuJoCo, a
+"kinematic mismatch" for the model's own Monte Carlo, which is a sampling or evaluation
+error, not physics), each with its outline drawn, a table of every part (sortable by any
+column: click its header) with the simulation's agreement and interval, and the parts that
+failed, with their messages.
 
 Figures are drawn with matplotlib (extra ``plot``) as inline SVG.
 """
@@ -114,16 +117,88 @@ def disagreements(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
     return sorted(out, key=lambda r: -abs(r["sim_predicted"] - r["sim_observed"]))
 
 
-def _table(head: Sequence[str], body: Sequence[Sequence[Any]]) -> str:
+def _engine_words(rows: Sequence[dict[str, Any]]) -> tuple[str, str]:
+    """What a disagreement is called for these rows' engine: (summary label, heading)."""
+    engines = {r.get("sim_engine") for r in rows}
+    if engines == {"kinematic"}:
+        return (
+            "kinematic mismatch (predicted outside the observed 95% interval)",
+            "Parts where the kinematic simulation misses the prediction",
+        )
+    return (
+        "physics disagrees (predicted outside the observed 95% interval)",
+        "Parts where physics disagrees with the model",
+    )
+
+
+#: Sorts a table by the column whose header is clicked (numbers as numbers; again: reversed).
+_SORT_JS = """<script>
+document.querySelectorAll('table.sortable th').forEach(function (th, i) {
+  th.style.cursor = 'pointer';
+  th.addEventListener('click', function () {
+    var table = th.closest('table'), rows = Array.from(table.rows).slice(1);
+    var dir = th.dataset.dir === 'asc' ? -1 : 1; th.dataset.dir = dir > 0 ? 'asc' : 'desc';
+    var key = function (r) { var c = r.cells[i]; var v = c.dataset.v ?? c.textContent;
+      var x = parseFloat(v); return isNaN(x) ? v : x; };
+    rows.sort(function (a, b) { var x = key(a), y = key(b);
+      if (typeof x !== typeof y) { return typeof x === 'number' ? -dir : dir; }
+      return x < y ? -dir : x > y ? dir : 0; });
+    rows.forEach(function (r) { table.tBodies[0].appendChild(r); });
+  });
+});
+</script>"""
+
+
+def _agreement(r: dict[str, Any]) -> str:
+    """A simulated row's verdict at 95%: agrees, or which way the observation misses."""
+    if r.get("sim_observed") is None:
+        return "-"
+    if r["sim_ci_low"] <= r["sim_predicted"] <= r["sim_ci_high"]:
+        return "agrees"
+    return "observed below" if r["sim_observed"] < r["sim_predicted"] else "observed above"
+
+
+def _parts_table(rows: Sequence[dict[str, Any]], limit: int) -> str:
+    """Every part (at most ``limit``), one row each, sortable by any column."""
+    head = [
+        "part", "status", "sides", "states", "Bayes actions", "Bayes cost", "Bayes success",
+        "engine", "predicted", "observed", "95% interval", "p", "jams", "simulation",
+    ]  # fmt: skip
+    body = []
+    for r in rows[:limit]:
+        sim = r.get("sim_observed") is not None
+        body.append(
+            [
+                r["path"],
+                r["status"],
+                r.get("sides") if r.get("sides") is not None else "-",
+                r.get("states") if r.get("states") is not None else "-",
+                r.get("bayes_actions") if r.get("bayes_actions") is not None else "-",
+                _num(r.get("bayes_cost")),
+                _num(r.get("bayes_probability")),
+                r.get("sim_engine") or "-",
+                _num(r.get("sim_predicted")) if sim else "-",
+                _num(r.get("sim_observed")) if sim else "-",
+                f"[{_num(r['sim_ci_low'])}, {_num(r['sim_ci_high'])}]" if sim else "-",
+                _num(r.get("sim_p_value"), 3) if sim else "-",
+                r.get("sim_jams") if sim and r.get("sim_jams") is not None else "-",
+                _agreement(r),
+            ]
+        )
+    return _table(head, body, sortable=True)
+
+
+def _table(head: Sequence[str], body: Sequence[Sequence[Any]], sortable: bool = False) -> str:
     cells = "".join(f"<th>{html.escape(str(h))}</th>" for h in head)
-    lines = [f"<table><tr>{cells}</tr>"]
+    cls = " class='sortable'" if sortable else ""
+    lines = [f"<table{cls}><thead><tr>{cells}</tr></thead><tbody>"]
     for row in body:
         tds = "".join(
             f"<td>{c}</td>" if str(c).startswith("<svg") else f"<td>{html.escape(str(c))}</td>"
             for c in row
         )
         lines.append(f"<tr>{tds}</tr>")
-    return "\n".join([*lines, "</table>"])
+    return "\n".join([*lines, "</tbody></table>"])
 
 
 def _fmean_or_none(xs: Sequence[float]) -> float | None:
@@ -136,7 +211,11 @@ def _num(x: float | None, digits: int = 4) -> str:
 
 
 def report_html(
-    rows: Sequence[dict[str, Any]], metadata: Sequence[dict[str, Any]] = (), *, limit: int = 50
+    rows: Sequence[dict[str, Any]],
+    metadata: Sequence[dict[str, Any]] = (),
+    *,
+    limit: int = 50,
+    limit_parts: int = 10_000,
 ) -> str:
     """The report of a results table, as one HTML document.
 
@@ -147,7 +226,9 @@ def report_html(
     metadata : sequence of dict
         The runs' metadata (:func:`~bayesgrasp.sweep.results.read_metadata`).
     limit : int
-        Most parts listed (and drawn) among those where physics disagrees, and errors.
+        Most parts listed (and drawn) among those where the simulation disagrees, and errors.
+    limit_parts : int
+        Most parts in the table of every part (the first ones of the results).
     """
     planned = [r for r in rows if r["status"] in ("ok", "no-plan")]
     failed = [r for r in rows if r["status"] == "error"]
@@ -209,10 +290,7 @@ def report_html(
     if sims:
         summary += [
             ("simulated parts", len(sims)),
-            (
-                "physics disagrees (predicted outside the observed 95% interval)",
-                len(disagreements(sims)),
-            ),
+            (_engine_words(sims)[0], len(disagreements(sims))),
         ]
     parts += ["<h2>Summary</h2>", _table(["", ""], summary)]
     if costs:
@@ -225,7 +303,7 @@ def report_html(
         parts += ["<h2>Predicted against observed success</h2>", _scatter(sims)]
         bad = disagreements(sims)[:limit]
         if bad:
-            parts.append("<h2>Parts where physics disagrees with the model</h2>")
+            parts.append(f"<h2>{html.escape(_engine_words(sims)[1])}</h2>")
             parts.append(
                 _table(
                     ["part", "outline", "predicted", "observed", "95% interval", "jams"],
@@ -242,6 +320,13 @@ def report_html(
                     ],
                 )
             )
+    if rows:
+        shown = min(len(rows), limit_parts)
+        parts += [
+            "<h2>Every part</h2>",
+            f"<p>{shown} of {len(rows)} parts; click a column's header to sort by it.</p>",
+            _parts_table(rows, limit_parts),
+        ]
     if failed:
         parts += [
             "<h2>Parts that failed</h2>",
@@ -250,7 +335,7 @@ def report_html(
                 [(r["path"], r["error_class"], r["error_message"]) for r in failed[:limit]],
             ),
         ]
-    parts.append("</body></html>")
+    parts += [_SORT_JS, "</body></html>"]
     return "\n".join(parts)
 
 

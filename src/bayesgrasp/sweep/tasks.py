@@ -785,7 +785,8 @@ def plan_part(
                 sim_observed=sim["observed_success"],
                 sim_ci_low=sim["ci95"][0],
                 sim_ci_high=sim["ci95"][1],
-                sim_p_value=sim["p_value"],
+                # physics: the success test, every trial counted (no states' chi-square)
+                sim_p_value=sim.get("success_p_value", sim["p_value"]),
                 sim_jams=sim["jams"],
                 sim_json=json.dumps(sim, allow_nan=False, separators=(",", ":")),
             )
