@@ -47,3 +47,26 @@ def test_sweep_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
         err = capsys.readouterr().err
         assert "cannot resume" in err and reason in err and "Traceback" not in err
     assert out.read_bytes() == before
+
+
+def test_outputs_never_land_where_the_sweep_reads_parts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Results or a report inside a swept folder would be read as parts by the next sweep;
+    one named like a part file would replace it; a missing PATH is not an empty sweep."""
+    parts = tmp_path / "parts"
+    parts.mkdir()
+    (parts / "a.csv").write_text("0,0\n3,0\n0,2\n", encoding="utf-8")
+    for argv in (
+        ["--out", str(parts / "rows.csv")],
+        ["--out", str(parts / "a.csv"), "--force"],
+        ["--out", str(tmp_path / "rows.csv"), "--report", str(parts / "r.html")],
+    ):
+        assert main(["sweep", str(parts), *argv]) == 2
+        err = capsys.readouterr().err
+        assert "input" in err and "write it elsewhere" in err and len(err.splitlines()) == 1
+    assert main(["sweep", str(parts / "*.csv"), "--out", str(parts / "a.csv"), "--force"]) == 2
+    assert "is an input of this sweep" in capsys.readouterr().err
+    assert sorted(p.name for p in parts.iterdir()) == ["a.csv"]
+    assert main(["sweep", str(tmp_path / "missing"), "--out", str(tmp_path / "r.csv")]) == 2
+    assert "no such file or folder" in capsys.readouterr().err

@@ -174,6 +174,7 @@ def sweep(
             from ..planning.robust import UNBOUNDED_GUARANTEE
 
             raise typer.BadParameter(UNBOUNDED_GUARANTEE, param_hint="--guaranteed")
+    _check_paths(paths, [("--out", out), ("--report", report_file)])
     extra = () if payoff is None else (str(payoff),)
     inputs = input_files(None, spec.prior, *paths, *extra)  # RESULTS: its own --resume/--force
     check_outputs([out], inputs, force=True, hint="--out", folders=True)
@@ -243,3 +244,32 @@ def sweep(
             f"guaranteed plan, {summary.errors} errors of which {summary.timeouts} timeouts) "
             f"by {summary.workers} workers in {summary.seconds:.1f} s"
         )
+
+
+def _check_paths(paths: list[str], outputs: list[tuple[str, Path | None]]) -> None:
+    """PATHs that exist (or are globs), and no output where the sweep reads its parts.
+
+    An output inside a folder being swept would be read as a part by the next sweep of that
+    folder (results, their ``.meta.json``), and one named like a part file would replace it.
+    """
+    import glob
+
+    for p in paths:
+        if not glob.has_magic(p) and not Path(p).exists():
+            raise typer.BadParameter(f"{p}: no such file or folder", param_hint="PATH")
+    for hint, target in outputs:
+        if target is None:
+            continue
+        t = target.resolve()
+        for p in paths:
+            for q in map(Path, glob.glob(p, recursive=True) if glob.has_magic(p) else [p]):
+                q = q.resolve()
+                if q == t:
+                    why = f"is an input of this sweep ({p})"
+                elif q.is_dir() and q in t.parents:
+                    why = f"is inside {p}, an input folder (the next sweep would read it)"
+                else:
+                    continue
+                raise typer.BadParameter(
+                    f"{str(target)!r} {why}: write it elsewhere", param_hint=hint
+                )

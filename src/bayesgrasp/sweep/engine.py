@@ -273,6 +273,9 @@ def _connect(workers: int | None, scheduler: str | None) -> tuple[Any, Any, int]
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
+        # A part past --timeout restarts its worker: the rows say so, Dask's warnings of
+        # lost tasks and restarts are not for the user.
+        silence_logs=logging.ERROR,
         # without a dashboard the scheduler still serves /health on 8787, or warns that
         # another cluster has it: any free port will do
         scheduler_kwargs={"dashboard_address": ":0"},
