@@ -108,7 +108,7 @@ JawLagOpt = Annotated[
         help="mujoco: contact asynchrony: in each squeeze one jaw (either, equally likely) "
         "starts closing SECONDS before the other and pushes the part jaw_speed * SECONDS / 2 "
         "(5 mm per second at the default 10 mm/s) before the other touches; the clearance is "
-        "raised to that push + 1 mm, as in the README's calibration of --contact-noise.",
+        "raised to that push + 1 mm (the documentation's calibration of --contact-noise).",
     ),
 ]
 SensorErrorOpt = Annotated[

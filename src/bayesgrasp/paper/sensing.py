@@ -167,7 +167,7 @@ def run_sensing_study(
     seed : int
     max_actions : int
         At most this many actions on any path, and in the sensorless plan (default 2: noisy
-        policies with push-grasps grow fast with depth, see the README).
+        policies with push-grasps grow fast with depth).
     sense : str
         ``width`` (columns exact, 1% and 5%) or ``width:SIGMA,RES`` relative to each
         part's largest diameter.

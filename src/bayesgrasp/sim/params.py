@@ -1,8 +1,8 @@
 """Settings of the physics check, each with its default and the reason for it.
 
 The defaults reproduce the frictionless squeeze model in MuJoCo 4.0.0; they come from the
-feasibility runs recorded in ``physics-notes.md`` (shared with the project) and from the
-measurements of this module's tests and benchmark (README, "Simulation").
+feasibility runs of the first MuJoCo scenes and from the measurements of this module's
+tests and benchmark (the accuracy study of the physics validation guide).
 """
 
 from __future__ import annotations
@@ -115,7 +115,7 @@ class SimParams:
         the other jaw closes; 0 means twice the part's size (enough for the part to turn
         to a stable push orientation, which needs a travel of the order of its size).
     jaw_lag : float
-        Contact asynchrony (README, "Noisy actions and payoffs"): in a squeeze one jaw's
+        Contact asynchrony (the guide's "Noisy actions and payoffs"): in a squeeze one jaw's
         target starts closing this many seconds before the other's. The leading jaw touches
         first and pushes the part ``jaw_speed * jaw_lag / 2`` before the other meets it,
         while that is under ``clearance``; beyond, the pushed part reaches the lagging jaw
