@@ -13,7 +13,11 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # Private names imported across modules in files other sessions own; each is to be made
 # public or moved by the owner of the file.
-KNOWN: dict[tuple[str, str, str], str] = {}
+KNOWN: dict[tuple[str, str, str], str] = {
+    ("bayesgrasp.cli.sensing", "bayesgrasp.cli.simulate", "_lagged"): (
+        "the command line's own helper: to be made public or moved by the owner of cli/"
+    ),
+}
 
 
 def _layout() -> ModuleType:
@@ -38,6 +42,13 @@ def test_no_private_name_imported_across_modules() -> None:
 def test_known_private_imports(pair: tuple[str, str, str]) -> None:
     if any((a, b, name) == pair for a, b, _, name in FOUND):
         pytest.xfail(KNOWN[pair])
+
+
+def test_the_lower_layers_have_no_circle() -> None:
+    graph = layout.import_graph(ROOT / "src")
+    low = [c for c in layout.circles(graph) if any(layout.layer_of(m) <= 2 for m in c)]
+    assert low == []
+    assert [i for i in layout.upward(graph) if layout.layer_of(i.source) <= 2] == []
 
 
 def test_the_checker_sees_private_names(tmp_path: Path) -> None:

@@ -826,7 +826,7 @@ class ConvexPolygon:
         ``px`` and ``py`` are the coordinates of ``pts`` as Python floats (the same values).
         """
         ordered = _sorted_pairs(px, py)  # by x first: the least and largest x at the ends
-        by_y = sorted(py)  # (cheaper than min and max)
+        by_y = sorted(py)  # the least and largest y at the ends
         x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], by_y[0], by_y[-1]
         extent = max(x1 - x0, y1 - y0)
         if _odd_magnitude(x0, x1, y0, y1, extent):
@@ -1373,6 +1373,24 @@ class Part:
         for arr in (*oriented, com):
             arr.setflags(write=False)
         return cls(name, hull, oriented[0], com, units, tuple(oriented[1:]))
+
+    def scaled(self, factor: float, units: str) -> Part:
+        """The part with its outline, holes and centre of mass multiplied by ``factor``.
+
+        :func:`bayesgrasp.units.convert` uses it to change units; ``units`` are the new ones.
+
+        Examples
+        --------
+        >>> p = Part.from_points([(0, 0), (1, 0), (0, 1)], units="cm").scaled(10, "mm")
+        >>> p.units, float(p.hull.vertices.max())
+        ('mm', 10.0)
+        """
+        com = self.center_of_mass * factor
+        if self.holes:
+            return Part.from_outline(
+                self.outline * factor, [h * factor for h in self.holes], self.name, com, units
+            )
+        return Part.from_points(self.outline * factor, self.name, com, units)
 
 
 _part_name, _part_hull, _part_outline, _part_center_of_mass, _part_units, _part_holes = (

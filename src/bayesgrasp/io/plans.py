@@ -322,7 +322,7 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
     non-arc curves with (its ``curve_error``), so a re-run with it gives the same numbers;
     a file of segments and arcs only has none (its arcs are exact).
     """
-    from .. import __version__
+    from .._version import __version__
 
     out: dict[str, Any] = {
         "version": __version__,
