@@ -15,7 +15,7 @@ the layers below it, never from a layer above:
    ``solid.policy`` (policies over poses), except the module of the next layer;
 4. ``strategy``: ``planning.strategy`` (one strategy type over every planner, and its exact
    evaluation);
-5. ``output``: ``io``, ``report``, ``report_curved``, ``figures``, ``sim``, ``paper``;
+5. ``output``: ``io``, ``report`` (with ``report.curved``), ``figures``, ``sim``, ``paper``;
 6. ``surface``: ``cli``, ``web``, ``sweep``, and the package's own ``__init__`` (the facade).
 
 Measured on every ``.py`` file under ``src/bayesgrasp`` with :mod:`ast`; nothing is imported:
@@ -64,7 +64,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("model", ("model",)),
     ("planning", ("planning", "solid.policy")),
     ("strategy", ("planning.strategy",)),
-    ("output", ("io", "report", "report_curved", "figures", "sim", "paper")),
+    ("output", ("io", "report", "figures", "sim", "paper")),
     ("surface", ("cli", "web", "sweep", "")),
 )
 

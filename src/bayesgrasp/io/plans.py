@@ -304,7 +304,7 @@ def part_document(part: Part) -> dict[str, Any]:
     out["center_of_mass"] = part.center_of_mass.tolist()
     out["id"] = part_id(part)
     if type(part) is not Part:  # a polygon has no curved member (and needs no import)
-        from ..report_curved import curved_document
+        from ..report.curved import curved_document
 
         curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts)
         if curved is not None:
