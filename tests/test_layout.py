@@ -21,10 +21,10 @@ KNOWN: dict[tuple[str, str, str], str] = {
 
 
 def _layout() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("layout", ROOT / "benchmarks" / "layout.py")
+    spec = importlib.util.spec_from_file_location("layout_measures", ROOT / "benchmarks" / "layout.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
-    sys.modules.setdefault("layout", module)
+    sys.modules["layout_measures"] = module  # for its dataclasses
     spec.loader.exec_module(module)
     return module
 
