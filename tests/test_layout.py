@@ -21,7 +21,8 @@ KNOWN: dict[tuple[str, str, str], str] = {
 
 
 def _layout() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("layout_measures", ROOT / "benchmarks" / "layout.py")
+    path = ROOT / "benchmarks" / "layout.py"
+    spec = importlib.util.spec_from_file_location("layout_measures", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     sys.modules["layout_measures"] = module  # for its dataclasses
