@@ -150,9 +150,6 @@ def convert(part: Part, units: str) -> Part:
     >>> p.units, float(p.hull.vertices.max())
     ('mm', 25.4)
     """
-    from .geometry.curved import CurvedPart
-    from .geometry.polygon import Part as PlainPart
-
     target = unit_name(units)
     if target is None:
         raise PartError("give the units to convert to")
@@ -163,15 +160,4 @@ def convert(part: Part, units: str) -> Part:
         )
     if part.units == target:
         return part
-    if isinstance(part, CurvedPart):
-        raise PartError(
-            f"part {part.name!r} is curved and in {part.units}: save the drawing in {target} "
-            "(its exact curves are not converted)"
-        )
-    f = factor(part.units, target)
-    com = part.center_of_mass * f
-    if part.holes:
-        return PlainPart.from_outline(
-            part.outline * f, [h * f for h in part.holes], part.name, com, target
-        )
-    return PlainPart.from_points(part.outline * f, part.name, com, target)
+    return part.scaled(factor(part.units, target), target)

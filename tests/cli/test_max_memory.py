@@ -55,11 +55,11 @@ def test_without_the_fallback_the_search_stops_with_the_reason() -> None:
 @settings(max_examples=12, deadline=None)
 def test_the_lower_bound_is_below_every_optimum(sensor: str, depth: int, actions: tuple) -> None:
     from bayesgrasp.model.sensing import parse_sensor
-    from bayesgrasp.planning.policy import _first_angles, _lower_bound, _space
+    from bayesgrasp.planning.policy import _lower_bound, candidate_first_angles, policy_space
 
     pb = Problem.build(shapes.load("house"), actions=actions)
-    space = _space(pb, None, depth)
-    angles, _ = _first_angles(space, pb.action_kinds, 512)
+    space = policy_space(pb, None, depth)
+    angles, _ = candidate_first_angles(space, pb.action_kinds, 512)
     bound = _lower_bound(space, parse_sensor(sensor), angles)
     assert bound <= plan_policy(pb, sensor, depth).expected_cost + 1e-12
 

@@ -423,7 +423,7 @@ def test_part_center_of_mass() -> None:
 def test_plain_python_and_numpy_hulls_agree(pts: np.ndarray) -> None:
     extent = float(np.max(np.ptp(pts, axis=0)))
     eps = Tolerance().length_for(extent)
-    xs, ys, area, cx, cy = geometry._hull_python(pts, eps)
+    xs, ys, area, cx, cy = geometry._hull_python(geometry._sorted_pairs(*pts.T.tolist()), eps)
     hull = pts[geometry._hull_indices(pts)]
     if len(hull) > 3:
         hull = geometry._drop_near_collinear(hull, eps)

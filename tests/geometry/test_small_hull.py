@@ -1,12 +1,10 @@
-"""The plain-Python hull of a few points against its step-for-step reference (issue 12).
+"""The parts of a few points, built on plain Python floats, against a reference.
 
-:func:`polygon._hull_small` skips the near-collinear test of every vertex the chains already
-passed by more than a bound, sums the area in one pass, and reads the scale off the points'
-extremes; :func:`polygon._hull_python` is the reference it must equal bit for bit (the same
-vertices, area, centroid and size, as float hex). Inputs: random, near-collinear (whole
-clouds and single vertices, the two where the chains meet included), duplicates, thin, huge
-and tiny clouds, under several tolerances. The lazily made arrays of the polygons and parts
-are compared with the eager construction.
+The hull of :data:`~bayesgrasp.sizes.SMALL` points or fewer is taken by
+:func:`polygon._hull_python`; :meth:`Part.from_points` must give its vertices, area, centroid
+and size bit for bit (as float hex), with the size computed here independently. Inputs:
+random, near-collinear, duplicates, thin, huge and tiny clouds, under several tolerances. The
+lazily made arrays of the polygons and parts are compared with the eager construction.
 """
 
 from __future__ import annotations
@@ -94,45 +92,11 @@ def reference(pts: FloatArray, tol: Tolerance) -> tuple[list[object], float] | N
     x0, x1 = min(px), max(px)
     extent = max(x1 - x0, max(py) - min(py))
     eps = tol.length_for(extent)
-    xs, ys, area, cx, cy = polygon._hull_python(pts, eps)
+    xs, ys, area, cx, cy = polygon._hull_python(polygon._sorted_pairs(px, py), eps)
     if len(xs) < 3 or area <= eps * extent:
         return None
     size = math.sqrt(max([(x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True)]))
     return hexes(xs, ys, area, cx, cy, size), extent
-
-
-@settings(max_examples=400, deadline=None)
-@given(pts=any_points(), tol=st.sampled_from(TOLERANCES))
-def test_small_hull_is_the_reference_bit_for_bit(pts: FloatArray, tol: Tolerance) -> None:
-    if np.max(np.abs(pts)) > 1e150 or np.ptp(pts, axis=0).max() < 1e-150:
-        return  # refused before any hull
-    ref = reference(pts, tol)
-    px, py = pts.T.tolist()
-    extent = max(max(px) - min(px), max(py) - min(py))
-    eps = tol.length_for(extent)
-    small = polygon._hull_small(polygon._sorted_pairs(px, py), eps, extent, min(py), max(py))
-    if ref is None:
-        xs, _, area, *_ = small
-        assert len(xs) < 3 or area <= eps * extent
-        return
-    assert hexes(*small) == ref[0]
-
-
-@settings(max_examples=300, deadline=None)
-@given(pts=any_points(), bound=st.sampled_from([0.0, 1e-12, 1e-9, 1e-3, math.inf]))
-def test_half_hull_is_the_chain_and_knows_when_its_tests_were_firm(
-    pts: FloatArray, bound: float
-) -> None:
-    pairs = polygon._sorted_pairs(*pts.T.tolist())
-    for points in (pairs, pairs[::-1]):
-        head, sure = polygon._half_hull(points, bound)
-        chain = head + points[-1:]  # the last point always ends the chain
-        assert chain == polygon._chain_python(points)
-        if sure:  # the last test of every inner vertex passed by more than the bound
-            for a, b, p in zip(chain, chain[1:], chain[2:], strict=False):
-                assert (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > bound
-        if bound == math.inf and len(chain) > 2:
-            assert not sure
 
 
 def test_the_bound_covers_the_chord_test() -> None:
@@ -144,72 +108,6 @@ def test_the_bound_covers_the_chord_test() -> None:
         bound = 2.0 * eps * extent
         for ux, uy in [rng.choice([-1.0, 1.0], 2) * extent, rng.uniform(-1, 1, 2) * extent]:
             assert eps * math.hypot(ux, uy) < bound  # the longest chords, and any
-
-
-@pytest.mark.parametrize(
-    "pts",
-    [
-        # The leftmost point 1.5e-11 off the chord of its neighbours: dropped, though both
-        # chains pass all their tests firmly (only the test where they meet catches it).
-        [(0.0, 0.0), (2e-11, -1.0), (1.0, -1.0), (1.0, 1.0), (1e-11, 1.0)],
-        # The same at the rightmost point.
-        [(1.0, 0.0), (1.0 - 2e-11, 1.0), (0.0, 1.0), (0.0, -1.0), (1.0 - 1e-11, -1.0)],
-    ],
-)
-def test_a_joint_vertex_near_its_chord_is_dropped_as_before(
-    pts: list[tuple[float, float]], monkeypatch: pytest.MonkeyPatch
-) -> None:
-    arr = np.array(pts)
-    ref = reference(arr, DEFAULT_TOLERANCE)
-    assert ref is not None
-    firm = []
-    real = polygon._firm
-
-    def watched(*args: object) -> bool:
-        firm.append(real(*args))  # type: ignore[arg-type]
-        return firm[-1]
-
-    monkeypatch.setattr(polygon, "_firm", watched)
-    part = Part.from_points(arr)
-    assert False in firm  # the chains were sure: the joint test decided
-    assert part.hull.n_sides == 4
-    xs, ys = part.hull._coords()
-    assert hexes(xs, ys, part.hull.area, *part.hull.centroid.tolist(), part.hull.size) == ref[0]
-
-
-@settings(max_examples=100, deadline=None)
-@given(pts=scattered_points(), below=st.floats(0.0, 2.0), above=st.floats(0.0, 2.0))
-def test_extremes_missing_from_the_hull_take_the_general_path(
-    pts: FloatArray, below: float, above: float
-) -> None:
-    """Were the least or largest y not a vertex (a rounding of the chain's tests could drop
-    it), the scale read off them would be wrong: the general path must take over."""
-    px, py = pts.T.tolist()
-    extent = max(max(px) - min(px), max(py) - min(py))
-    if not 1e-140 < extent < 1e140:
-        return
-    eps = DEFAULT_TOLERANCE.length_for(extent)
-    y0, y1 = min(py) - below * extent, max(py) + above * extent
-    got = polygon._hull_small(polygon._sorted_pairs(px, py), eps, extent, y0, y1)
-    xs, ys, area, cx, cy = polygon._hull_python(pts, eps)
-    if len(xs) >= 3 and area > 0.0:
-        size = polygon._size(zip(xs, ys, strict=True), cx, cy)
-        assert hexes(*got) == hexes(xs, ys, area, cx, cy, size)
-
-
-def test_the_study_polygons_take_the_short_path(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The general drop runs only for the odd polygon (none of these 300)."""
-    calls = []
-    general = polygon._drop_and_measure
-
-    def counted(xs: list[float], ys: list[float], eps: float) -> object:
-        calls.append(len(xs))
-        return general(xs, ys, eps)
-
-    monkeypatch.setattr(polygon, "_drop_and_measure", counted)
-    for pts in np.random.default_rng(1).uniform(size=(300, 10, 2)):
-        Part.from_points(pts)
-    assert calls == []
 
 
 # --------------------------------------------------------------------------- Part.from_points

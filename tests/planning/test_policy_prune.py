@@ -20,7 +20,7 @@ from numpy.testing import assert_allclose
 from bayesgrasp.model import CostModel, HistogramPrior, Problem
 from bayesgrasp.model.sensing import StateSpace, WidthSensor
 from bayesgrasp.paper.study import random_polygon
-from bayesgrasp.planning.policy import Policy, _Solver, _solver, plan_policy
+from bayesgrasp.planning.policy import Policy, _Solver, make_solver, plan_policy
 
 ALL = frozenset({"cut", "floor", "deepen"})
 SUBSETS = [frozenset(), frozenset({"cut"}), frozenset({"floor"}), frozenset({"deepen"}), ALL]
@@ -111,7 +111,7 @@ def test_prunings_visit_fewer_beliefs() -> None:
 def programme(seed: int, rel: float, prune: frozenset[str]) -> _Solver:
     pb = Problem.build(random_polygon(seed, 8))
     space = StateSpace.build([pb])
-    return _solver(space, noisy(pb, rel, 0.5), prune)
+    return make_solver(space, noisy(pb, rel, 0.5), prune)
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])

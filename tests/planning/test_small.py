@@ -178,7 +178,7 @@ def test_every_study_polygon_fused_against_general(actions: tuple[str, ...]) -> 
 @pytest.mark.parametrize("goal", ["single", "symmetry"])
 def test_large_accuracies(accuracy: float, goal: str) -> None:
     """Gripper accuracies up to and past a quarter turn, the fused planner against the
-    general one: the bound ``cap - 2 max(tol, accuracy - _ROUNDING)`` up to which the fused
+    general one: the bound ``cap - 2 max(tol, accuracy - ROUNDING)`` up to which the fused
     one takes its front before the widths falls to and below ``tol`` here (it then takes
     the arcs below ``tol``, and the widths stop at the widest basin)."""
     rng = np.random.default_rng(4)

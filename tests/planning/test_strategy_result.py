@@ -35,7 +35,7 @@ from bayesgrasp.model.sensing import StateSpace, parse_sensor
 from bayesgrasp.planning import StrategyResult, plan_bfs, plan_exact, plan_guaranteed, solve
 from bayesgrasp.planning import noisy_policy as npol
 from bayesgrasp.planning.noisy import PlanEvaluator, evaluate_plan, plan_noisy
-from bayesgrasp.planning.policy import _PRUNE, _solver, plan_policy
+from bayesgrasp.planning.policy import DEFAULT_PRUNE, make_solver, plan_policy
 from bayesgrasp.planning.result import PlanStep
 from bayesgrasp.planning.robust import plan_guaranteed_noisy
 from bayesgrasp.planning.strategy import evaluate
@@ -267,7 +267,7 @@ def test_each_candidate_turn_is_one_action_once(name: str, noise: str) -> None:
     space = StateSpace.build(pb)
     sensor = parse_sensor("width")
     model = npol._Model(space, sensor, NOISES[noise])
-    for k in _solver(space, sensor, _PRUNE).kinds:
+    for k in make_solver(space, sensor, DEFAULT_PRUNE).kinds:
         mid, _ = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
         mats = model.matrices(k.name, mid)
         kept = mats[npol._first_of_each_matrix(mats)]

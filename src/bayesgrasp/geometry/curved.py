@@ -1159,6 +1159,13 @@ class CurvedPart(Part):
     _model: dict[str, object] = field(default_factory=dict, repr=False)
     hole_rings: tuple[CurvedRing, ...] = ()
 
+    def scaled(self, factor: float, units: str) -> Part:
+        """Refused: the exact curves are not converted (save the drawing in ``units``)."""
+        raise PartError(
+            f"part {self.name!r} is curved and in {self.units}: save the drawing in {units} "
+            "(its exact curves are not converted)"
+        )
+
     @property
     def error(self) -> float:
         """The bound on the distance between the model and the real outline."""

@@ -281,13 +281,17 @@ def _monotone_chain(xs: list[float], ys: list[float]) -> list[int]:
 
 
 def _hull_python(
-    pts: FloatArray, eps: float
+    ordered: list[tuple[float, float]], eps: float
 ) -> tuple[list[float], list[float], float, float, float]:
-    """Hull, area and centroid of a few points in plain Python.
+    """Hull, area and centroid of a few points, in plain Python floats.
 
-    For a few points numpy's cost per call is larger than the work. The steps are those of
-    ``_hull_indices``, ``_drop_near_collinear`` and ``polygon_area_centroid``. The reference
-    of :func:`_hull_small` (which makes the same decisions with less work).
+    ``ordered``: the points sorted (:func:`_sorted_pairs`; consumed). Andrew's monotone
+    chain (the lower chain left to right, the upper right to left, :func:`_chain_python`),
+    then the vertices within ``eps`` of their neighbours' chord dropped and the area and
+    centroid measured (:func:`_drop_and_measure`): the steps of :func:`_hull_indices`,
+    :func:`_drop_near_collinear` and :func:`polygon_area_centroid`, with the same results
+    (tests/geometry/test_polygon.py holds the two paths together). For a few points the
+    work is smaller than numpy's cost of a call.
 
     Returns
     -------
@@ -296,7 +300,6 @@ def _hull_python(
     area, cx, cy : float
         Area and centroid (area 0 when degenerate).
     """
-    ordered = _sorted_pairs(*pts.T.tolist())
     lower = _chain_python(ordered)
     ordered.reverse()
     hull = lower[:-1] + _chain_python(ordered)[:-1]
@@ -371,73 +374,9 @@ def _chain_python(points: list[tuple[float, float]]) -> list[tuple[float, float]
     return chain
 
 
-# Below this the bound of _hull_small is not trusted (products near the underflow).
+# Below this the bound ``2 eps extent`` of ConvexPolygon._of_firm_ring is not trusted
+# (products near the underflow).
 _TINY = 1e-280
-
-
-def _hull_small(
-    ordered: list[tuple[float, float]], eps: float, extent: float, y0: float, y1: float
-) -> tuple[list[float], list[float], float, float, float, float]:
-    """:func:`_hull_python` and the hull's size, with the same results and less work.
-
-    ``ordered``: the points sorted (:func:`_sorted_pairs`, consumed), ``extent`` their
-    largest width along x or y, ``y0`` and ``y1`` their least and largest y. Returns the
-    hull's ``xs, ys, area, cx, cy`` as :func:`_hull_python` does and the size (the largest
-    distance from the centroid).
-
-    The near-collinear test of a vertex, ``|u x w| <= eps |u|`` (``u`` from the previous
-    vertex to the next, ``w`` to the vertex), needs no work for most vertices: the chain's
-    last test of a vertex ``b`` between ``a`` and ``p`` is ``(b - a) x (p - a) > 0`` with
-    the same two rounded products in the other order, so the same magnitude; and
-    ``eps |u| <= eps sqrt(2) extent`` (every coordinate difference is at most the extent),
-    less than ``bound = 2 eps extent`` after rounding. When every test the chains passed
-    exceeded the bound, only the two vertices where the chains meet are tested; otherwise
-    :func:`_drop_and_measure` decides as before.
-    """
-    bound = 2.0 * eps * extent
-    if not bound >= _TINY:  # (also NaN) every vertex tested
-        bound = math.inf
-    lower, sure = _half_hull(ordered, bound)
-    ordered.reverse()
-    upper, sure_upper = _half_hull(ordered, bound)
-    hull = lower + upper
-    n = len(hull)
-    last = len(lower)  # where the chains meet: the first and the last point
-    if n >= 3 and (
-        n == 3
-        or (sure and sure_upper and _firm(hull, 0, eps, bound) and _firm(hull, last, eps, bound))
-    ):
-        measured = _measure(hull, last, y0, y1)
-        if measured is not None:
-            return measured
-    xs, ys, area, cx, cy = _drop_and_measure([p[0] for p in hull], [p[1] for p in hull], eps)
-    if not xs:
-        return xs, ys, area, cx, cy, 0.0
-    return xs, ys, area, cx, cy, _size(zip(xs, ys, strict=True), cx, cy)
-
-
-def _measure(
-    hull: list[tuple[float, float]], last: int, y0: float, y1: float
-) -> tuple[list[float], list[float], float, float, float, float] | None:
-    """:func:`_drop_and_measure` of a hull chain with nothing to drop, and the hull's size.
-
-    ``hull``: the vertices counter-clockwise from the lexicographically least, ``last`` the
-    index of the largest, ``y0`` and ``y1`` the least and largest y of the points. The same
-    sums in the same order, and the same scale, the largest ``|x - ox|`` and ``|y - oy|``
-    over the vertices (a rounded difference is monotone in its terms): the last point, of
-    the largest x, is a vertex, and the least and largest y are checked to be. ``None``
-    when they are not, or the scale or area is degenerate: :func:`_drop_and_measure` decides.
-    """
-    ox, oy = hull[0]
-    scale = max(hull[last][0] - ox, y1 - oy, oy - y0)
-    xs, ys = [p[0] for p in hull], [p[1] for p in hull]
-    twice, cx, cy = _area_sums(hull[1:], ox, oy, scale)
-    if not (twice != 0.0 and y0 in ys and y1 in ys and 0.0 < scale < math.inf):
-        return None
-    unit = scale / (3.0 * twice)
-    cx = cx * unit + ox
-    cy = cy * unit + oy
-    return xs, ys, 0.5 * twice * scale * scale, cx, cy, _size(hull, cx, cy)
 
 
 def _area_sums(
@@ -485,60 +424,6 @@ def _size(points: Iterable[tuple[float, float]], cx: float, cy: float) -> float:
         if d > top:
             top = d
     return math.sqrt(top)
-
-
-def _firm(hull: list[tuple[float, float]], i: int, eps: float, bound: float) -> bool:
-    """Whether vertex ``i`` of a hull chain passes the near-collinear test (is kept).
-
-    Beyond ``bound`` (see :func:`_hull_small`) without the length of the chord.
-    """
-    ax, ay = hull[i - 1]
-    x, y = hull[i]
-    bx, by = hull[(i + 1) % len(hull)]
-    ux, uy = bx - ax, by - ay
-    c = abs(ux * (y - ay) - uy * (x - ax))
-    return c > bound or not c <= eps * math.hypot(ux, uy)
-
-
-def _half_hull(
-    points: list[tuple[float, float]], bound: float
-) -> tuple[list[tuple[float, float]], bool]:
-    """:func:`_chain_python` (the same tests) less its last point, and whether it was firm.
-
-    The last point of the chain is the last of ``points``. Firm: every test the chain
-    passed exceeded ``bound``. The chain's last two points ``a`` and ``b`` are kept in local
-    variables, the rest in a list; when ``b`` is dropped from a chain of two, ``a`` and
-    ``b`` are the same point (a test between two equal points never passes: its cross
-    product is 0).
-    """
-    if len(points) < 2:
-        return [], True
-    below: list[tuple[float, float]] = []
-    pop, push = below.pop, below.append
-    a, b = points[0], points[1]
-    ax, ay = a
-    bx, by = b
-    sure = True
-    for p in points[2:]:
-        x, y = p
-        while True:
-            c = (bx - ax) * (y - ay) - (by - ay) * (x - ax)
-            if c > bound:
-                break
-            if c > 0:
-                sure = False
-                break
-            b, bx, by = a, ax, ay  # b is dropped
-            if not below:
-                break
-            a = pop()
-            ax, ay = a
-        if a is not b:
-            push(a)
-        a, ax, ay = b, bx, by
-        b, bx, by = p, x, y
-    push(a)
-    return below, sure
 
 
 def _drop_near_collinear(v: FloatArray, eps: float) -> FloatArray:
@@ -826,7 +711,7 @@ class ConvexPolygon:
         ``px`` and ``py`` are the coordinates of ``pts`` as Python floats (the same values).
         """
         ordered = _sorted_pairs(px, py)  # by x first: the least and largest x at the ends
-        by_y = sorted(py)  # (cheaper than min and max)
+        by_y = sorted(py)  # the least and largest y at the ends
         x0, x1, y0, y1 = ordered[0][0], ordered[-1][0], by_y[0], by_y[-1]
         extent = max(x1 - x0, y1 - y0)
         if _odd_magnitude(x0, x1, y0, y1, extent):
@@ -834,10 +719,10 @@ class ConvexPolygon:
         eps = tol.length_for(extent)
         if extent == 0.0:
             _refuse(pts, eps)
-        xs, ys, area, cx, cy, size = _hull_small(ordered, eps, extent, y0, y1)
+        xs, ys, area, cx, cy = _hull_python(ordered, eps)
         if len(xs) < 3 or area <= eps * extent:
             _refuse(pts, eps)
-        return cls._of_floats(xs, ys, tol, area, cx, cy, size)
+        return cls._of_floats(xs, ys, tol, area, cx, cy, _size(zip(xs, ys, strict=True), cx, cy))
 
     @classmethod
     def _of_firm_ring(
@@ -871,13 +756,15 @@ class ConvexPolygon:
         :data:`_RING_FIRM` ``D^2`` (10^2 times ``16 u D^2``), every test of the monotone
         chains decides as exact arithmetic does: the hull's vertices are the ring's, every
         one, counter-clockwise from the lexicographically least. And when ``|least|`` is
-        also above twice the chains' bound ``2 eps extent`` of :func:`_hull_small`, no vertex
-        is within ``eps`` of its neighbours' chord, so the near-collinear test drops none,
-        and :func:`_measure`'s sums in that order give the same area, centroid and size as
-        either path of :func:`_hull_small`. Odd magnitudes and degenerate areas go to the
-        hull, which words the refusals.
+        also above twice ``bound = 2 eps extent`` (the near-collinear test of a vertex is
+        ``|u x w| <= eps |u|``, ``u`` the chord of its neighbours, and ``eps |u| <= eps
+        sqrt(2) extent`` stays below ``bound`` after rounding), no vertex is within ``eps`` of
+        its neighbours' chord, so the near-collinear test drops none, and
+        :func:`_area_sums` (:func:`_drop_and_measure`'s sums in its order) gives the same
+        area, centroid and size as :func:`_hull_python`. Odd magnitudes and degenerate areas
+        go to the hull, which words the refusals.
         """
-        # _hull_of_floats's tests and _hull_small's bound, inline (the same operations).
+        # _hull_of_floats's tests, and the bound above.
         w, h = x1 - x0, y1 - y0
         extent = w if w >= h else h  # max(w, h)
         if _odd_magnitude(x0, x1, y0, y1, extent):
@@ -901,8 +788,8 @@ class ConvexPolygon:
             i = n - 1
         if i:  # (else the lists are kept: the caller hands them over)
             xs, ys = xs[i:] + xs[:i], ys[i:] + ys[:i]
-        # _measure's sums, in its order (the ring holds the least and largest y, and the
-        # largest x is the x of its lexicographically largest point).
+        # _drop_and_measure's scale and sums, in its order (the ring holds the least and
+        # largest y, and the largest x is the x of its lexicographically largest point).
         ox, oy = xs[0], ys[0]
         scale = x1 - ox  # max(x1 - ox, y1 - oy, oy - y0)
         if y1 - oy > scale:
@@ -1373,6 +1260,24 @@ class Part:
         for arr in (*oriented, com):
             arr.setflags(write=False)
         return cls(name, hull, oriented[0], com, units, tuple(oriented[1:]))
+
+    def scaled(self, factor: float, units: str) -> Part:
+        """The part with its outline, holes and centre of mass multiplied by ``factor``.
+
+        :func:`bayesgrasp.units.convert` uses it to change units; ``units`` are the new ones.
+
+        Examples
+        --------
+        >>> p = Part.from_points([(0, 0), (1, 0), (0, 1)], units="cm").scaled(10, "mm")
+        >>> p.units, float(p.hull.vertices.max())
+        ('mm', 10.0)
+        """
+        com = self.center_of_mass * factor
+        if self.holes:
+            return Part.from_outline(
+                self.outline * factor, [h * factor for h in self.holes], self.name, com, units
+            )
+        return Part.from_points(self.outline * factor, self.name, com, units)
 
 
 _part_name, _part_hull, _part_outline, _part_center_of_mass, _part_units, _part_holes = (

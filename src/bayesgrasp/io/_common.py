@@ -19,7 +19,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +29,14 @@ from numpy.typing import NDArray
 from .. import files
 from ..errors import MissingExtraError, PartError, PartFileError
 from ..geometry import Part, find_crossing
-from ._flatten import Curve, FlattenBudget, Polyline, TooManyPoints, join, predicted_points
+from ._flatten import (
+    FlattenBudget,
+    Polyline,
+    Ring,
+    TooManyPoints,
+    join,
+    predicted_points,
+)
 
 __all__ = [
     "DEFAULT_RELATIVE_TOLERANCE",
@@ -110,16 +117,6 @@ class ReadOptions:
     layer: str | None = None
     tolerance: float | None = None
     max_points: int = MAX_POINTS
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Ring:
-    """A closed ring of curves, with where it came from (for messages)."""
-
-    curves: tuple[Curve, ...]
-    source: str
-    group: str = ""
-    points: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
 
 
 def fail(path: Path, reason: str) -> PartFileError:

@@ -20,8 +20,7 @@ from numpy.typing import NDArray
 
 from ..geometry import Part
 from ..geometry.curved import CurvedRing, CurvePatches, curved_part
-from ._common import Ring
-from ._flatten import Bezier, Curve, EllipticArc, FlattenBudget, Polyline
+from ._flatten import Bezier, Curve, EllipticArc, FlattenBudget, Polyline, Ring
 
 __all__ = ["circle_of", "curved_assembly", "curved_ring", "patches_of"]
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from itertools import islice
 
 import numpy as np
@@ -33,6 +33,7 @@ __all__ = [
     "EllipticArc",
     "FlattenBudget",
     "Polyline",
+    "Ring",
     "TooManyPoints",
     "join",
 ]
@@ -304,6 +305,16 @@ class Adaptive(Curve):
 
     def reverse(self) -> Adaptive:
         return Adaptive(self.sampler, self.first, self.last, self.box, not self.backwards)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Ring:
+    """A closed ring of curves, with where it came from (for messages)."""
+
+    curves: tuple[Curve, ...]
+    source: str
+    group: str = ""
+    points: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
 
 
 def join(curves: Iterable[Curve], tol: float, budget: FlattenBudget, what: str) -> FloatArray:

@@ -304,7 +304,7 @@ def part_document(part: Part) -> dict[str, Any]:
     out["center_of_mass"] = part.center_of_mass.tolist()
     out["id"] = part_id(part)
     if type(part) is not Part:  # a polygon has no curved member (and needs no import)
-        from ..report_curved import curved_document
+        from ..report.curved import curved_document
 
         curved = curved_document(part)  # arcs, error bound, what it rests on (curved parts)
         if curved is not None:
@@ -322,7 +322,7 @@ def provenance(problem: Problem, method: str | None = None, **more: Any) -> dict
     non-arc curves with (its ``curve_error``), so a re-run with it gives the same numbers;
     a file of segments and arcs only has none (its arcs are exact).
     """
-    from .. import __version__
+    from .._version import __version__
 
     out: dict[str, Any] = {
         "version": __version__,

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 
 from ..angles import TWO_PI
 from ..errors import PlanningError
+from .states import nearest_state
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..geometry.transfer import TransferFunction
@@ -71,8 +72,6 @@ class Goal:
         >>> Goal("symmetry").success_states(s, np.pi / 2, 2).tolist()
         [False, True, False, True]
         """
-        from .problem import nearest_state
-
         g = self.group_order(symmetry_order)
         targets = final_orientation + TWO_PI * np.arange(g) / g
         mask = np.zeros(states.n_states, dtype=bool)

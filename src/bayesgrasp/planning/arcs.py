@@ -139,7 +139,7 @@ ARC_CHUNK = 1 << 20
 # The lengths admit a margin above ``accuracy`` by ``span < L - 2 accuracy``, the staircases
 # compute it as ``(L - span) / 2``: these may differ by rounding, and the witness chain must
 # exist whenever the lengths allow it.
-_ROUNDING = 1e-13
+ROUNDING = 1e-13
 
 
 @dataclass(frozen=True, slots=True)
@@ -249,7 +249,7 @@ def period_cap(problem: Problem) -> float:
     ``2 pi / g`` when that is smaller (``g`` the goal's group order).
     """
     period = 0.0
-    for t in problem.action_kinds:  # a loop: cheaper than max() over a generator here
+    for t in problem.action_kinds:
         if problem.transfers[t].period > period:
             period = problem.transfers[t].period
     cap = TWO_PI / problem.goal_group
@@ -343,7 +343,7 @@ _span_of = operator.itemgetter(0)
 
 # Slack of the span bounds of SpanFront (and of the fused planner's staircases): far above
 # the rounding of sums and differences of angles below 4 pi (a few ulps, about 1e-15).
-_SPAN_SLACK = 1e-12
+SPAN_SLACK = 1e-12
 
 
 class SpanFront:
@@ -354,30 +354,25 @@ class SpanFront:
     bit those of the whole front: the same candidates, the same float operations and the
     same Pareto rule (:func:`pareto_front`: a stable sort by span, widths strictly
     increasing, of equal spans the last kept; so of an equal span and width the arc of the
-    first basin). In the order that costs least on Python floats:
+    first basin). In this order:
 
     - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
-    - the arcs of two or more basins by a stable sort on the span alone, in the order
-      ``(i, j)`` (a sort on floats: tuples compare several times slower). Of the arcs of one
-      span the front keeps the widest, and of those the first, the least ``i`` (one row
-      has one arc of each span and width): the same arc as the order ``(span, width, i)``
-      keeps, which the second batch below uses. A prefix of either order gives the front's
-      arcs of spans below the first span not taken (later arcs span more, so they can
-      neither join the front below it nor replace an arc there): :meth:`cover` takes the
-      arcs one by one, only as far as asked.
+    - the arcs of two or more basins by a stable sort on the span alone, ties in the order
+      ``(i, j)``. Of the arcs of one span the front keeps the widest, and of those the
+      first, the least ``i`` (one row has one arc of each span and width): the same arc as
+      the order ``(span, width, i)`` keeps, which the second batch below uses. A prefix
+      of either order gives the front's arcs of spans below the first span not taken
+      (later arcs span more, so they can neither join the front below it nor replace an
+      arc there): :meth:`cover` takes the arcs one by one, only as far as asked.
     - The arcs are enumerated in two batches: first those of each row ``i`` whose last
       stable orientation lies below ``s_i + first`` (``first`` at most ``max_span`` and
-      ``2 pi``), then, only if a bound above ``first - _SPAN_SLACK`` is asked, the rest
+      ``2 pi``), then, only if a bound above ``first - SPAN_SLACK`` is asked, the rest
       (sorted in with the arcs not taken yet). An arc of the second batch spans at least
       ``first`` less a rounding, so the first batch holds every arc that spans less than
-      ``first - _SPAN_SLACK``. The planner of one action type passes the spans its widths
+      ``first - SPAN_SLACK``. The planner of one action type passes the spans its widths
       ask for at most (``cap - 2 max(tol, accuracy)``, see
       :func:`bayesgrasp.planning.exact.plan_exact`), so the arcs of a squeeze that span a
       half-turn (K of about K^2 / 2) are seldom made.
-
-    (On this interpreter a comprehension or a call of ``min`` or ``max`` costs as much as
-    several loop steps, and ``map`` over a few floats more than a loop; the loops below avoid
-    them.)
     """
 
     __slots__ = (
@@ -429,7 +424,7 @@ class SpanFront:
         self.stable, self.lo, self.max_span = stable, lo, max_span
         self._s2, self._hi2, self._first = s2, hi2, first
         self._cand, self._pos = cand, 0
-        self._complete = math.inf if first >= max_span else first - _SPAN_SLACK
+        self._complete = math.inf if first >= max_span else first - SPAN_SLACK
         self.spans, self.widths, self.rows = [0.0], [widest], [top]
         self.covered = -math.inf
 
@@ -736,7 +731,7 @@ class Staircase:
         at = np.where(r < n, self.rest[np.minimum(r, n - 1)], -np.inf)
         before = np.where(r > 0, 0.5 * (self.width[np.maximum(r - 1, 0)] - x), -np.inf)
         value = np.maximum(at, before)
-        ok = (value > self.tol) & (value >= self.accuracy - _ROUNDING)
+        ok = (value > self.tol) & (value >= self.accuracy - ROUNDING)
         return np.asarray(np.where(ok, value, -np.inf), dtype=np.float64)
 
     def pick(self, x: float) -> Arc:
@@ -761,7 +756,7 @@ def _tau(
     """
     inf = math.inf
     n = len(c)
-    floor = accuracy - _ROUNDING
+    floor = accuracy - ROUNDING
     left = bisect.bisect_left
     out: list[float] = []
     add = out.append

@@ -48,7 +48,7 @@ from ..model.cost import CostModel
 from ..model.prior import Prior, UniformPrior
 from ..model.problem import Problem
 from . import arcs, result
-from .arcs import _ROUNDING, _SPAN_SLACK, ArcPlanner, Counts, Scored
+from .arcs import ROUNDING, SPAN_SLACK, ArcPlanner, Counts, Scored
 from .result import (
     COST_RTOL,
     PlanOption,
@@ -192,8 +192,8 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
       there and no further, the same arcs the whole front holds below that span. A loop
       over the front's arcs that ends at the first ``-inf`` (next two items) ends at the
       same arc however far beyond its bound the front was taken.
-    - *tau where it can be finite.* Let ``T`` be ``max(tol, accuracy - _ROUNDING)``: a
-      ``tau`` is ``-inf`` unless above ``tol`` and at least ``accuracy - _ROUNDING``, so
+    - *tau where it can be finite.* Let ``T`` be ``max(tol, accuracy - ROUNDING)``: a
+      ``tau`` is ``-inf`` unless above ``tol`` and at least ``accuracy - ROUNDING``, so
       every entry of a staircase has a rest of at least ``T`` (or ``inf``), and let
       ``Wmax`` be its widest entry. An entry ``r`` with ``c_r = fl(w_r - 2 rest_r) >= x``
       needs ``x <= Wmax - 2 T`` but for a rounding; so for ``x >= Wmax - 2 T + slack`` the
@@ -224,11 +224,11 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     if f.period < cap:
         cap = f.period
     margin2 = 2.0 * (tol if tol >= accuracy else accuracy)  # max(tol, accuracy)
-    floor = accuracy - _ROUNDING  # Staircase.tau: margins from accuracy (less the rounding)
+    floor = accuracy - ROUNDING  # Staircase.tau: margins from accuracy (less the rounding)
     low = tol if tol >= floor else floor  # T: every finite tau is at least this
     stable, lo, hi = f.values
     # ArcPlanner.max_span; the widths ask for spans below cap - margin2 <= cap - 2 T only.
-    front = arcs.SpanFront(stable, lo, hi, f.period + tol, cap - 2.0 * low + 2.0 * _SPAN_SLACK)
+    front = arcs.SpanFront(stable, lo, hi, f.period + tol, cap - 2.0 * low + 2.0 * SPAN_SLACK)
     spans, widths, rows = front.spans, front.widths, front.rows
     cover = front.cover
     left = bisect.bisect_left
@@ -237,7 +237,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     uniform = type(prior) is UniformPrior  # its max_arc_mass: group * length / (2 pi)
 
     # Every bound the widths ask, at once (one pass over the arcs; see the docstring).
-    bound = cap - 2.0 * low + _SPAN_SLACK
+    bound = cap - 2.0 * low + SPAN_SLACK
     cover(bound if bound > tol else tol)
     n = left(spans, tol) - 1
     grown = [widths[n] if n >= 0 else 0.0]  # W_1, W_2, ...
@@ -312,7 +312,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     if floor > passing:
         passing = floor
     w0 = widths[0]
-    bound = w0 - 2.0 * low + _SPAN_SLACK
+    bound = w0 - 2.0 * low + SPAN_SLACK
     if bound > front.covered:
         cover(bound)
     tau = []
@@ -329,7 +329,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     for m in range(2, longest):
         if m == last:  # the longest plan's staircase: asked at two spans only, _stair_top
             if tau:
-                bound = widths[len(tau) - 1] - 2.0 * low + _SPAN_SLACK
+                bound = widths[len(tau) - 1] - 2.0 * low + SPAN_SLACK
                 if bound > front.covered:
                     cover(bound)
             top_tau = tau
@@ -359,7 +359,7 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
         stairs.append((idx, rest, wid, c))
         tau = []
         if c:
-            bound = wid[-1] - 2.0 * low + _SPAN_SLACK
+            bound = wid[-1] - 2.0 * low + SPAN_SLACK
             if bound > front.covered:
                 cover(bound)
             for x in spans:  # Staircase.tau, as far as it passes

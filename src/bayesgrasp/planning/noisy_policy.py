@@ -123,22 +123,22 @@ from ..model.sensing import StateSpace, WidthSensor, parse_sensor
 from ..model.states import nearest_state
 from .noisy import plan_noisy
 from .policy import (
-    _DEFAULT_MAX_ACTIONS,
-    _PRUNE,
+    DEFAULT_MAX_ACTIONS,
     DEFAULT_MAX_MEMORY_MB,
+    DEFAULT_PRUNE,
     Branch,
     Declare,
     Policy,
+    PolicyBuilder,
     PolicyNode,
     Reject,
-    _Builder,
-    _first_angles,
-    _search,
-    _solver,
-    _space,
-    _start_ratio,
+    candidate_first_angles,
+    make_solver,
     memory_bytes,
     plan_policy,
+    policy_space,
+    search_policy,
+    start_ratio,
 )
 from .result import PlanStep
 from .strategy import Evaluation, evaluate_tree
@@ -551,7 +551,7 @@ def _linear(model: _Model, kinds: Sequence[str], angles: Sequence[float], final:
 def plan_noisy_policy(
     problems: Problem | Iterable[Problem],
     sensor: str | WidthSensor = "width",
-    max_actions: int = _DEFAULT_MAX_ACTIONS,
+    max_actions: int = DEFAULT_MAX_ACTIONS,
     noise: NoiseModel | None = None,
     *,
     payoff: Payoff | ArrayLike | None = None,
@@ -635,10 +635,10 @@ def plan_noisy_policy(
             sensorless=sensorless,
         )
     noise = noise or NoiseModel()
-    space = _space(problems, part_prior, max_actions)
+    space = policy_space(problems, part_prior, max_actions)
     main = space.problems[0]
     model = _Model(space, sens, noise)
-    solver = _solver(space, sens, _PRUNE)
+    solver = make_solver(space, sens, DEFAULT_PRUNE)
     u: FloatArray | None = None
     if payoff is not None:
         if space.n_parts > 1:
@@ -671,7 +671,7 @@ def plan_noisy_policy(
         k.transfer = np.zeros((len(mid), space.n_states), dtype=np.intp)  # unused: matrices
         k.matrices = np.ascontiguousarray(mats)
     kinds = solver.kinds
-    angles, angles_exact = _first_angles(space, main.action_kinds, max_first_angles)
+    angles, angles_exact = candidate_first_angles(space, main.action_kinds, max_first_angles)
     roots = np.array([model.initial(k.name, a) for k in kinds for a in angles])  # (R, N)
     root_kind = [ti for ti in range(len(kinds)) for _ in angles]
     root_angle = [a for _ in kinds for a in angles]
@@ -698,16 +698,16 @@ def plan_noisy_policy(
         known.append(
             (_linear(model, kinds_, alphas, opt.evaluation.final_state), alphas[0], "sensorless")
         )
-    lam = _start_ratio(solver, roots, root_kind)
+    lam = start_ratio(solver, roots, root_kind)
     evaluated = [(_exact(model, t, a).expected_cost, t, a, label) for t, a, label in known]
     for c, *_ in evaluated:
         if math.isfinite(c):
             lam = min(lam, c)
 
-    best_pick, it = _search(
+    best_pick, it = search_policy(
         solver, roots, root_kind, lam, max_actions, max_iterations, sens.sigma > 0
     )
-    builder = _Builder(solver, max_actions)
+    builder = PolicyBuilder(solver, max_actions)
     k = kinds[root_kind[best_pick]]
     root = builder.node(
         k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, max_actions - 1, 0.0, 1, True

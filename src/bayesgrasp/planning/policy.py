@@ -198,13 +198,13 @@ IntArray = NDArray[np.intp]
 _QUANT = float(2**40)  # beliefs are memoised after rounding to multiples of 2**-40
 _EPS = 1e-12  # value comparisons (ties go to fewer actions)
 _TINY = 1e-13  # a reading this unlikely times its most to gain by acting again ends in a leaf
-_DEFAULT_MAX_ACTIONS = 3
+DEFAULT_MAX_ACTIONS = 3
 _Memo = dict[tuple[bytes, int], tuple[float, tuple[Any, ...] | None, float, float]]
 _NO_FLOOR = -1e300  # no lower bound known (finite, so that 0 * it is 0)
 # The exact search's prunings (each can be turned off to test it against the search without):
 # budgets passed down ("cut"), values at higher prices as lower bounds ("floor"), and
 # starting the parametric search from the best ratio one action shorter ("deepen").
-_PRUNE = frozenset({"cut", "floor", "deepen"})
+DEFAULT_PRUNE = frozenset({"cut", "floor", "deepen"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -871,7 +871,7 @@ class _Tally:
 
 
 @dataclass(slots=True)
-class _Builder:
+class PolicyBuilder:
     solver: _Solver
     max_actions: int
     tally: _Tally = field(default_factory=_Tally)
@@ -1100,7 +1100,7 @@ def _same_leaf(a: object, b: object) -> bool:
 # -- the planner ---------------------------------------------------------------------------
 
 
-def _first_angles(
+def candidate_first_angles(
     space: StateSpace, kinds: Sequence[str], max_first_angles: int
 ) -> tuple[list[float], bool]:
     """Candidate world angles of the first action, and whether they are all that can matter."""
@@ -1198,7 +1198,9 @@ def memory_bytes(max_memory_mb: float) -> int:
     return max(1, int(max_memory_mb * 2**20))
 
 
-def _solver(space: StateSpace, sens: WidthSensor, prune: Collection[str] = _PRUNE) -> _Solver:
+def make_solver(
+    space: StateSpace, sens: WidthSensor, prune: Collection[str] = DEFAULT_PRUNE
+) -> _Solver:
     """The programme of a state space and sensor (its kinds, bins, goal and bounds)."""
     main = space.problems[0]
     cost = main.cost
@@ -1248,7 +1250,7 @@ def _solver(space: StateSpace, sens: WidthSensor, prune: Collection[str] = _PRUN
 def plan_policy(
     problems: Problem | Iterable[Problem],
     sensor: str | WidthSensor = "width",
-    max_actions: int = _DEFAULT_MAX_ACTIONS,
+    max_actions: int = DEFAULT_MAX_ACTIONS,
     *,
     part_prior: str | Sequence[float] | None = None,
     first_angles: Sequence[float] | None = None,
@@ -1259,7 +1261,7 @@ def plan_policy(
     time_limit_s: float | None = DEFAULT_TIME_LIMIT_S,
     best_so_far: bool = True,
     progress: Callable[[int, int], None] | None = None,
-    _prune: Collection[str] = _PRUNE,
+    _prune: Collection[str] = DEFAULT_PRUNE,
 ) -> Policy:
     """The Bayes policy: least expected cost over all policies of at most ``max_actions``.
 
@@ -1327,7 +1329,7 @@ def plan_policy(
     8.0
     """
     sens = parse_sensor(sensor)
-    space = _space(problems, part_prior, max_actions)
+    space = policy_space(problems, part_prior, max_actions)
     main = space.problems[0]
     max_bytes = memory_bytes(max_memory_mb)
     seconds = time_seconds(time_limit_s)
@@ -1339,7 +1341,7 @@ def plan_policy(
             )
         angles_exact = False
     else:
-        angles, angles_exact = _first_angles(space, main.action_kinds, max_first_angles)
+        angles, angles_exact = candidate_first_angles(space, main.action_kinds, max_first_angles)
 
     def sensorless_within(depth: int) -> float | None:
         if not (sensorless and space.n_parts == 1):
@@ -1350,18 +1352,18 @@ def plan_policy(
 
     def attempt(depth: int, known: float | None, deadline: float) -> Policy:
         """The best policy within ``depth`` actions; ``known``: a known plan's cost."""
-        solver = _solver(space, sens, _prune)
+        solver = make_solver(space, sens, _prune)
         solver.max_bytes, solver.deadline, solver.time_limit = max_bytes, deadline, seconds
         solver.progress = progress if math.isfinite(seconds) else None
         roots, root_kind, root_angle = _roots(space, solver.kinds, angles)
         # A known policy's ratio starts the parametric search: one action then declare the
         # likeliest state on every reading, or the sensorless Bayes plan (one part).
-        lam = _start_ratio(solver, roots, root_kind)
+        lam = start_ratio(solver, roots, root_kind)
         if known is not None and math.isfinite(known):
             lam = min(lam, known)
         deepen = "deepen" in _prune and sens.sigma > 0
-        best_pick, it = _search(solver, roots, root_kind, lam, depth, max_iterations, deepen)
-        builder = _Builder(solver, depth)
+        best_pick, it = search_policy(solver, roots, root_kind, lam, depth, max_iterations, deepen)
+        builder = PolicyBuilder(solver, depth)
         k = solver.kinds[root_kind[best_pick]]
         root = builder.node(
             k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, depth - 1, 0.0, 1, True
@@ -1411,7 +1413,7 @@ def _lower_bound(space: StateSpace, sens: WidthSensor, angles: Sequence[float]) 
     it succeeds with probability ``P <= U`` (:meth:`_Solver.bound` of the belief after the
     first action; 1 without pi pairs), and ``E[cost] >= E[C] / P >= c_first / U + v``.
     """
-    solver = _solver(space, sens)
+    solver = make_solver(space, sens)
     roots, root_kind, _ = _roots(space, solver.kinds, angles)
     u, _ = solver.bound(roots)
     first = np.array([solver.kinds[ti].first_cost for ti in root_kind])
@@ -1419,7 +1421,7 @@ def _lower_bound(space: StateSpace, sens: WidthSensor, angles: Sequence[float]) 
         return float(np.min(first / u)) + solver.verify
 
 
-def _space(
+def policy_space(
     problems: Problem | Iterable[Problem],
     part_prior: str | Sequence[float] | None,
     max_actions: int,
@@ -1437,7 +1439,7 @@ def _space(
     return space
 
 
-def _start_ratio(solver: _Solver, roots: FloatArray, root_kind: Sequence[int]) -> float:
+def start_ratio(solver: _Solver, roots: FloatArray, root_kind: Sequence[int]) -> float:
     """The least ratio of "one action, then declare the likeliest state on every reading"."""
     joint = solver.joint(roots)  # (R, B, N)
     s, _ = solver.success(joint)
@@ -1447,7 +1449,7 @@ def _start_ratio(solver: _Solver, roots: FloatArray, root_kind: Sequence[int]) -
     return float(np.min(ratios))
 
 
-def _search(
+def search_policy(
     solver: _Solver,
     roots: FloatArray,
     root_kind: Sequence[int],
@@ -1540,7 +1542,7 @@ def _search(
 
 
 def _finish(
-    builder: _Builder,
+    builder: PolicyBuilder,
     root: PolicyNode,
     space: StateSpace,
     sensor: WidthSensor,

@@ -426,8 +426,8 @@ def short_turns(actions: Sequence[Action], angles: Sequence[float]) -> tuple[lis
     carry = 0.0  # how much further round the part lies in the current frame
     remainder, pi = math.remainder, math.pi
     for action, angle in zip(actions, angles, strict=True):
-        # wrap(angle + carry), then wrap_period(a, g) (angles.py), inlined: the planners
-        # make every step of every plan here.
+        # The gripper's turn in (-pi, pi] (angles.wrap), then within the gripper's period
+        # (angles.wrap_period): the same angle as the gripper sees it.
         r = remainder(angle + carry, TWO_PI)
         a = pi if r == -pi else r
         g = action.gripper_period
@@ -468,7 +468,7 @@ def new_option(
     tolerance: float | None,
     success_arc: tuple[float, float],
 ) -> PlanOption:
-    """``PlanOption(...)`` of these fields, made faster (for the planners' inner loops)."""
+    """The same object as ``PlanOption(...)`` of these fields, for the planners' loops."""
     out = _new(PlanOption)
     a, b, c, d, e, f = _set_option
     a(out, steps)
@@ -495,7 +495,7 @@ def new_result(
     most_certain: int,
     method: str,
 ) -> PlanResult:
-    """``PlanResult(problem, options, bayes, most_certain, method)``, made faster."""
+    """The same object as ``PlanResult(problem, options, bayes, most_certain, method)``."""
     out = _new(PlanResult)
     a, b, c, d, e, f, g, h = _set_result
     a(out, problem)

@@ -18,7 +18,7 @@ from ..errors import PartError, PartFileError
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
-    from ..io._common import ReadOptions
+    from ..io import ReadOptions
     from .mesh import Solid
     from .poses import PoseStudy
 

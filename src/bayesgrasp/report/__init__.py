@@ -19,23 +19,23 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .geometry.polygon import Part
-from .geometry.push import RadiusFunction
-from .geometry.transfer import TransferFunction
-from .io.plans import (
+from ..geometry.polygon import Part
+from ..geometry.push import RadiusFunction
+from ..geometry.transfer import TransferFunction
+from ..io.plans import (
     guaranteed_document,
     json_float,
     option_document,
     part_document,
     plan_document,
 )
-from .model.actions import ACTIONS, SQUEEZE, Action, get_action
-from .model.prior import Prior, UniformPrior
+from ..model.actions import ACTIONS, SQUEEZE, Action, get_action
+from ..model.prior import Prior, UniformPrior
 
 if TYPE_CHECKING:  # ``squeeze`` and ``push`` print tables without importing the planners
-    from .planning.guaranteed import GuaranteedPlan
-    from .planning.result import PlanOption, PlanReport
-    from .sim.kinematic import SimulationResult
+    from ..planning.guaranteed import GuaranteedPlan
+    from ..planning.result import PlanOption, PlanReport
+    from ..sim.kinematic import SimulationResult
 
 __all__ = [
     "guaranteed_text",
@@ -104,7 +104,7 @@ def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -
     for i, (s, lo, hi, p) in enumerate(zip(f.stable, f.basin_lo, f.basin_hi, probs, strict=True)):
         basin = f"({num(math.degrees(lo), '9.3f')}, {num(math.degrees(hi), '9.3f')})"
         lines.append(f"{i:>5}  {num(math.degrees(s), '12.3f')}  {basin:>23}  {p:11.4f}")
-    from .report_curved import curved_lines
+    from .curved import curved_lines
 
     lines += curved_lines(part) if f.kind == "squeeze" else []
     return "\n".join(lines)
@@ -237,7 +237,7 @@ def plan_table(report: PlanReport, max_actions: int | None = None) -> str:
     else:
         what = "most certain plan"
     lines.append(f"B = Bayes plan (least expected cost), C = {what}")
-    from .report_curved import shallow_warnings
+    from .curved import shallow_warnings
 
     lines += shallow_warnings(pb, _finals(report))
     if report.nodes is not None:
@@ -263,7 +263,7 @@ def simulate_json(res: SimulationResult, part: Part | None = None) -> dict[str, 
 
     ``observed`` per orientation is the fraction of all trials (jammed trials end in none).
     """
-    from .sim.result import verdict_document
+    from ..sim.result import verdict_document
 
     doc = option_document(res.option)
     plan = {k: (json_float(v) if isinstance(v, float) else v) for k, v in doc.items()}

@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .geometry.curved import SHALLOW, CurvedPart, RestingState, resting_states
+from ..geometry.curved import SHALLOW, CurvedPart, RestingState, resting_states
 
 if TYPE_CHECKING:
-    from .geometry.polygon import Part
-    from .model.problem import Problem
+    from ..geometry.polygon import Part
+    from ..model.problem import Problem
 
 __all__ = ["curved_document", "curved_lines", "shallow_warnings"]
 

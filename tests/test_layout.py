@@ -1,0 +1,95 @@
+"""The package's layout: no private name is imported across modules (``benchmarks/layout.py``)."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# Private names imported across modules in files other sessions own; each is to be made
+# public or moved by the owner of the file.
+KNOWN: dict[tuple[str, str, str], str] = {
+    ("bayesgrasp.cli.sensing", "bayesgrasp.cli.simulate", "_lagged"): (
+        "the command line's own helper: to be made public or moved by the owner of cli/"
+    ),
+}
+
+
+def _layout() -> ModuleType:
+    path = ROOT / "benchmarks" / "layout.py"
+    spec = importlib.util.spec_from_file_location("layout_measures", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["layout_measures"] = module  # for its dataclasses
+    spec.loader.exec_module(module)
+    return module
+
+
+layout = _layout()
+FOUND = layout.private_imports(ROOT / "src")
+
+
+def test_no_private_name_imported_across_modules() -> None:
+    found = [(a, b, line, name) for a, b, line, name in FOUND if (a, b, name) not in KNOWN]
+    assert found == [], "\n".join(f"{a}:{line} imports {name} of {b}" for a, b, line, name in found)
+
+
+@pytest.mark.parametrize("pair", sorted(KNOWN), ids=lambda p: f"{p[0]}:{p[2]}")
+def test_known_private_imports(pair: tuple[str, str, str]) -> None:
+    if any((a, b, name) == pair for a, b, _, name in FOUND):
+        pytest.xfail(KNOWN[pair])
+
+
+def test_the_lower_layers_have_no_circle() -> None:
+    graph = layout.import_graph(ROOT / "src")
+    low = [c for c in layout.circles(graph) if any(layout.layer_of(m) <= 2 for m in c)]
+    assert low == []
+    assert [i for i in layout.upward(graph) if layout.layer_of(i.source) <= 2] == []
+
+
+def test_the_checker_sees_private_names(tmp_path: Path) -> None:
+    pkg = tmp_path / "bayesgrasp"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "sub" / "__init__.py").write_text("")
+    (pkg / "sub" / "_hidden.py").write_text("X = 1\n")
+    (pkg / "a.py").write_text("_SECRET = 1\nPUBLIC = 2\n__all__ = ['PUBLIC']\n")
+    (pkg / "b.py").write_text(
+        "from .a import _SECRET, PUBLIC, __all__\n"
+        "from . import a\n"
+        "from .sub import _hidden\n"
+        "def f():\n    return a._SECRET + a.PUBLIC\n"
+    )
+    (pkg / "sub" / "c.py").write_text("from . import _hidden\n")  # its own package: allowed
+    found = layout.private_imports(tmp_path)
+    assert [(s, t, n) for s, t, _, n in found] == [
+        ("bayesgrasp.b", "bayesgrasp.a", "_SECRET"),
+        ("bayesgrasp.b", "bayesgrasp.a", "_SECRET"),
+        ("bayesgrasp.b", "bayesgrasp.sub._hidden", "(module)"),
+    ]
+
+
+def test_the_checker_sees_circles_and_upward_imports(tmp_path: Path) -> None:
+    pkg = tmp_path / "bayesgrasp"
+    (pkg / "model").mkdir(parents=True)
+    (pkg / "geometry").mkdir()
+    for folder in (pkg, pkg / "model", pkg / "geometry"):
+        (folder / "__init__.py").write_text("")
+    (pkg / "model" / "goal.py").write_text("def f():\n    from .problem import g\n")
+    (pkg / "model" / "problem.py").write_text("from .goal import f\ndef g(): ...\n")
+    (pkg / "geometry" / "polygon.py").write_text(
+        "from typing import TYPE_CHECKING\n"
+        "if TYPE_CHECKING:\n    from ..model.goal import f\n"  # annotations only: not counted
+        "def h():\n    from ..model.problem import g\n"
+    )
+    graph = layout.import_graph(tmp_path)
+    assert layout.circles(graph) == [["bayesgrasp.model.goal", "bayesgrasp.model.problem"]]
+    assert [(i.source, i.target) for i in layout.upward(graph)] == [
+        ("bayesgrasp.geometry.polygon", "bayesgrasp.model.problem")
+    ]
+    assert layout.layer_of("bayesgrasp.planning.strategy") > layout.layer_of("bayesgrasp.planning")
