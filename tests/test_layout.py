@@ -7,17 +7,7 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-import pytest
-
 ROOT = Path(__file__).resolve().parent.parent
-
-# Private names imported across modules in files other sessions own; each is to be made
-# public or moved by the owner of the file.
-KNOWN: dict[tuple[str, str, str], str] = {
-    ("bayesgrasp.cli.sensing", "bayesgrasp.cli.simulate", "_lagged"): (
-        "the command line's own helper: to be made public or moved by the owner of cli/"
-    ),
-}
 
 
 def _layout() -> ModuleType:
@@ -35,14 +25,8 @@ FOUND = layout.private_imports(ROOT / "src")
 
 
 def test_no_private_name_imported_across_modules() -> None:
-    found = [(a, b, line, name) for a, b, line, name in FOUND if (a, b, name) not in KNOWN]
+    found = FOUND
     assert found == [], "\n".join(f"{a}:{line} imports {name} of {b}" for a, b, line, name in found)
-
-
-@pytest.mark.parametrize("pair", sorted(KNOWN), ids=lambda p: f"{p[0]}:{p[2]}")
-def test_known_private_imports(pair: tuple[str, str, str]) -> None:
-    if any((a, b, name) == pair for a, b, _, name in FOUND):
-        pytest.xfail(KNOWN[pair])
 
 
 def test_the_lower_layers_have_no_circle() -> None:

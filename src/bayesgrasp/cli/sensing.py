@@ -152,9 +152,9 @@ def simulate_policy_command(
     scale = units_scale(units) if units is not None else None
     params = None  # --jaw-lag: checked for every candidate before any work
     if jaw_lag:
-        from .simulate import _lagged
+        from .simulate import lagged_params
 
-        checked = [_lagged(jaw_lag, p, units) for p in parts]  # one SimParams for all
+        checked = [lagged_params(jaw_lag, p, units) for p in parts]  # one SimParams for all
         params = checked[0]
     if engine is Engine.mujoco and sensor.kind == "exact":
         sensor = mujoco_sensor(parts[0], scale or units_scale(parts[0].units))

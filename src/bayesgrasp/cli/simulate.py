@@ -253,7 +253,7 @@ def simulate(
             "centroid to its farthest vertex): the jaws would close beside it",
             param_hint="--offset",
         )
-    params = _lagged(jaw_lag, p, units) if jaw_lag else None
+    params = lagged_params(jaw_lag, p, units) if jaw_lag else None
     pay = _read_payoff(payoff)
     if (not model.exact or pay is not None) and which in ("bayes", "most-certain", "guaranteed"):
         pb, option, label = noise_aware_plan(which, spec, p, model, pay)
@@ -442,7 +442,7 @@ def _payoff_vector(payoff: Any, problem: Any) -> Any:
         raise typer.BadParameter(str(exc), param_hint="--payoff") from None
 
 
-def _lagged(lag: float, part: Any, units: str | None) -> Any:
+def lagged_params(lag: float, part: Any, units: str | None) -> Any:
     """The MuJoCo settings of ``--jaw-lag``: the lag, and room for the push it makes.
 
     The leading jaw pushes ``jaw_speed * lag / 2`` before the other touches; the clearance is

@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import MissingExtraError, SimulationError
-from .mesh_scene import MeshBody, _finite_array, mesh_body, pose_frame
+from .mesh_scene import MeshBody, finite_array, mesh_body, pose_frame
 
 __all__ = ["DropStudy", "SqueezeCheck", "drop_poses", "squeeze_topples", "static_topples"]
 
@@ -96,7 +96,7 @@ def _unit_normals(normals: ArrayLike, name: str) -> FloatArray:
     arr = np.asarray(normals, dtype=np.float64) if not isinstance(normals, str) else None
     if arr is None or arr.ndim not in (1, 2):
         raise SimulationError(f"`{name}` must be unit vectors of shape (K, 3)")
-    arr = _finite_array(np.atleast_2d(arr), name, (None, 3))
+    arr = finite_array(np.atleast_2d(arr), name, (None, 3))
     if len(arr) == 0:
         raise SimulationError(f"`{name}` must hold at least one normal")
     norm = np.linalg.norm(arr, axis=1)
@@ -416,8 +416,8 @@ def static_topples(
     >>> static_topples(tall, (0.5, 0.5, 3), (0, 0, -1), 0.0, jaw_height=0.05)
     False
     """
-    v = _finite_array(vertices, "vertices", (None, 3))
-    c = _finite_array(com, "com", (3,))
+    v = finite_array(vertices, "vertices", (None, 3))
+    c = finite_array(com, "com", (3,))
     nrm = _unit_normals(normal, "normal")[0]
     if push == 0:
         return False
@@ -533,8 +533,8 @@ def squeeze_topples(
     off = _number(push, "push", -1.0, 1.0, open_low=False)
     tilt_limit = _number(tilt_limit_deg, "tilt_limit_deg", 0.0, 90.0)
     body = mesh_body(vertices, faces, com, size)
-    v_local = _finite_array(vertices, "vertices", (None, 3))
-    c_local = _finite_array(com, "com", (3,))
+    v_local = finite_array(vertices, "vertices", (None, 3))
+    c_local = finite_array(com, "com", (3,))
     predicted = static_topples(
         v_local, c_local, nrm, angle, jaw_height=jaw_h, friction=mu, push=off
     )

@@ -34,7 +34,7 @@ FloatArray = NDArray[np.float64]
 DENSITY = 1200.0
 
 
-def _finite_array(value: ArrayLike, name: str, shape: tuple[int | None, ...]) -> FloatArray:
+def finite_array(value: ArrayLike, name: str, shape: tuple[int | None, ...]) -> FloatArray:
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError):
@@ -211,8 +211,8 @@ def mesh_body(
     """
     from scipy.spatial import ConvexHull, QhullError
 
-    v = _finite_array(vertices, "vertices", (None, 3))
-    c = _finite_array(com, "com", (3,))
+    v = finite_array(vertices, "vertices", (None, 3))
+    c = finite_array(com, "com", (3,))
     try:
         f = np.asarray(faces)
     except (TypeError, ValueError):
