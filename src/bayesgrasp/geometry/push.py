@@ -1,6 +1,6 @@
 """Pushing: the radius function, the push function and the push-grasp function.
 
-Convention (README, "Conventions"): the *pushing jaw* is the jaw on the gripper's ``-x``
+Convention (the documentation's conventions): the *pushing jaw* is the jaw on the gripper's ``-x``
 side. It moves toward ``+x`` and touches the part first; the part, at orientation ``theta``
 (counter-clockwise, user coordinates, relative to the gripper frame), turns under
 quasi-static frictionless pushing until an edge lies flat against that jaw; then the other

@@ -5,7 +5,7 @@ of the jaws. Each kind is one frozen :class:`Action`: its name (used in costs, p
 documents), the one-letter tag of tables, its *transfer function* on orientations (built from
 the part and its squeeze function), the period of its gripper angle, and what it reads. The
 planners, reports, execution and simulation read these attributes; adding a kind is one
-:func:`register_action` call (README, "Architecture").
+:func:`register_action` call (the documentation's architecture page).
 
 Every action here ends with the jaws closed on the part, so it ends in a stable orientation
 of the squeeze function (the states of the problem) and reads the jaw separation there.
