@@ -116,8 +116,8 @@ across the parametric steps; the effect pattern of each class on a support is ke
 belief's images are then one weighted count). What remains is about 0.1 ms of numpy per
 searched belief. Noisy readings with push-grasps (no pi-pair bound) or with SIGMA large
 against the width differences (many ambiguous bins) are the slow cases: see the
-documentation's performance page. Neighbouring readings that lead to the same subtree are joined into
-one branch of the returned tree (the policy is the same).
+documentation's performance page. Neighbouring readings that lead to the same subtree are
+joined into one branch of the returned tree (the policy is the same).
 
 First gripper angle: under the uniform prior it does not matter (0). Otherwise the root
 belief is linear in the angle between the angles where a basin boundary meets a breakpoint
