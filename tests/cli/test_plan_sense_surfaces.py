@@ -364,7 +364,9 @@ def sweep_options(
         raise typer.Exit(0)
 
     monkeypatch.setattr(sweeps, "run_sweep", capture)
-    argv = ["sweep", str(tmp_path), "--out", str(tmp_path / "rows.csv"), *args]
+    parts = tmp_path / "parts"  # results never go where the sweep reads parts
+    parts.mkdir(exist_ok=True)
+    argv = ["sweep", str(parts), "--out", str(tmp_path / "rows.csv"), *args]
     assert run(capsys, *argv)[0] == 0
     return seen[0]
 
