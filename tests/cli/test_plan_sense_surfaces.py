@@ -384,6 +384,6 @@ def test_sweep_takes_the_one_option(
     )
     plain = sweep_options(capsys, monkeypatch, tmp_path, "--max-squeezes", "12")
     assert (plain.max_actions, plain.sense) == (12, None)
-    err = refused(capsys, "sweep", str(tmp_path), "--out", str(tmp_path / "r.csv"), "--sense",
-                  "width", "--max-actions", "9")  # fmt: skip
+    err = refused(capsys, "sweep", str(tmp_path / "parts"), "--out", str(tmp_path / "r.csv"),
+                  "--sense", "width", "--max-actions", "9")  # fmt: skip
     assert "at most 8 actions deep" in err
