@@ -24,7 +24,7 @@ ARGS = [
     "--no-first-run",
 ]
 ROOT = Path(__file__).resolve().parents[2]
-SCREENSHOT = ROOT / "docs" / "figures" / "web.png"
+SCREENSHOT = ROOT / "docs" / "screenshots" / "web-plan.png"
 TRIANGLE_CLICKS = [(100, 300), (300, 300), (160, 120)]  # canvas pixels
 TRIANGLE = [[25.0, 25.0], [75.0, 25.0], [40.0, 70.0]]  # grid 20 px = 5 mm, y up
 
@@ -249,6 +249,7 @@ def test_draw_change_prior_share_and_play(
     assert ok >= 1
     assert outcomes(page) == library_outcomes(page, TRIANGLE, "vonmises:30,4")
     assert "oriented" in page.locator("#anim-status").text_content()
+    SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SCREENSHOT), full_page=True)
     assert SCREENSHOT.stat().st_size > 10_000
 
@@ -380,3 +381,78 @@ def test_sensing_policy_reads_as_the_cli(server: str, page: Any) -> None:
     page.fill("#sense", "width:-1,1")
     assert _policy_tree(page) == ""
     assert "sigma" in str(page.locator("#policy-summary.error").text_content())
+
+
+def test_curved_upload_round_trip_through_the_shared_url(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    """The uploaded file (not its hull) travels in the URL: the shared link plans the same."""
+    peanut = ROOT / "examples" / "peanut.svg"
+    code, want = cli_json("plan", str(peanut))
+    assert code == 0
+    bayes = want["options"][want["bayes"]]
+    assert bayes["squeezes"] == 1 and bayes["success_probability"] == pytest.approx(0.5)
+    assert bayes["expected_cost"] == pytest.approx(4.0)
+    page.goto(server + "/")
+    page.set_input_files("#file", str(peanut))
+    wait_rows(page, expected_rows(want))
+    assert "peanut.svg" in page.locator("#file-name").text_content()
+    shared = page.url
+    assert "file=" in shared and "format=svg" in shared and "v=" not in shared
+    other = page.context.new_page()
+    other.goto(shared)
+    wait_rows(other, expected_rows(want))
+    assert "peanut" in other.locator("#file-name").text_content()
+    # choosing a catalogue part forgets the file: its label and the URL follow
+    other.select_option("#catalogue", "house")
+    _, house = cli_json("plan", "house")
+    wait_rows(other, expected_rows(house))
+    assert other.locator("#file-name").text_content() == ""
+    assert "part=house" in other.url and "file=" not in other.url
+    other.close()
+
+
+def test_validation_messages_next_to_the_inputs(server: str, page: Any) -> None:
+    """An empty cost and no action are errors beside their inputs; old results are cleared."""
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze")
+    page.wait_for_selector("#plans tbody tr")
+    page.fill("#cost-verify", "")
+    page.click("#plan")
+    page.wait_for_selector("#cost-verify-error")
+    assert "verify cost" in page.locator("#cost-verify-error").text_content()
+    assert page.locator("#plans tbody tr").count() == 0
+    page.fill("#cost-verify", "1")
+    page.uncheck("#act-squeeze")
+    page.click("#plan")
+    page.wait_for_selector("#actions-error")
+    assert "at least one action" in page.locator("#actions-error").text_content()
+    assert page.locator("#cost-verify-error").count() == 0
+    page.check("#act-squeeze")
+    page.click("#plan")
+    page.wait_for_selector("#plans tbody tr")
+    assert page.locator(".field-error").count() == 0
+
+
+def test_sensor_in_the_url_and_plan_count_wording(server: str, page: Any) -> None:
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze&sense=width%3A0.5%2C0.1")
+    page.wait_for_selector("#plans tbody tr")
+    assert page.locator("#sense").input_value() == "width:0.5,0.1"
+    assert "sense=width%3A0.5%2C0.1" in page.url
+    status = page.locator("#status").text_content()
+    n = page.locator("#plans tbody tr").count()
+    assert f"{n} plan" + ("" if n == 1 else "s") in status
+    assert "1 plans" not in status
+
+
+def test_no_horizontal_overflow_at_390_px(server: str, browser: Any) -> None:
+    context = browser.new_context(viewport={"width": 390, "height": 844})
+    pg = context.new_page()
+    try:
+        pg.goto(server + "/#part=house&prior=uniform&actions=squeeze")
+        pg.wait_for_selector("#plans tbody tr")
+        pg.click("#play")
+        pg.wait_for_selector("#anim[data-done=true]")
+        width = pg.evaluate("document.documentElement.scrollWidth")
+        assert width <= 390, width
+    finally:
+        context.close()

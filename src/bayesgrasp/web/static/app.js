@@ -138,6 +138,7 @@ function setupCanvas() {
 }
 
 function useVertices(vertices, name) {
+  showFileName("");
   state.vertices = vertices;
   state.catalogue = "";
   state.file = null;
@@ -157,8 +158,8 @@ function options() {
   const actions = ["squeeze", "push-grasp"].filter((a) => $(`act-${a}`).checked);
   const o = {
     prior,
-    actions: actions.join(",") || "squeeze",
-    costs: { squeeze: Number($("cost-squeeze").value), "push-grasp": Number($("cost-push-grasp").value) },
+    actions: actions.join(","),
+    costs: Object.fromEntries(actions.map((a) => [a, Number($(`cost-${a}`).value)])),
     verify_cost: Number($("cost-verify").value),
     retry_cost: Number($("cost-retry").value),
     accuracy: Number($("accuracy").value),
@@ -186,21 +187,40 @@ function partBody() {
 function writeHash() {
   const q = new URLSearchParams();
   if (state.catalogue) q.set("part", state.catalogue);
-  else if (state.vertices.length) q.set("v", state.vertices.map((v) => v.join(",")).join(";"));
+  else if (state.file && state.file.packed) {
+    q.set("file", state.file.packed);
+    q.set("format", state.file.format);
+    q.set("name", state.file.name);
+  } else if (state.vertices.length) q.set("v", state.vertices.map((v) => v.join(",")).join(";"));
   const o = options();
   q.set("prior", o.prior);
   q.set("actions", o.actions);
   for (const k of ["verify_cost", "retry_cost", "accuracy", "goal", "method", "max_actions"])
     if (o[k] !== undefined) q.set(k, o[k]);
-  q.set("squeeze_cost", o.costs.squeeze);
-  q.set("push_grasp_cost", o.costs["push-grasp"]);
+  q.set("squeeze_cost", $("cost-squeeze").value);
+  q.set("push_grasp_cost", $("cost-push-grasp").value);
   const n = noise();
   for (const k of ["turn_noise", "contact_noise"]) if (n[k] !== undefined) q.set(k, n[k]);
+  q.set("sense", $("sense").value.trim() || "width");
+  q.set("sense_depth", $("sense-depth").value);
   window.history.replaceState(null, "", "#" + q.toString());
 }
 
-function readHash() {
+async function readHash() {
   const q = new URLSearchParams(window.location.hash.slice(1));
+  if (q.has("file")) {
+    try {
+      const text = await unpack(q.get("file"));
+      const format = q.get("format") || "svg";
+      const name = q.get("name") || "part";
+      state.file = { format, data_base64: btoa(text), name, packed: q.get("file") };
+      state.catalogue = "";
+      state.vertices = [];
+      showFileName(`${name}.${format}`);
+    } catch (err) {
+      setStatus(`the file in the address cannot be read: ${err.message || err}`, true);
+    }
+  }
   const prior = q.get("prior") || "uniform";
   if (prior.startsWith("vonmises:")) {
     const [m, k] = prior.slice(9).split(",");
@@ -222,6 +242,8 @@ function readHash() {
   set("max-actions", "max_actions");
   set("cost-squeeze", "squeeze_cost");
   set("cost-push-grasp", "push_grasp_cost");
+  set("sense", "sense");
+  set("sense-depth", "sense_depth");
   const [kind, turnDeg] = (q.get("turn_noise") || "").split(":");
   $("turn-kind").value = kind === "normal" || kind === "uniform" ? kind : "";
   if ($("turn-kind").value) $("turn-deg").value = turnDeg;
@@ -233,6 +255,10 @@ function readHash() {
   } else if (q.get("v")) {
     state.vertices = q.get("v").split(";").map((s) => s.split(",").map(Number));
     state.name = "drawn";
+    state.catalogue = "";
+    state.file = null;
+    $("catalogue").value = "";
+    showFileName("");
   }
 }
 
@@ -282,9 +308,14 @@ async function run() {
     setStatus("add at least three vertices (or choose a part)");
     return;
   }
+  if (!validate()) {
+    clearResults();
+    return;
+  }
   writeHash();
   const gen = ++generation;
   setStatus("planning...");
+  $("output").classList.add("stale");
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
@@ -293,24 +324,19 @@ async function run() {
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
     if (gen !== generation) return;
+    $("output").classList.remove("stale");
     state.last = { plan, squeeze, push };
-    if (state.file) {
-      // the uploaded part travels in the URL as its hull
-      state.vertices = plan.part.vertices;
-      state.file = null;
-      state.name = plan.part.name;
-      drawCanvas();
-      writeHash();
-    }
     drawHull(plan.part);
     drawDiameter(plan.part, squeeze);
     drawTable(plan);
     drawAnimationFrame(0);
-    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${plan.options.length} plans`);
+    const n = plan.options.length;
+    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${n} ${n === 1 ? "plan" : "plans"}`);
     document.body.dataset.planned = String(gen);
     loadGallery();
   } catch (err) {
     if (gen !== generation) return;
+    clearResults();
     setStatus(String(err.message || err), true);
     document.body.dataset.planned = "error";
   }
@@ -500,6 +526,7 @@ function play() {
 }
 
 async function showFigures() {
+  if (!validate()) return;
   const body = { part: partBody(), ...options() };
   for (const name of ["transfer", "plan"]) {
     const r = await fetch(`${API}/figures/${name}.svg`, {
@@ -578,6 +605,7 @@ function policyLines(node, depth, first, unit, lines) {
 }
 
 async function showPolicy() {
+  if (!validate()) return;
   const o = options();
   const body = { part: partBody(), ...o, sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
   $("policy-summary").textContent = "planning the policy...";
@@ -621,6 +649,7 @@ async function loadCatalogue() {
     undoStack.push(state.vertices.map((v) => v.slice()));
     state.catalogue = name;
     state.file = null;
+    showFileName("");
     state.vertices = [];
     drawCanvas();
     state.outline = entry.outline;
@@ -638,7 +667,12 @@ function setupFile() {
     for (let i = 0; i < bytes.length; i += 0x8000) bin += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
     state.catalogue = "";
     state.vertices = [];
-    state.file = { format: ext, data_base64: btoa(bin), name: f.name.replace(/\.[^.]*$/, "").replace(/[^A-Za-z0-9_. -]/g, "_").slice(0, 64) || "part" };
+    const name = f.name.replace(/\.[^.]*$/, "").replace(/[^A-Za-z0-9_. -]/g, "_").slice(0, 64) || "part";
+    state.file = { format: ext, data_base64: btoa(bin), name, packed: await pack(bin) };
+    state.outline = null;
+    $("catalogue").value = "";
+    drawCanvas();
+    showFileName(f.name);
     schedule();
   });
 }
@@ -655,9 +689,10 @@ async function loadGallery() {
       const q = new URLSearchParams();
       q.set("v", row.vertices.map((v) => v.join(",")).join(";"));
       for (const [k, v] of Object.entries(row.options)) if (typeof v !== "object") q.set(k, v);
+      for (const [k, v] of Object.entries(row.options.costs || {})) q.set(`${k.replace("-", "_")}_cost`, v);
       a.href = "#" + q.toString();
       a.textContent = `${row.name}: ${row.squeezes} actions, p = ${row.success_probability === null ? "-" : row.success_probability.toFixed(3)}`;
-      a.addEventListener("click", () => setTimeout(() => { readHash(); drawCanvas(); schedule(); }, 0));
+      a.addEventListener("click", () => setTimeout(async () => { await readHash(); drawCanvas(); schedule(); }, 0));
       li.appendChild(a);
       ul.appendChild(li);
     }
@@ -671,18 +706,123 @@ async function loadGallery() {
 function start() {
   setupCanvas();
   setupFile();
-  readHash();
+  const ready = readHash();
   drawCanvas();
   $("plan").addEventListener("click", run);
   $("play").addEventListener("click", play);
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
   $("options").addEventListener("change", schedule);
-  window.addEventListener("hashchange", () => { readHash(); drawCanvas(); schedule(); });
-  loadCatalogue().then(() => {
-    if (state.catalogue || state.vertices.length >= 3) run();
+  window.addEventListener("hashchange", async () => { await readHash(); drawCanvas(); schedule(); });
+  Promise.all([ready, loadCatalogue()]).then(() => {
+    if (state.catalogue || state.file || state.vertices.length >= 3) run();
   });
   loadGallery();
 }
 
 start();
+
+// ---- the uploaded file in the URL: deflate-raw, base64url ------------------------------------
+
+function toBase64Url(bin) {
+  return btoa(bin).replace(/\+/g, "-").replace(/\//g, "_").replace(/=+$/, "");
+}
+
+function fromBase64Url(s) {
+  const b = s.replace(/-/g, "+").replace(/_/g, "/");
+  return atob(b + "===".slice((b.length + 3) % 4));
+}
+
+async function pack(bin) {
+  // a binary string (the file's bytes) compressed for the address bar
+  const bytes = Uint8Array.from(bin, (c) => c.charCodeAt(0));
+  const stream = new Blob([bytes]).stream().pipeThrough(new CompressionStream("deflate-raw"));
+  const out = new Uint8Array(await new Response(stream).arrayBuffer());
+  let s = "";
+  for (let i = 0; i < out.length; i += 0x8000) s += String.fromCharCode.apply(null, out.subarray(i, i + 0x8000));
+  return toBase64Url(s);
+}
+
+async function unpack(packed) {
+  const bytes = Uint8Array.from(fromBase64Url(packed), (c) => c.charCodeAt(0));
+  const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate-raw"));
+  const out = new Uint8Array(await new Response(stream).arrayBuffer());
+  let s = "";
+  for (let i = 0; i < out.length; i += 0x8000) s += String.fromCharCode.apply(null, out.subarray(i, i + 0x8000));
+  return s;
+}
+
+function showFileName(text) {
+  $("file-name").textContent = text ? `current file: ${text}` : "";
+  if (!text) $("file").value = "";
+}
+
+// ---- validation: each message next to the input that caused it -------------------------------
+
+function fieldError(id, message) {
+  const input = $(id);
+  let span = document.getElementById(`${id}-error`);
+  if (!message) {
+    input.removeAttribute("aria-invalid");
+    if (span) span.remove();
+    return;
+  }
+  input.setAttribute("aria-invalid", "true");
+  if (!span) {
+    span = document.createElement("span");
+    span.id = `${id}-error`;
+    span.className = "field-error";
+    span.setAttribute("role", "alert");
+    const anchor = input.closest("label, fieldset") || input;
+    anchor.insertAdjacentElement("afterend", span);
+  }
+  span.textContent = message;
+}
+
+function validate() {
+  let ok = true;
+  const number = (id, what, lo, hi, required) => {
+    const raw = $(id).value.trim();
+    let msg = "";
+    if (raw === "") msg = required ? `${what}: enter a number` : "";
+    else if (!Number.isFinite(Number(raw))) msg = `${what}: not a number`;
+    else if (Number(raw) < lo) msg = `${what}: must be at least ${lo}`;
+    else if (hi !== undefined && Number(raw) > hi) msg = `${what}: must be at most ${hi}`;
+    fieldError(id, msg);
+    if (msg) ok = false;
+  };
+  number("cost-squeeze", "squeeze cost", 0, undefined, $("act-squeeze").checked);
+  number("cost-push-grasp", "push-grasp cost", 0, undefined, $("act-push-grasp").checked);
+  number("cost-verify", "verify cost", 0, undefined, true);
+  number("cost-retry", "retry cost", 0, undefined, true);
+  number("accuracy", "accuracy", 0, 180, true);
+  number("max-actions", "max actions", 1, 1000, false);
+  number("contact-noise", "contact noise", 0, 1, false);
+  if ($("turn-kind").value) number("turn-deg", "turn error", 0, undefined, true);
+  else fieldError("turn-deg", "");
+  if ($("prior-kind").value === "vonmises") {
+    number("prior-mean", "mean", -360, 360, true);
+    number("prior-kappa", "kappa", 0, undefined, true);
+  } else {
+    fieldError("prior-mean", "");
+    fieldError("prior-kappa", "");
+  }
+  const acts = $("act-squeeze").checked || $("act-push-grasp").checked;
+  fieldError("actions", acts ? "" : "choose at least one action");
+  if (!acts) ok = false;
+  if (!ok) setStatus("fix the marked inputs", true);
+  return ok;
+}
+
+function clearResults() {
+  state.last = null;
+  $("output").classList.remove("stale");
+  $("plans").querySelector("tbody").replaceChildren();
+  $("hull").replaceChildren();
+  $("diameter").replaceChildren();
+  $("anim").replaceChildren();
+  $("anim-status").textContent = "";
+  for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
+  $("policy-tree").textContent = "";
+  $("policy-summary").textContent = "";
+}
