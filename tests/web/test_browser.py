@@ -284,6 +284,13 @@ def test_catalogue_and_gallery(server: str, page: Any, cli_json: CliJson) -> Non
     _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
     wait_rows(page, expected_rows(want))
     assert page.locator("#catalogue").input_value() == "house"
+    # the catalogue part is drawn on the canvas, inside it
+    page.wait_for_selector("#given-part")
+    box = page.evaluate(
+        """() => { const b = document.getElementById('given-part').getBBox();
+                   return [b.x, b.y, b.x + b.width, b.y + b.height]; }"""
+    )
+    assert 0 <= box[0] < box[2] <= 400 and 0 <= box[1] < box[3] <= 400
     page.wait_for_function("document.querySelectorAll('#gallery li').length > 0")
 
 

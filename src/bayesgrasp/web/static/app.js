@@ -79,6 +79,11 @@ function drawCanvas() {
     el("line", { x1: i, y1: 0, x2: i, y2: SIZE, class: "grid" }, svg);
     el("line", { x1: 0, y1: i, x2: SIZE, y2: i, class: "grid" }, svg);
   }
+  if ((state.catalogue || state.file) && state.outline && state.outline.length >= 3) {
+    // a catalogue or uploaded part, fitted to the canvas (it is not edited here)
+    const f = fit(state.outline, SIZE, 24);
+    el("polygon", { points: state.outline.map((p) => f(p).join(",")).join(" "), class: "poly", id: "given-part" }, svg);
+  }
   const pts = state.vertices.map((v) => toCanvas(v[0], v[1]));
   if (pts.length >= 2) el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "poly" }, svg);
   if (pts.length >= 3) {
@@ -94,7 +99,8 @@ function drawCanvas() {
       svg.setPointerCapture(evt.pointerId);
     });
   });
-  $("coords").value = state.vertices.map((v) => `${v[0]}, ${v[1]}`).join("\n");
+  const short = (x) => String(Number(x.toPrecision(6)));
+  $("coords").value = state.vertices.map((v) => `${short(v[0])}, ${short(v[1])}`).join("\n");
 }
 
 function setupCanvas() {
@@ -326,6 +332,10 @@ async function run() {
     if (gen !== generation) return;
     $("output").classList.remove("stale");
     state.last = { plan, squeeze, push };
+    if (state.file) {
+      state.outline = plan.part.vertices; // the hull of the exact model
+      drawCanvas();
+    }
     drawHull(plan.part);
     drawDiameter(plan.part, squeeze);
     drawTable(plan);
@@ -642,6 +652,12 @@ async function loadCatalogue() {
     $("catalogue").appendChild(o);
   }
   $("catalogue").value = state.catalogue;
+  state.catalogueParts = doc.parts;
+  const given = doc.parts.find((p) => p.name === state.catalogue);
+  if (given) {
+    state.outline = given.outline;
+    drawCanvas();
+  }
   $("catalogue").addEventListener("change", () => {
     const name = $("catalogue").value;
     if (!name) return;
@@ -651,8 +667,8 @@ async function loadCatalogue() {
     state.file = null;
     showFileName("");
     state.vertices = [];
-    drawCanvas();
     state.outline = entry.outline;
+    drawCanvas();
     schedule();
   });
 }
