@@ -291,7 +291,18 @@ def test_catalogue_and_gallery(server: str, page: Any, cli_json: CliJson) -> Non
                    return [b.x, b.y, b.x + b.width, b.y + b.height]; }"""
     )
     assert 0 <= box[0] < box[2] <= 400 and 0 <= box[1] < box[3] <= 400
+    # automatic plans are not in the gallery; a saved view is, and its link reproduces it
+    assert page.locator("#gallery li").count() == 0
+    page.click("#save")
     page.wait_for_function("document.querySelectorAll('#gallery li').length > 0")
+    assert page.locator("#gallery li svg.thumb polygon").count() == 1
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze&verify_cost=3")
+    _, key = cli_json("plan", "key", "--verify-cost", "3")
+    wait_rows(page, expected_rows(key))
+    page.click("#gallery li a")
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#catalogue").input_value() == "house"
+    assert "part=house" in page.url
 
 
 def test_noise_fields_reach_the_plan_and_the_link(

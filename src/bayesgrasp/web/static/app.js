@@ -258,6 +258,10 @@ async function readHash() {
     state.catalogue = q.get("part");
     $("catalogue").value = state.catalogue;
     state.vertices = [];
+    state.file = null;
+    showFileName("");
+    const entry = (state.catalogueParts || []).find((p) => p.name === state.catalogue);
+    state.outline = entry ? entry.outline : null;
   } else if (q.get("v")) {
     state.vertices = q.get("v").split(";").map((s) => s.split(",").map(Number));
     state.name = "drawn";
@@ -343,7 +347,6 @@ async function run() {
     const n = plan.options.length;
     setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${n} ${n === 1 ? "plan" : "plans"}`);
     document.body.dataset.planned = String(gen);
-    loadGallery();
   } catch (err) {
     if (gen !== generation) return;
     clearResults();
@@ -693,27 +696,69 @@ function setupFile() {
   });
 }
 
-async function loadGallery() {
+let galleryPage = 1;
+const PER_PAGE = 8;
+
+function thumbnail(outline) {
+  const svg = el("svg", { viewBox: "0 0 64 64", width: 64, height: 64, class: "thumb" });
+  if (outline.length >= 3) {
+    const f = fit(outline, 64, 4);
+    el("polygon", { points: outline.map((p) => f(p).join(",")).join(" "), class: "poly" }, svg);
+  }
+  return svg;
+}
+
+async function loadGallery(page) {
+  if (page) galleryPage = page;
   try {
-    const r = await fetch(API + "/gallery?limit=20");
+    const r = await fetch(`${API}/saved?page=${galleryPage}&per_page=${PER_PAGE}`);
     const doc = await r.json();
     const ul = $("gallery");
     ul.replaceChildren();
     for (const row of doc.rows) {
       const li = document.createElement("li");
       const a = document.createElement("a");
-      const q = new URLSearchParams();
-      q.set("v", row.vertices.map((v) => v.join(",")).join(";"));
-      for (const [k, v] of Object.entries(row.options)) if (typeof v !== "object") q.set(k, v);
-      for (const [k, v] of Object.entries(row.options.costs || {})) q.set(`${k.replace("-", "_")}_cost`, v);
-      a.href = "#" + q.toString();
-      a.textContent = `${row.name}: ${row.squeezes} actions, p = ${row.success_probability === null ? "-" : row.success_probability.toFixed(3)}`;
-      a.addEventListener("click", () => setTimeout(async () => { await readHash(); drawCanvas(); schedule(); }, 0));
+      a.href = "#" + row.view;
+      a.appendChild(thumbnail(row.outline));
+      const s = row.summary || {};
+      const n = s.actions;
+      const text = document.createElement("span");
+      text.textContent = `${row.name}: ${n === undefined ? "" : `${n} ${n === 1 ? "action" : "actions"}, `}` +
+        `p = ${s.success_probability == null ? "-" : s.success_probability.toFixed(3)}, ` +
+        `cost ${s.expected_cost == null ? "-" : s.expected_cost.toFixed(3)}`;
+      a.appendChild(text);
       li.appendChild(a);
       ul.appendChild(li);
     }
+    const pages = Math.max(1, Math.ceil(doc.total / PER_PAGE));
+    $("gallery-page").textContent = doc.total ? `page ${galleryPage} of ${pages} (${doc.total} saved)` : "nothing saved yet";
+    $("gallery-prev").disabled = galleryPage <= 1;
+    $("gallery-next").disabled = galleryPage >= pages;
   } catch (err) {
     /* the gallery is optional */
+  }
+}
+
+async function saveView() {
+  if (!state.last) {
+    setStatus("plan a part before saving it", true);
+    return;
+  }
+  const { plan } = state.last;
+  const o = plan.options[plan.bayes];
+  const outline = state.vertices.length >= 3 ? state.vertices : state.outline || plan.part.vertices;
+  const body = {
+    name: plan.part.name,
+    view: window.location.hash.slice(1),
+    outline,
+    summary: { actions: o.steps.length, success_probability: o.success_probability, expected_cost: o.expected_cost },
+  };
+  try {
+    await post("/saved", body);
+    setStatus(`saved ${plan.part.name} to the gallery`);
+    loadGallery(1);
+  } catch (err) {
+    setStatus(String(err.message || err), true);
   }
 }
 
@@ -728,6 +773,9 @@ function start() {
   $("play").addEventListener("click", play);
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
+  $("save").addEventListener("click", saveView);
+  $("gallery-prev").addEventListener("click", () => loadGallery(galleryPage - 1));
+  $("gallery-next").addEventListener("click", () => loadGallery(galleryPage + 1));
   $("options").addEventListener("change", schedule);
   window.addEventListener("hashchange", async () => { await readHash(); drawCanvas(); schedule(); });
   Promise.all([ready, loadCatalogue()]).then(() => {
