@@ -52,3 +52,44 @@ def test_no_gallery_without_a_data_folder() -> None:
         assert c.get("/api/v1/saved").json()["total"] == 0
         body = {"name": "a", "view": "part=house", "outline": []}
         assert c.post("/api/v1/saved", json=body).status_code == 404
+
+
+def test_functions_and_beliefs_agree_with_the_plan(client: Any, cli_json: Any) -> None:
+    """The last belief's mass at the final orientation is the plan's success probability."""
+    from pathlib import Path
+
+    peanut = Path(__file__).resolve().parents[2] / "examples" / "peanut.svg"
+    for part, args in (
+        ({"catalogue": "house"}, ["house"]),
+        ({"catalogue": "key"}, ["key", "--prior", "vonmises:30,4"]),
+    ):
+        body: dict[str, Any] = {"part": part}
+        if len(args) > 1:
+            body["prior"] = args[2]
+        r = client.post("/api/v1/views/functions", json=body)
+        assert r.status_code == 200, r.text
+        doc = r.json()
+        _, want = cli_json("plan", *args)
+        bayes = want["options"][want["bayes"]]
+        assert len(doc["belief"]) == len(bayes["steps"])
+        assert abs(sum(a["probability"] for a in doc["belief"][0]) - 1) < 1e-9
+        final = doc["plan"]["final_deg"]
+        mass = sum(
+            a["probability"]
+            for a in doc["belief"][-1]
+            if abs((a["orientation_deg"] - final + 180) % 360 - 180) < 1e-6
+        )
+        assert abs(mass - bayes["success_probability"]) < 1e-9
+        assert len(doc["functions"]["diameter"]) == len(doc["theta_deg"]) == 721
+        for name in ("squeeze", "push", "push_grasp"):
+            assert set(doc["functions"][name]) <= {
+                round(x % 360, 4) for x in doc["stable_deg"][name]
+            } | {round(x, 4) for x in doc["functions"][name]}
+    import base64
+
+    data = base64.b64encode(peanut.read_bytes()).decode()
+    r = client.post(
+        "/api/v1/views/functions", json={"part": {"file": {"format": "svg", "data_base64": data}}}
+    )
+    assert r.status_code == 200, r.text
+    assert r.json()["plan"]["success_probability"] == 0.5
