@@ -421,6 +421,17 @@ def test_curved_upload_round_trip_through_the_shared_url(
     other.goto(shared)
     wait_rows(other, expected_rows(want))
     assert "peanut" in other.locator("#file-name").text_content()
+    # the figures: every function drawn, the belief of the last step at the final orientation
+    other.wait_for_selector("#belief svg.belief")
+    assert other.locator("#functions svg.chart").count() >= 2
+    mass = other.evaluate(
+        """() => [...document.querySelectorAll('#belief svg:last-of-type rect[fill="#2a9a2a"]')]
+            .reduce((a, r) => a + Number(r.dataset.p), 0)"""
+    )
+    assert mass == pytest.approx(bayes["success_probability"])
+    other.hover("#functions svg.chart")
+    assert "θ" in other.locator("#functions svg.chart .tip").first.text_content()
+    other.locator("#functions").screenshot(path=str(SCREENSHOT.with_name("web-functions.png")))
     # choosing a catalogue part forgets the file: its label and the URL follow
     other.select_option("#catalogue", "house")
     _, house = cli_json("plan", "house")
@@ -472,5 +483,8 @@ def test_no_horizontal_overflow_at_390_px(server: str, browser: Any) -> None:
         pg.wait_for_selector("#anim[data-done=true]")
         width = pg.evaluate("document.documentElement.scrollWidth")
         assert width <= 390, width
+        pg.wait_for_selector("#belief svg.belief")
+        pg.screenshot(path=str(SCREENSHOT.with_name("web-phone.png")), full_page=True)
+        assert pg.evaluate("document.documentElement.scrollWidth") <= 390
     finally:
         context.close()

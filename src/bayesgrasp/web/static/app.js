@@ -344,6 +344,7 @@ async function run() {
     drawDiameter(plan.part, squeeze);
     drawTable(plan);
     drawAnimationFrame(0);
+    loadFunctions(part, o, gen);
     const n = plan.options.length;
     setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${n} ${n === 1 ? "plan" : "plans"}`);
     document.body.dataset.planned = String(gen);
@@ -886,7 +887,119 @@ function clearResults() {
   $("diameter").replaceChildren();
   $("anim").replaceChildren();
   $("anim-status").textContent = "";
+  $("functions").replaceChildren();
+  $("belief").replaceChildren();
+  state.functions = null;
   for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
   $("policy-tree").textContent = "";
   $("policy-summary").textContent = "";
+}
+
+// ---- interactive figures drawn from the JSON of /views/functions ---------------------------
+
+const round = (x, d) => String(Number(x.toFixed(d)));
+
+function chart(svg, xs, ys, opts) {
+  // a line chart with hover values; the wheel zooms the angle axis, a double click resets it
+  const W = 640, H = 260, L = 56, R = 12, T = 12, B = 34;
+  let lo = opts.lo === undefined ? xs[0] : opts.lo, hi = opts.hi === undefined ? xs[xs.length - 1] : opts.hi;
+  const draw = () => {
+    svg.replaceChildren();
+    svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+    const keep = xs.map((x, i) => i).filter((i) => xs[i] >= lo && xs[i] <= hi);
+    const vals = keep.map((i) => ys[i]);
+    let y0 = Math.min(...vals), y1 = Math.max(...vals);
+    if (opts.angle) { y0 = 0; y1 = 360; }
+    if (y1 - y0 < 1e-9) { y0 -= 1; y1 += 1; }
+    const X = (x) => L + ((W - L - R) * (x - lo)) / (hi - lo);
+    const Y = (y) => H - B - ((H - T - B) * (y - y0)) / (y1 - y0);
+    el("rect", { x: L, y: T, width: W - L - R, height: H - T - B, fill: "#fff", stroke: "#ccc" }, svg);
+    for (let k = 0; k <= 4; k++) {
+      const xv = lo + ((hi - lo) * k) / 4, yv = y0 + ((y1 - y0) * k) / 4;
+      el("text", { x: X(xv), y: H - 14, "text-anchor": "middle", "font-size": 13 }, svg).textContent = round(xv, 1);
+      el("text", { x: L - 4, y: Y(yv) + 4, "text-anchor": "end", "font-size": 13 }, svg).textContent = round(yv, opts.angle ? 0 : 2);
+    }
+    el("text", { x: W / 2, y: H - 1, "text-anchor": "middle", "font-size": 13 }, svg).textContent = `${opts.x} (deg)`;
+    const d = keep.map((i, k) => `${k ? "L" : "M"}${X(xs[i]).toFixed(1)},${Y(ys[i]).toFixed(1)}`).join("");
+    el("path", { d, fill: "none", stroke: "#2f4b6e", "stroke-width": 2, class: "curve" }, svg);
+    const dot = el("circle", { r: 4, fill: "#d62728", visibility: "hidden" }, svg);
+    const tip = el("text", { x: L + 6, y: T + 16, "font-size": 14, class: "tip" }, svg);
+    svg.onmousemove = (evt) => {
+      const r = svg.getBoundingClientRect();
+      const px = ((evt.clientX - r.left) * W) / r.width;
+      const x = lo + ((px - L) * (hi - lo)) / (W - L - R);
+      let best = keep[0];
+      for (const i of keep) if (Math.abs(xs[i] - x) < Math.abs(xs[best] - x)) best = i;
+      dot.setAttribute("cx", X(xs[best]));
+      dot.setAttribute("cy", Y(ys[best]));
+      dot.setAttribute("visibility", "visible");
+      tip.textContent = `${opts.x} ${round(xs[best], 2)}°: ${opts.y} ${round(ys[best], opts.angle ? 2 : 3)}${opts.angle ? "°" : ""}`;
+    };
+  };
+  svg.onwheel = (evt) => {
+    evt.preventDefault();
+    const mid = (lo + hi) / 2, half = ((hi - lo) / 2) * (evt.deltaY > 0 ? 1.25 : 0.8);
+    lo = Math.max(xs[0], mid - half);
+    hi = Math.min(xs[xs.length - 1], mid + half);
+    draw();
+  };
+  svg.ondblclick = () => { lo = xs[0]; hi = xs[xs.length - 1]; draw(); };
+  draw();
+}
+
+const FUNCTION_NAMES = {
+  diameter: ["diameter d(θ)", false],
+  squeeze: ["squeeze s(θ)", true],
+  radius: ["radius r(θ)", false],
+  push: ["push p(θ)", true],
+  push_grasp: ["push-grasp g(θ)", true],
+};
+
+async function loadFunctions(part, o, gen) {
+  try {
+    const doc = await post("/views/functions", { part, ...o });
+    if (gen !== generation) return;
+    state.functions = doc;
+    const box = $("functions");
+    box.replaceChildren();
+    for (const [key, [label, angle]] of Object.entries(FUNCTION_NAMES)) {
+      if (!doc.functions[key]) continue;
+      const fig = document.createElement("figure");
+      const cap = document.createElement("figcaption");
+      cap.textContent = label;
+      const svg = el("svg", { class: "chart", "data-function": key, role: "img", "aria-label": label });
+      fig.append(cap, svg);
+      box.appendChild(fig);
+      chart(svg, doc.theta_deg, doc.functions[key], { x: "θ", y: label.split(" ")[0], angle });
+    }
+    drawBelief(doc);
+  } catch (err) {
+    if (gen === generation) $("functions").textContent = String(err.message || err);
+  }
+}
+
+function drawBelief(doc) {
+  // one bar chart a step: the probability of each orientation after the step
+  const box = $("belief");
+  box.replaceChildren();
+  doc.belief.forEach((atoms, k) => {
+    const st = doc.plan.steps[k];
+    const W = 640, H = 120, L = 40, B = 26, T = 8;
+    const svg = el("svg", { viewBox: `0 0 ${W} ${H}`, class: "chart belief", "data-step": k + 1 });
+    const cap = document.createElement("figcaption");
+    cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°)`;
+    const fig = document.createElement("figure");
+    fig.append(cap, svg);
+    box.appendChild(fig);
+    const X = (a) => L + ((W - L - 10) * (((a % 360) + 360) % 360)) / 360;
+    el("line", { x1: L, y1: H - B, x2: W - 10, y2: H - B, stroke: "#555" }, svg);
+    for (let a = 0; a <= 360; a += 90)
+      el("text", { x: X(a === 360 ? 359.999 : a), y: H - 8, "text-anchor": "middle", "font-size": 13 }, svg).textContent = `${a}`;
+    for (const { orientation_deg: a, probability: p } of atoms) {
+      const h = (H - B - T) * p;
+      const goal = Math.abs(((a - doc.plan.final_deg + 540) % 360) - 180) < 1e-6 && k === doc.belief.length - 1;
+      const bar = el("rect", { x: X(a) - 4, y: H - B - h, width: 8, height: Math.max(h, 0.5), fill: goal ? "#2a9a2a" : "#2f4b6e", "data-p": p }, svg);
+      el("title", {}, bar).textContent = `${round(a, 2)}°: p = ${round(p, 4)}`;
+    }
+  });
 }
