@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import socket
 import subprocess
 import sys
@@ -488,3 +489,53 @@ def test_no_horizontal_overflow_at_390_px(server: str, browser: Any) -> None:
         assert pg.evaluate("document.documentElement.scrollWidth") <= 390
     finally:
         context.close()
+
+
+MATRIX = [
+    # (what the test does on the page, the CLI options it means, what the URL then holds)
+    (("select", "#prior-kind", "vonmises"), ["--prior", "vonmises:0,4"], "prior=vonmises"),
+    (("fill", "#prior-mean", "30"), ["--prior", "vonmises:30,4"], "vonmises%3A30%2C4"),
+    (("fill", "#cost-verify", "3"), ["--verify-cost", "3"], "verify_cost=3"),
+    (("fill", "#cost-squeeze", "2"), ["--squeeze-cost", "2"], "squeeze_cost=2"),
+    (("fill", "#cost-retry", "0.5"), ["--retry-cost", "0.5"], "retry_cost=0.5"),
+    (("fill", "#accuracy", "2"), ["--accuracy", "2"], "accuracy=2"),
+    (("select", "#goal", "symmetry"), ["--goal", "symmetry"], "goal=symmetry"),
+    (("fill", "#max-actions", "2"), ["--max-actions", "2"], "max_actions=2"),
+    (("check", "#act-push-grasp", ""), ["--actions", "squeeze,push-grasp"], "push-grasp"),
+]
+
+
+def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
+    """Change each input in turn: the table, the URL and the figures' plan follow each time."""
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    _, want = cli_json("plan", "key")
+    wait_rows(page, expected_rows(want))
+    args: dict[str, list[str]] = {}
+    for (how, selector, value), cli, in_url in MATRIX:
+        if how == "select":
+            page.select_option(selector, value)
+        elif how == "fill":
+            page.fill(selector, value)
+        else:
+            page.check(selector)
+        page.click("#plan")
+        args[cli[0]] = cli
+        flat = [a for v in args.values() for a in v]
+        code, want = cli_json("plan", "key", *flat)
+        assert code == 0, (flat, want)
+        wait_rows(page, expected_rows(want))
+        assert in_url in page.url, (in_url, page.url)
+        # the figures show the same part and plan as the table
+        page.wait_for_function(
+            "() => document.querySelectorAll('#belief svg.belief').length === "
+            f"{len(want['options'][want['bayes']]['steps'])}"
+        )
+        steps = page.evaluate("() => state.functions.plan.steps.map((s) => s.alpha_deg)")
+        bayes = want["options"][want["bayes"]]
+        assert steps == pytest.approx([math.degrees(s["alpha_rad"]) for s in bayes["steps"]])
+        # the shared link gives the same table in a fresh page
+        if in_url in ("goal=symmetry", "push-grasp"):
+            other = page.context.new_page()
+            other.goto(page.url)
+            wait_rows(other, expected_rows(want))
+            other.close()
