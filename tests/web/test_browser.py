@@ -433,6 +433,12 @@ def test_curved_upload_round_trip_through_the_shared_url(
     other.hover("#functions svg.chart")
     assert "θ" in other.locator("#functions svg.chart .tip").first.text_content()
     other.locator("#functions").screenshot(path=str(SCREENSHOT.with_name("web-functions.png")))
+    # the sensing policy plans the file too: its sensorless cost is the plan's
+    other.click("#policy")
+    other.wait_for_selector("body[data-policy=done]")
+    assert "sensorless Bayes plan 4.0000" in other.locator("#policy-summary").text_content()
+    assert other.locator("#policy-nodes details.policy-node").count() >= 1
+    other.locator("#policy-nodes").screenshot(path=str(SCREENSHOT.with_name("web-policy.png")))
     # choosing a catalogue part forgets the file: its label and the URL follow
     other.select_option("#catalogue", "house")
     _, house = cli_json("plan", "house")

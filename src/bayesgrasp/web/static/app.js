@@ -624,6 +624,7 @@ async function showPolicy() {
   const body = { part: partBody(), ...o, sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
   $("policy-summary").textContent = "planning the policy...";
   $("policy-tree").textContent = "";
+  $("policy-nodes").replaceChildren();
   try {
     const doc = await post("/policy", body);
     state.policyParts = doc.parts.length;
@@ -631,6 +632,7 @@ async function showPolicy() {
     const last = state.last && state.last.plan ? state.last.plan.part : null;
     const units = last && last.name === doc.parts[0] ? last.units : null;
     $("policy-tree").textContent = policyLines(doc.root, 0, true, units ? ` ${units}` : "", []).join("\n");
+    $("policy-nodes").replaceChildren(policyNode(doc.root, true, units ? ` ${units}` : ""));
     const blind = doc.sensorless_cost === null ? "" : ` (sensorless Bayes plan ${doc.sensorless_cost.toFixed(4)})`;
     $("policy-summary").textContent =
       `expected cost ${doc.expected_cost.toFixed(4)}${blind}, success ${doc.success_probability.toFixed(4)} a cycle, ` +
@@ -892,6 +894,7 @@ function clearResults() {
   state.functions = null;
   for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
   $("policy-tree").textContent = "";
+  $("policy-nodes").replaceChildren();
   $("policy-summary").textContent = "";
 }
 
@@ -1002,4 +1005,37 @@ function drawBelief(doc) {
       el("title", {}, bar).textContent = `${round(a, 2)}°: p = ${round(p, 4)}`;
     }
   });
+}
+
+// ---- the policy as a collapsible tree ---------------------------------------------------------
+
+function policyNode(node, first, unit) {
+  // an action node: <details> whose summary is the action and whose children are its readings
+  const d = document.createElement("details");
+  d.open = true;
+  d.className = "policy-node";
+  const act = node.action;
+  const sum = document.createElement("summary");
+  const a = round((act.alpha_rad * 180) / Math.PI, 2);
+  sum.textContent = first ? `${act.type} with the gripper at ${a}°` : `turn ${a}°, ${act.type}`;
+  d.appendChild(sum);
+  const ul = document.createElement("ul");
+  for (const b of node.branches) {
+    const li = document.createElement("li");
+    const [lo, hi] = b.reading;
+    const reads =
+      lo === null && hi === null ? "any width"
+      : lo === null ? `width below ${round(hi, 2)}${unit}`
+      : hi === null ? `width ${round(lo, 2)}${unit} or more`
+      : `width in [${round(lo, 2)}, ${round(hi, 2)})${unit}`;
+    const head = `${reads} (p = ${prob(b.probability)})`;
+    const n = b.next;
+    if (n.action) {
+      li.append(document.createTextNode(head + ":"), policyNode(n, false, unit));
+    } else if (n.reject) li.textContent = `${head}: reject`;
+    else li.textContent = `${head}: declare ${round((n.declare.orientation_rad * 180) / Math.PI, 2)}° (success ${round(n.success_probability, 3)})`;
+    ul.appendChild(li);
+  }
+  d.appendChild(ul);
+  return d;
 }
