@@ -469,6 +469,32 @@ def test_validation_messages_next_to_the_inputs(server: str, page: Any) -> None:
     assert page.locator(".field-error").count() == 0
 
 
+def test_payoff_reaches_the_plan_and_the_link(
+    server: str, page: Any, cli_json: CliJson, tmp_path: Path
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    page.wait_for_selector("#plans tbody tr")
+    page.fill("#payoff", "not json")
+    page.click("#plan")
+    page.wait_for_selector("#payoff-error")
+    assert "not valid JSON" in page.locator("#payoff-error").text_content()
+    _, exact = cli_json("plan", "key")
+    state = exact["options"][exact["bayes"]]["final_orientation_rad"]
+    deg = f"{math.degrees(state):.6f}"
+    pay = tmp_path / "payoff.json"
+    pay.write_text(json.dumps({"payoff": {deg: 1.0}, "default": 0.0}))
+    _, want = cli_json("plan", "key", "--payoff", str(pay))
+    page.fill("#payoff", json.dumps({deg: 1.0}))
+    page.click("#plan")
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#payoff-error").count() == 0
+    assert "payoff=" in page.url
+    other = page.context.new_page()
+    other.goto(page.url)
+    wait_rows(other, expected_rows(want))
+    other.close()
+
+
 def test_sensor_in_the_url_and_plan_count_wording(server: str, page: Any) -> None:
     page.goto(server + "/#part=house&prior=uniform&actions=squeeze&sense=width%3A0.5%2C0.1")
     page.wait_for_selector("#plans tbody tr")

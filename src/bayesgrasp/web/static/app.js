@@ -181,6 +181,14 @@ function noise() {
   const o = {};
   if ($("turn-kind").value) o.turn_noise = `${$("turn-kind").value}:${Number($("turn-deg").value)}`;
   if ($("contact-noise").value !== "") o.contact_noise = Number($("contact-noise").value);
+  const pay = $("payoff").value.trim();
+  if (pay) {
+    try {
+      o.payoff = { payoff: JSON.parse(pay), default: 0 };
+    } catch (err) {
+      /* validate() reports it */
+    }
+  }
   return o;
 }
 
@@ -207,6 +215,7 @@ function writeHash() {
   q.set("push_grasp_cost", $("cost-push-grasp").value);
   const n = noise();
   for (const k of ["turn_noise", "contact_noise"]) if (n[k] !== undefined) q.set(k, n[k]);
+  if ($("payoff").value.trim()) q.set("payoff", $("payoff").value.trim());
   q.set("sense", $("sense").value.trim() || "width");
   q.set("sense_depth", $("sense-depth").value);
   window.history.replaceState(null, "", "#" + q.toString());
@@ -249,6 +258,7 @@ async function readHash() {
   set("cost-squeeze", "squeeze_cost");
   set("cost-push-grasp", "push_grasp_cost");
   set("sense", "sense");
+  $("payoff").value = q.get("payoff") || "";
   set("sense-depth", "sense_depth");
   const [kind, turnDeg] = (q.get("turn_noise") || "").split(":");
   $("turn-kind").value = kind === "normal" || kind === "uniform" ? kind : "";
@@ -874,6 +884,19 @@ function validate() {
     fieldError("prior-mean", "");
     fieldError("prior-kappa", "");
   }
+  const pay = $("payoff").value.trim();
+  let payMsg = "";
+  if (pay) {
+    try {
+      const v = JSON.parse(pay);
+      if (typeof v !== "object" || v === null || Array.isArray(v)) payMsg = 'payoff: an object {"DEG": V, ...}';
+      else if (Object.values(v).some((x) => typeof x !== "number" || x < 0 || x > 1)) payMsg = "payoff: every value must be a number in [0, 1]";
+    } catch (err) {
+      payMsg = "payoff: not valid JSON";
+    }
+  }
+  fieldError("payoff", payMsg);
+  if (payMsg) ok = false;
   const acts = $("act-squeeze").checked || $("act-push-grasp").checked;
   fieldError("actions", acts ? "" : "choose at least one action");
   if (!acts) ok = false;
@@ -990,7 +1013,8 @@ function drawBelief(doc) {
     const W = 640, H = 120, L = 40, B = 26, T = 8;
     const svg = el("svg", { viewBox: `0 0 ${W} ${H}`, class: "chart belief", "data-step": k + 1 });
     const cap = document.createElement("figcaption");
-    cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°)`;
+    const exact = Object.keys(noise()).length ? ", the noise-free Bayes plan (the table's plan is noise-aware)" : "";
+    cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°${exact})`;
     const fig = document.createElement("figure");
     fig.append(cap, svg);
     box.appendChild(fig);
