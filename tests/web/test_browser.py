@@ -559,7 +559,8 @@ def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
         assert in_url in page.url, (in_url, page.url)
         # the figures show the same part and plan as the table
         page.wait_for_function(
-            "() => document.querySelectorAll('#belief svg.belief').length === "
+            "() => state.functions !== null && "
+            "document.querySelectorAll('#belief svg.belief').length === "
             f"{len(want['options'][want['bayes']]['steps'])}"
         )
         steps = page.evaluate("() => state.functions.plan.steps.map((s) => s.alpha_deg)")

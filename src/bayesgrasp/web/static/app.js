@@ -336,6 +336,8 @@ async function run() {
   const gen = ++generation;
   setStatus("planning...");
   $("output").classList.add("stale");
+  state.functions = null; // the figures follow the new plan, never show the previous one
+  $("belief").replaceChildren();
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
