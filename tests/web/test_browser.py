@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import socket
 import subprocess
 import sys
@@ -24,7 +25,7 @@ ARGS = [
     "--no-first-run",
 ]
 ROOT = Path(__file__).resolve().parents[2]
-SCREENSHOT = ROOT / "docs" / "figures" / "web.png"
+SCREENSHOT = ROOT / "docs" / "screenshots" / "web-plan.png"
 TRIANGLE_CLICKS = [(100, 300), (300, 300), (160, 120)]  # canvas pixels
 TRIANGLE = [[25.0, 25.0], [75.0, 25.0], [40.0, 70.0]]  # grid 20 px = 5 mm, y up
 
@@ -249,6 +250,7 @@ def test_draw_change_prior_share_and_play(
     assert ok >= 1
     assert outcomes(page) == library_outcomes(page, TRIANGLE, "vonmises:30,4")
     assert "oriented" in page.locator("#anim-status").text_content()
+    SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SCREENSHOT), full_page=True)
     assert SCREENSHOT.stat().st_size > 10_000
 
@@ -283,7 +285,25 @@ def test_catalogue_and_gallery(server: str, page: Any, cli_json: CliJson) -> Non
     _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
     wait_rows(page, expected_rows(want))
     assert page.locator("#catalogue").input_value() == "house"
+    # the catalogue part is drawn on the canvas, inside it
+    page.wait_for_selector("#given-part")
+    box = page.evaluate(
+        """() => { const b = document.getElementById('given-part').getBBox();
+                   return [b.x, b.y, b.x + b.width, b.y + b.height]; }"""
+    )
+    assert 0 <= box[0] < box[2] <= 400 and 0 <= box[1] < box[3] <= 400
+    # automatic plans are not in the gallery; a saved view is, and its link reproduces it
+    assert page.locator("#gallery li").count() == 0
+    page.click("#save")
     page.wait_for_function("document.querySelectorAll('#gallery li').length > 0")
+    assert page.locator("#gallery li svg.thumb polygon").count() == 1
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze&verify_cost=3")
+    _, key = cli_json("plan", "key", "--verify-cost", "3")
+    wait_rows(page, expected_rows(key))
+    page.click("#gallery li a")
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#catalogue").input_value() == "house"
+    assert "part=house" in page.url
 
 
 def test_noise_fields_reach_the_plan_and_the_link(
@@ -380,3 +400,175 @@ def test_sensing_policy_reads_as_the_cli(server: str, page: Any) -> None:
     page.fill("#sense", "width:-1,1")
     assert _policy_tree(page) == ""
     assert "sigma" in str(page.locator("#policy-summary.error").text_content())
+
+
+def test_curved_upload_round_trip_through_the_shared_url(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    """The uploaded file (not its hull) travels in the URL: the shared link plans the same."""
+    peanut = ROOT / "examples" / "peanut.svg"
+    code, want = cli_json("plan", str(peanut))
+    assert code == 0
+    bayes = want["options"][want["bayes"]]
+    assert bayes["squeezes"] == 1 and bayes["success_probability"] == pytest.approx(0.5)
+    assert bayes["expected_cost"] == pytest.approx(4.0)
+    page.goto(server + "/")
+    page.set_input_files("#file", str(peanut))
+    wait_rows(page, expected_rows(want))
+    assert "peanut.svg" in page.locator("#file-name").text_content()
+    shared = page.url
+    assert "file=" in shared and "format=svg" in shared and "v=" not in shared
+    other = page.context.new_page()
+    other.goto(shared)
+    wait_rows(other, expected_rows(want))
+    assert "peanut" in other.locator("#file-name").text_content()
+    # the figures: every function drawn, the belief of the last step at the final orientation
+    other.wait_for_selector("#belief svg.belief")
+    assert other.locator("#functions svg.chart").count() >= 2
+    mass = other.evaluate(
+        """() => [...document.querySelectorAll('#belief svg:last-of-type rect[fill="#2a9a2a"]')]
+            .reduce((a, r) => a + Number(r.dataset.p), 0)"""
+    )
+    assert mass == pytest.approx(bayes["success_probability"])
+    other.hover("#functions svg.chart")
+    assert "θ" in other.locator("#functions svg.chart .tip").first.text_content()
+    other.locator("#functions").screenshot(path=str(SCREENSHOT.with_name("web-functions.png")))
+    # the sensing policy plans the file too: its sensorless cost is the plan's
+    other.click("#policy")
+    other.wait_for_selector("body[data-policy=done]")
+    assert "sensorless Bayes plan 4.0000" in other.locator("#policy-summary").text_content()
+    assert other.locator("#policy-nodes details.policy-node").count() >= 1
+    other.locator("#policy-nodes").screenshot(path=str(SCREENSHOT.with_name("web-policy.png")))
+    # choosing a catalogue part forgets the file: its label and the URL follow
+    other.select_option("#catalogue", "house")
+    _, house = cli_json("plan", "house")
+    wait_rows(other, expected_rows(house))
+    assert other.locator("#file-name").text_content() == ""
+    assert "part=house" in other.url and "file=" not in other.url
+    other.close()
+
+
+def test_validation_messages_next_to_the_inputs(server: str, page: Any) -> None:
+    """An empty cost and no action are errors beside their inputs; old results are cleared."""
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze")
+    page.wait_for_selector("#plans tbody tr")
+    page.fill("#cost-verify", "")
+    page.click("#plan")
+    page.wait_for_selector("#cost-verify-error")
+    assert "verify cost" in page.locator("#cost-verify-error").text_content()
+    assert page.locator("#plans tbody tr").count() == 0
+    page.fill("#cost-verify", "1")
+    page.uncheck("#act-squeeze")
+    page.click("#plan")
+    page.wait_for_selector("#actions-error")
+    assert "at least one action" in page.locator("#actions-error").text_content()
+    assert page.locator("#cost-verify-error").count() == 0
+    page.check("#act-squeeze")
+    page.click("#plan")
+    page.wait_for_selector("#plans tbody tr")
+    assert page.locator(".field-error").count() == 0
+
+
+def test_payoff_reaches_the_plan_and_the_link(
+    server: str, page: Any, cli_json: CliJson, tmp_path: Path
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    page.wait_for_selector("#plans tbody tr")
+    page.fill("#payoff", "not json")
+    page.click("#plan")
+    page.wait_for_selector("#payoff-error")
+    assert "not valid JSON" in page.locator("#payoff-error").text_content()
+    _, exact = cli_json("plan", "key")
+    state = exact["options"][exact["bayes"]]["final_orientation_rad"]
+    deg = f"{math.degrees(state):.6f}"
+    pay = tmp_path / "payoff.json"
+    pay.write_text(json.dumps({"payoff": {deg: 1.0}, "default": 0.0}))
+    _, want = cli_json("plan", "key", "--payoff", str(pay))
+    page.fill("#payoff", json.dumps({deg: 1.0}))
+    page.click("#plan")
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#payoff-error").count() == 0
+    assert "payoff=" in page.url
+    other = page.context.new_page()
+    other.goto(page.url)
+    wait_rows(other, expected_rows(want))
+    other.close()
+
+
+def test_sensor_in_the_url_and_plan_count_wording(server: str, page: Any) -> None:
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze&sense=width%3A0.5%2C0.1")
+    page.wait_for_selector("#plans tbody tr")
+    assert page.locator("#sense").input_value() == "width:0.5,0.1"
+    assert "sense=width%3A0.5%2C0.1" in page.url
+    status = page.locator("#status").text_content()
+    n = page.locator("#plans tbody tr").count()
+    assert f"{n} plan" + ("" if n == 1 else "s") in status
+    assert "1 plans" not in status
+
+
+def test_no_horizontal_overflow_at_390_px(server: str, browser: Any) -> None:
+    context = browser.new_context(viewport={"width": 390, "height": 844})
+    pg = context.new_page()
+    try:
+        pg.goto(server + "/#part=house&prior=uniform&actions=squeeze")
+        pg.wait_for_selector("#plans tbody tr")
+        pg.click("#play")
+        pg.wait_for_selector("#anim[data-done=true]")
+        width = pg.evaluate("document.documentElement.scrollWidth")
+        assert width <= 390, width
+        pg.wait_for_selector("#belief svg.belief")
+        pg.screenshot(path=str(SCREENSHOT.with_name("web-phone.png")), full_page=True)
+        assert pg.evaluate("document.documentElement.scrollWidth") <= 390
+    finally:
+        context.close()
+
+
+MATRIX = [
+    # (what the test does on the page, the CLI options it means, what the URL then holds)
+    (("select", "#prior-kind", "vonmises"), ["--prior", "vonmises:0,4"], "prior=vonmises"),
+    (("fill", "#prior-mean", "30"), ["--prior", "vonmises:30,4"], "vonmises%3A30%2C4"),
+    (("fill", "#cost-verify", "3"), ["--verify-cost", "3"], "verify_cost=3"),
+    (("fill", "#cost-squeeze", "2"), ["--squeeze-cost", "2"], "squeeze_cost=2"),
+    (("fill", "#cost-retry", "0.5"), ["--retry-cost", "0.5"], "retry_cost=0.5"),
+    (("fill", "#accuracy", "2"), ["--accuracy", "2"], "accuracy=2"),
+    (("select", "#goal", "symmetry"), ["--goal", "symmetry"], "goal=symmetry"),
+    (("fill", "#max-actions", "2"), ["--max-actions", "2"], "max_actions=2"),
+    (("check", "#act-push-grasp", ""), ["--actions", "squeeze,push-grasp"], "push-grasp"),
+]
+
+
+def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
+    """Change each input in turn: the table, the URL and the figures' plan follow each time."""
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    _, want = cli_json("plan", "key")
+    wait_rows(page, expected_rows(want))
+    args: dict[str, list[str]] = {}
+    for (how, selector, value), cli, in_url in MATRIX:
+        if how == "select":
+            page.select_option(selector, value)
+        elif how == "fill":
+            page.fill(selector, value)
+        else:
+            page.check(selector)
+        page.click("#plan")
+        args[cli[0]] = cli
+        flat = [a for v in args.values() for a in v]
+        code, want = cli_json("plan", "key", *flat)
+        assert code == 0, (flat, want)
+        wait_rows(page, expected_rows(want))
+        assert in_url in page.url, (in_url, page.url)
+        # the figures show the same part and plan as the table
+        page.wait_for_function(
+            "() => state.functions !== null && "
+            "document.querySelectorAll('#belief svg.belief').length === "
+            f"{len(want['options'][want['bayes']]['steps'])}"
+        )
+        steps = page.evaluate("() => state.functions.plan.steps.map((s) => s.alpha_deg)")
+        bayes = want["options"][want["bayes"]]
+        assert steps == pytest.approx([math.degrees(s["alpha_rad"]) for s in bayes["steps"]])
+        # the shared link gives the same table in a fresh page
+        if in_url in ("goal=symmetry", "push-grasp"):
+            other = page.context.new_page()
+            other.goto(page.url)
+            wait_rows(other, expected_rows(want))
+            other.close()

@@ -54,6 +54,7 @@ except ImportError as exc:  # pragma: no cover - the extra is missing
     raise MissingExtraError(exc.name or "fastapi", "web") from None
 
 from ..errors import BayesGraspError, NoPlanError
+from . import views
 from .gallery import Gallery
 from .models import (
     ErrorBody,
@@ -1027,6 +1028,7 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
         rows = service.gallery.rows(limit) if service.gallery is not None else []
         return {"schema": "bayesgrasp.gallery/1", "rows": rows}
 
+    app.include_router(views.router)
     static = resources.files("bayesgrasp.web") / "static"
     index = Path(str(static)) / "index.html"
 

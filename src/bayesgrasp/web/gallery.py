@@ -33,6 +33,14 @@ CREATE TABLE IF NOT EXISTS parts (
     expected_cost REAL,
     squeezes INTEGER,
     updated REAL NOT NULL
+);
+CREATE TABLE IF NOT EXISTS saved (
+    key TEXT PRIMARY KEY,
+    name TEXT NOT NULL,
+    view TEXT NOT NULL,
+    outline TEXT NOT NULL,
+    summary TEXT NOT NULL,
+    saved REAL NOT NULL
 )
 """
 
@@ -82,7 +90,7 @@ class Gallery:
         self._lock = threading.Lock()
         with self._connect() as db:
             db.execute("PRAGMA journal_mode=WAL")  # readers do not wait for the writer
-            db.execute(_SCHEMA)
+            db.executescript(_SCHEMA)
 
     @contextlib.contextmanager
     def _connect(self) -> Iterator[sqlite3.Connection]:
@@ -147,6 +155,65 @@ class Gallery:
             }
             for key, name, verts, opts, p, c, k, t in found
         ]
+
+    def save(
+        self, name: str, view: str, outline: list[list[float]], summary: dict[str, Any]
+    ) -> str:
+        """Keep a view the user saved: its address fragment, outline and plan numbers.
+
+        ``view`` is the page's address fragment (the part and every option), so the entry
+        reproduces the view; saving the same view again only refreshes its time. Returns the
+        entry's id.
+
+        Examples
+        --------
+        >>> import tempfile
+        >>> g = Gallery(tempfile.mkdtemp())
+        >>> i = g.save("a", "part=house", [[0, 0], [1, 0], [0, 1]], {"expected_cost": 2.0})
+        >>> page = g.saved_page(1, 10)
+        >>> page["total"], page["rows"][0]["id"] == i, page["rows"][0]["view"]
+        (1, True, 'part=house')
+        """
+        key = hashlib.sha256(view.encode()).hexdigest()
+        row = (
+            key,
+            name[:80],
+            view,
+            json.dumps(outline, separators=(",", ":")),
+            json.dumps(summary, sort_keys=True, separators=(",", ":")),
+            time.time(),
+        )
+        with self._lock, self._connect() as db:
+            db.execute("INSERT OR REPLACE INTO saved VALUES (?, ?, ?, ?, ?, ?)", row)
+            db.execute(
+                "DELETE FROM saved WHERE key NOT IN "
+                "(SELECT key FROM saved ORDER BY saved DESC, rowid DESC LIMIT ?)",
+                (self.max_rows,),
+            )
+        return key[:16]
+
+    def saved_page(self, page: int, per_page: int) -> dict[str, Any]:
+        """One page (from 1) of the saved views, newest first, and how many there are."""
+        page, per_page = max(1, page), max(1, per_page)
+        with self._lock, self._connect() as db:
+            (total,) = db.execute("SELECT COUNT(*) FROM saved").fetchone()
+            found = db.execute(
+                "SELECT key, name, view, outline, summary, saved FROM saved "
+                "ORDER BY saved DESC, rowid DESC LIMIT ? OFFSET ?",
+                (per_page, (page - 1) * per_page),
+            ).fetchall()
+        rows = [
+            {
+                "id": key[:16],
+                "name": name,
+                "view": view,
+                "outline": json.loads(outline),
+                "summary": json.loads(summary),
+                "saved": t,
+            }
+            for key, name, view, outline, summary, t in found
+        ]
+        return {"page": page, "per_page": per_page, "total": int(total), "rows": rows}
 
     def __len__(self) -> int:
         with self._lock, self._connect() as db:

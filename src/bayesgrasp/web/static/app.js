@@ -79,6 +79,11 @@ function drawCanvas() {
     el("line", { x1: i, y1: 0, x2: i, y2: SIZE, class: "grid" }, svg);
     el("line", { x1: 0, y1: i, x2: SIZE, y2: i, class: "grid" }, svg);
   }
+  if ((state.catalogue || state.file) && state.outline && state.outline.length >= 3) {
+    // a catalogue or uploaded part, fitted to the canvas (it is not edited here)
+    const f = fit(state.outline, SIZE, 24);
+    el("polygon", { points: state.outline.map((p) => f(p).join(",")).join(" "), class: "poly", id: "given-part" }, svg);
+  }
   const pts = state.vertices.map((v) => toCanvas(v[0], v[1]));
   if (pts.length >= 2) el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "poly" }, svg);
   if (pts.length >= 3) {
@@ -94,7 +99,8 @@ function drawCanvas() {
       svg.setPointerCapture(evt.pointerId);
     });
   });
-  $("coords").value = state.vertices.map((v) => `${v[0]}, ${v[1]}`).join("\n");
+  const short = (x) => String(Number(x.toPrecision(6)));
+  $("coords").value = state.vertices.map((v) => `${short(v[0])}, ${short(v[1])}`).join("\n");
 }
 
 function setupCanvas() {
@@ -138,6 +144,7 @@ function setupCanvas() {
 }
 
 function useVertices(vertices, name) {
+  showFileName("");
   state.vertices = vertices;
   state.catalogue = "";
   state.file = null;
@@ -157,8 +164,8 @@ function options() {
   const actions = ["squeeze", "push-grasp"].filter((a) => $(`act-${a}`).checked);
   const o = {
     prior,
-    actions: actions.join(",") || "squeeze",
-    costs: { squeeze: Number($("cost-squeeze").value), "push-grasp": Number($("cost-push-grasp").value) },
+    actions: actions.join(","),
+    costs: Object.fromEntries(actions.map((a) => [a, Number($(`cost-${a}`).value)])),
     verify_cost: Number($("cost-verify").value),
     retry_cost: Number($("cost-retry").value),
     accuracy: Number($("accuracy").value),
@@ -174,6 +181,14 @@ function noise() {
   const o = {};
   if ($("turn-kind").value) o.turn_noise = `${$("turn-kind").value}:${Number($("turn-deg").value)}`;
   if ($("contact-noise").value !== "") o.contact_noise = Number($("contact-noise").value);
+  const pay = $("payoff").value.trim();
+  if (pay) {
+    try {
+      o.payoff = { payoff: JSON.parse(pay), default: 0 };
+    } catch (err) {
+      /* validate() reports it */
+    }
+  }
   return o;
 }
 
@@ -186,21 +201,41 @@ function partBody() {
 function writeHash() {
   const q = new URLSearchParams();
   if (state.catalogue) q.set("part", state.catalogue);
-  else if (state.vertices.length) q.set("v", state.vertices.map((v) => v.join(",")).join(";"));
+  else if (state.file && state.file.packed) {
+    q.set("file", state.file.packed);
+    q.set("format", state.file.format);
+    q.set("name", state.file.name);
+  } else if (state.vertices.length) q.set("v", state.vertices.map((v) => v.join(",")).join(";"));
   const o = options();
   q.set("prior", o.prior);
   q.set("actions", o.actions);
   for (const k of ["verify_cost", "retry_cost", "accuracy", "goal", "method", "max_actions"])
     if (o[k] !== undefined) q.set(k, o[k]);
-  q.set("squeeze_cost", o.costs.squeeze);
-  q.set("push_grasp_cost", o.costs["push-grasp"]);
+  q.set("squeeze_cost", $("cost-squeeze").value);
+  q.set("push_grasp_cost", $("cost-push-grasp").value);
   const n = noise();
   for (const k of ["turn_noise", "contact_noise"]) if (n[k] !== undefined) q.set(k, n[k]);
+  if ($("payoff").value.trim()) q.set("payoff", $("payoff").value.trim());
+  q.set("sense", $("sense").value.trim() || "width");
+  q.set("sense_depth", $("sense-depth").value);
   window.history.replaceState(null, "", "#" + q.toString());
 }
 
-function readHash() {
+async function readHash() {
   const q = new URLSearchParams(window.location.hash.slice(1));
+  if (q.has("file")) {
+    try {
+      const text = await unpack(q.get("file"));
+      const format = q.get("format") || "svg";
+      const name = q.get("name") || "part";
+      state.file = { format, data_base64: btoa(text), name, packed: q.get("file") };
+      state.catalogue = "";
+      state.vertices = [];
+      showFileName(`${name}.${format}`);
+    } catch (err) {
+      setStatus(`the file in the address cannot be read: ${err.message || err}`, true);
+    }
+  }
   const prior = q.get("prior") || "uniform";
   if (prior.startsWith("vonmises:")) {
     const [m, k] = prior.slice(9).split(",");
@@ -222,6 +257,9 @@ function readHash() {
   set("max-actions", "max_actions");
   set("cost-squeeze", "squeeze_cost");
   set("cost-push-grasp", "push_grasp_cost");
+  set("sense", "sense");
+  $("payoff").value = q.get("payoff") || "";
+  set("sense-depth", "sense_depth");
   const [kind, turnDeg] = (q.get("turn_noise") || "").split(":");
   $("turn-kind").value = kind === "normal" || kind === "uniform" ? kind : "";
   if ($("turn-kind").value) $("turn-deg").value = turnDeg;
@@ -230,9 +268,17 @@ function readHash() {
     state.catalogue = q.get("part");
     $("catalogue").value = state.catalogue;
     state.vertices = [];
+    state.file = null;
+    showFileName("");
+    const entry = (state.catalogueParts || []).find((p) => p.name === state.catalogue);
+    state.outline = entry ? entry.outline : null;
   } else if (q.get("v")) {
     state.vertices = q.get("v").split(";").map((s) => s.split(",").map(Number));
     state.name = "drawn";
+    state.catalogue = "";
+    state.file = null;
+    $("catalogue").value = "";
+    showFileName("");
   }
 }
 
@@ -282,9 +328,16 @@ async function run() {
     setStatus("add at least three vertices (or choose a part)");
     return;
   }
+  if (!validate()) {
+    clearResults();
+    return;
+  }
   writeHash();
   const gen = ++generation;
   setStatus("planning...");
+  $("output").classList.add("stale");
+  state.functions = null; // the figures follow the new plan, never show the previous one
+  $("belief").replaceChildren();
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
@@ -293,24 +346,23 @@ async function run() {
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
     if (gen !== generation) return;
+    $("output").classList.remove("stale");
     state.last = { plan, squeeze, push };
     if (state.file) {
-      // the uploaded part travels in the URL as its hull
-      state.vertices = plan.part.vertices;
-      state.file = null;
-      state.name = plan.part.name;
+      state.outline = plan.part.vertices; // the hull of the exact model
       drawCanvas();
-      writeHash();
     }
     drawHull(plan.part);
     drawDiameter(plan.part, squeeze);
     drawTable(plan);
     drawAnimationFrame(0);
-    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${plan.options.length} plans`);
+    loadFunctions(part, o, gen);
+    const n = plan.options.length;
+    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${n} ${n === 1 ? "plan" : "plans"}`);
     document.body.dataset.planned = String(gen);
-    loadGallery();
   } catch (err) {
     if (gen !== generation) return;
+    clearResults();
     setStatus(String(err.message || err), true);
     document.body.dataset.planned = "error";
   }
@@ -500,6 +552,7 @@ function play() {
 }
 
 async function showFigures() {
+  if (!validate()) return;
   const body = { part: partBody(), ...options() };
   for (const name of ["transfer", "plan"]) {
     const r = await fetch(`${API}/figures/${name}.svg`, {
@@ -578,10 +631,12 @@ function policyLines(node, depth, first, unit, lines) {
 }
 
 async function showPolicy() {
+  if (!validate()) return;
   const o = options();
   const body = { part: partBody(), ...o, sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
   $("policy-summary").textContent = "planning the policy...";
   $("policy-tree").textContent = "";
+  $("policy-nodes").replaceChildren();
   try {
     const doc = await post("/policy", body);
     state.policyParts = doc.parts.length;
@@ -589,6 +644,7 @@ async function showPolicy() {
     const last = state.last && state.last.plan ? state.last.plan.part : null;
     const units = last && last.name === doc.parts[0] ? last.units : null;
     $("policy-tree").textContent = policyLines(doc.root, 0, true, units ? ` ${units}` : "", []).join("\n");
+    $("policy-nodes").replaceChildren(policyNode(doc.root, true, units ? ` ${units}` : ""));
     const blind = doc.sensorless_cost === null ? "" : ` (sensorless Bayes plan ${doc.sensorless_cost.toFixed(4)})`;
     $("policy-summary").textContent =
       `expected cost ${doc.expected_cost.toFixed(4)}${blind}, success ${doc.success_probability.toFixed(4)} a cycle, ` +
@@ -614,6 +670,12 @@ async function loadCatalogue() {
     $("catalogue").appendChild(o);
   }
   $("catalogue").value = state.catalogue;
+  state.catalogueParts = doc.parts;
+  const given = doc.parts.find((p) => p.name === state.catalogue);
+  if (given) {
+    state.outline = given.outline;
+    drawCanvas();
+  }
   $("catalogue").addEventListener("change", () => {
     const name = $("catalogue").value;
     if (!name) return;
@@ -621,9 +683,10 @@ async function loadCatalogue() {
     undoStack.push(state.vertices.map((v) => v.slice()));
     state.catalogue = name;
     state.file = null;
+    showFileName("");
     state.vertices = [];
-    drawCanvas();
     state.outline = entry.outline;
+    drawCanvas();
     schedule();
   });
 }
@@ -638,31 +701,79 @@ function setupFile() {
     for (let i = 0; i < bytes.length; i += 0x8000) bin += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
     state.catalogue = "";
     state.vertices = [];
-    state.file = { format: ext, data_base64: btoa(bin), name: f.name.replace(/\.[^.]*$/, "").replace(/[^A-Za-z0-9_. -]/g, "_").slice(0, 64) || "part" };
+    const name = f.name.replace(/\.[^.]*$/, "").replace(/[^A-Za-z0-9_. -]/g, "_").slice(0, 64) || "part";
+    state.file = { format: ext, data_base64: btoa(bin), name, packed: await pack(bin) };
+    state.outline = null;
+    $("catalogue").value = "";
+    drawCanvas();
+    showFileName(f.name);
     schedule();
   });
 }
 
-async function loadGallery() {
+let galleryPage = 1;
+const PER_PAGE = 8;
+
+function thumbnail(outline) {
+  const svg = el("svg", { viewBox: "0 0 64 64", width: 64, height: 64, class: "thumb" });
+  if (outline.length >= 3) {
+    const f = fit(outline, 64, 4);
+    el("polygon", { points: outline.map((p) => f(p).join(",")).join(" "), class: "poly" }, svg);
+  }
+  return svg;
+}
+
+async function loadGallery(page) {
+  if (page) galleryPage = page;
   try {
-    const r = await fetch(API + "/gallery?limit=20");
+    const r = await fetch(`${API}/saved?page=${galleryPage}&per_page=${PER_PAGE}`);
     const doc = await r.json();
     const ul = $("gallery");
     ul.replaceChildren();
     for (const row of doc.rows) {
       const li = document.createElement("li");
       const a = document.createElement("a");
-      const q = new URLSearchParams();
-      q.set("v", row.vertices.map((v) => v.join(",")).join(";"));
-      for (const [k, v] of Object.entries(row.options)) if (typeof v !== "object") q.set(k, v);
-      a.href = "#" + q.toString();
-      a.textContent = `${row.name}: ${row.squeezes} actions, p = ${row.success_probability === null ? "-" : row.success_probability.toFixed(3)}`;
-      a.addEventListener("click", () => setTimeout(() => { readHash(); drawCanvas(); schedule(); }, 0));
+      a.href = "#" + row.view;
+      a.appendChild(thumbnail(row.outline));
+      const s = row.summary || {};
+      const n = s.actions;
+      const text = document.createElement("span");
+      text.textContent = `${row.name}: ${n === undefined ? "" : `${n} ${n === 1 ? "action" : "actions"}, `}` +
+        `p = ${s.success_probability == null ? "-" : s.success_probability.toFixed(3)}, ` +
+        `cost ${s.expected_cost == null ? "-" : s.expected_cost.toFixed(3)}`;
+      a.appendChild(text);
       li.appendChild(a);
       ul.appendChild(li);
     }
+    const pages = Math.max(1, Math.ceil(doc.total / PER_PAGE));
+    $("gallery-page").textContent = doc.total ? `page ${galleryPage} of ${pages} (${doc.total} saved)` : "nothing saved yet";
+    $("gallery-prev").disabled = galleryPage <= 1;
+    $("gallery-next").disabled = galleryPage >= pages;
   } catch (err) {
     /* the gallery is optional */
+  }
+}
+
+async function saveView() {
+  if (!state.last) {
+    setStatus("plan a part before saving it", true);
+    return;
+  }
+  const { plan } = state.last;
+  const o = plan.options[plan.bayes];
+  const outline = state.vertices.length >= 3 ? state.vertices : state.outline || plan.part.vertices;
+  const body = {
+    name: plan.part.name,
+    view: window.location.hash.slice(1),
+    outline,
+    summary: { actions: o.steps.length, success_probability: o.success_probability, expected_cost: o.expected_cost },
+  };
+  try {
+    await post("/saved", body);
+    setStatus(`saved ${plan.part.name} to the gallery`);
+    loadGallery(1);
+  } catch (err) {
+    setStatus(String(err.message || err), true);
   }
 }
 
@@ -671,18 +782,286 @@ async function loadGallery() {
 function start() {
   setupCanvas();
   setupFile();
-  readHash();
+  const ready = readHash();
   drawCanvas();
   $("plan").addEventListener("click", run);
   $("play").addEventListener("click", play);
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
+  $("save").addEventListener("click", saveView);
+  $("gallery-prev").addEventListener("click", () => loadGallery(galleryPage - 1));
+  $("gallery-next").addEventListener("click", () => loadGallery(galleryPage + 1));
   $("options").addEventListener("change", schedule);
-  window.addEventListener("hashchange", () => { readHash(); drawCanvas(); schedule(); });
-  loadCatalogue().then(() => {
-    if (state.catalogue || state.vertices.length >= 3) run();
+  window.addEventListener("hashchange", async () => { await readHash(); drawCanvas(); schedule(); });
+  Promise.all([ready, loadCatalogue()]).then(() => {
+    if (state.catalogue || state.file || state.vertices.length >= 3) run();
   });
   loadGallery();
 }
 
 start();
+
+// ---- the uploaded file in the URL: deflate-raw, base64url ------------------------------------
+
+function toBase64Url(bin) {
+  return btoa(bin).replace(/\+/g, "-").replace(/\//g, "_").replace(/=+$/, "");
+}
+
+function fromBase64Url(s) {
+  const b = s.replace(/-/g, "+").replace(/_/g, "/");
+  return atob(b + "===".slice((b.length + 3) % 4));
+}
+
+async function pack(bin) {
+  // a binary string (the file's bytes) compressed for the address bar
+  const bytes = Uint8Array.from(bin, (c) => c.charCodeAt(0));
+  const stream = new Blob([bytes]).stream().pipeThrough(new CompressionStream("deflate-raw"));
+  const out = new Uint8Array(await new Response(stream).arrayBuffer());
+  let s = "";
+  for (let i = 0; i < out.length; i += 0x8000) s += String.fromCharCode.apply(null, out.subarray(i, i + 0x8000));
+  return toBase64Url(s);
+}
+
+async function unpack(packed) {
+  const bytes = Uint8Array.from(fromBase64Url(packed), (c) => c.charCodeAt(0));
+  const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate-raw"));
+  const out = new Uint8Array(await new Response(stream).arrayBuffer());
+  let s = "";
+  for (let i = 0; i < out.length; i += 0x8000) s += String.fromCharCode.apply(null, out.subarray(i, i + 0x8000));
+  return s;
+}
+
+function showFileName(text) {
+  $("file-name").textContent = text ? `current file: ${text}` : "";
+  if (!text) $("file").value = "";
+}
+
+// ---- validation: each message next to the input that caused it -------------------------------
+
+function fieldError(id, message) {
+  const input = $(id);
+  let span = document.getElementById(`${id}-error`);
+  if (!message) {
+    input.removeAttribute("aria-invalid");
+    if (span) span.remove();
+    return;
+  }
+  input.setAttribute("aria-invalid", "true");
+  if (!span) {
+    span = document.createElement("span");
+    span.id = `${id}-error`;
+    span.className = "field-error";
+    span.setAttribute("role", "alert");
+    const anchor = input.closest("label, fieldset") || input;
+    anchor.insertAdjacentElement("afterend", span);
+  }
+  span.textContent = message;
+}
+
+function validate() {
+  let ok = true;
+  const number = (id, what, lo, hi, required) => {
+    const raw = $(id).value.trim();
+    let msg = "";
+    if (raw === "") msg = required ? `${what}: enter a number` : "";
+    else if (!Number.isFinite(Number(raw))) msg = `${what}: not a number`;
+    else if (Number(raw) < lo) msg = `${what}: must be at least ${lo}`;
+    else if (hi !== undefined && Number(raw) > hi) msg = `${what}: must be at most ${hi}`;
+    fieldError(id, msg);
+    if (msg) ok = false;
+  };
+  number("cost-squeeze", "squeeze cost", 0, undefined, $("act-squeeze").checked);
+  number("cost-push-grasp", "push-grasp cost", 0, undefined, $("act-push-grasp").checked);
+  number("cost-verify", "verify cost", 0, undefined, true);
+  number("cost-retry", "retry cost", 0, undefined, true);
+  number("accuracy", "accuracy", 0, 180, true);
+  number("max-actions", "max actions", 1, 1000, false);
+  number("contact-noise", "contact noise", 0, 1, false);
+  if ($("turn-kind").value) number("turn-deg", "turn error", 0, undefined, true);
+  else fieldError("turn-deg", "");
+  if ($("prior-kind").value === "vonmises") {
+    number("prior-mean", "mean", -360, 360, true);
+    number("prior-kappa", "kappa", 0, undefined, true);
+  } else {
+    fieldError("prior-mean", "");
+    fieldError("prior-kappa", "");
+  }
+  const pay = $("payoff").value.trim();
+  let payMsg = "";
+  if (pay) {
+    try {
+      const v = JSON.parse(pay);
+      if (typeof v !== "object" || v === null || Array.isArray(v)) payMsg = 'payoff: an object {"DEG": V, ...}';
+      else if (Object.values(v).some((x) => typeof x !== "number" || x < 0 || x > 1)) payMsg = "payoff: every value must be a number in [0, 1]";
+    } catch (err) {
+      payMsg = "payoff: not valid JSON";
+    }
+  }
+  fieldError("payoff", payMsg);
+  if (payMsg) ok = false;
+  const acts = $("act-squeeze").checked || $("act-push-grasp").checked;
+  fieldError("actions", acts ? "" : "choose at least one action");
+  if (!acts) ok = false;
+  if (!ok) setStatus("fix the marked inputs", true);
+  return ok;
+}
+
+function clearResults() {
+  state.last = null;
+  $("output").classList.remove("stale");
+  $("plans").querySelector("tbody").replaceChildren();
+  $("hull").replaceChildren();
+  $("diameter").replaceChildren();
+  $("anim").replaceChildren();
+  $("anim-status").textContent = "";
+  $("functions").replaceChildren();
+  $("belief").replaceChildren();
+  state.functions = null;
+  for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
+  $("policy-tree").textContent = "";
+  $("policy-nodes").replaceChildren();
+  $("policy-summary").textContent = "";
+}
+
+// ---- interactive figures drawn from the JSON of /views/functions ---------------------------
+
+const round = (x, d) => String(Number(x.toFixed(d)));
+
+function chart(svg, xs, ys, opts) {
+  // a line chart with hover values; the wheel zooms the angle axis, a double click resets it
+  const W = 640, H = 260, L = 56, R = 12, T = 12, B = 34;
+  let lo = opts.lo === undefined ? xs[0] : opts.lo, hi = opts.hi === undefined ? xs[xs.length - 1] : opts.hi;
+  const draw = () => {
+    svg.replaceChildren();
+    svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+    const keep = xs.map((x, i) => i).filter((i) => xs[i] >= lo && xs[i] <= hi);
+    const vals = keep.map((i) => ys[i]);
+    let y0 = Math.min(...vals), y1 = Math.max(...vals);
+    if (opts.angle) { y0 = 0; y1 = 360; }
+    if (y1 - y0 < 1e-9) { y0 -= 1; y1 += 1; }
+    const X = (x) => L + ((W - L - R) * (x - lo)) / (hi - lo);
+    const Y = (y) => H - B - ((H - T - B) * (y - y0)) / (y1 - y0);
+    el("rect", { x: L, y: T, width: W - L - R, height: H - T - B, fill: "#fff", stroke: "#ccc" }, svg);
+    for (let k = 0; k <= 4; k++) {
+      const xv = lo + ((hi - lo) * k) / 4, yv = y0 + ((y1 - y0) * k) / 4;
+      el("text", { x: X(xv), y: H - 14, "text-anchor": "middle", "font-size": 13 }, svg).textContent = round(xv, 1);
+      el("text", { x: L - 4, y: Y(yv) + 4, "text-anchor": "end", "font-size": 13 }, svg).textContent = round(yv, opts.angle ? 0 : 2);
+    }
+    el("text", { x: W / 2, y: H - 1, "text-anchor": "middle", "font-size": 13 }, svg).textContent = `${opts.x} (deg)`;
+    const d = keep.map((i, k) => `${k ? "L" : "M"}${X(xs[i]).toFixed(1)},${Y(ys[i]).toFixed(1)}`).join("");
+    el("path", { d, fill: "none", stroke: "#2f4b6e", "stroke-width": 2, class: "curve" }, svg);
+    const dot = el("circle", { r: 4, fill: "#d62728", visibility: "hidden" }, svg);
+    const tip = el("text", { x: L + 6, y: T + 16, "font-size": 14, class: "tip" }, svg);
+    svg.onmousemove = (evt) => {
+      const r = svg.getBoundingClientRect();
+      const px = ((evt.clientX - r.left) * W) / r.width;
+      const x = lo + ((px - L) * (hi - lo)) / (W - L - R);
+      let best = keep[0];
+      for (const i of keep) if (Math.abs(xs[i] - x) < Math.abs(xs[best] - x)) best = i;
+      dot.setAttribute("cx", X(xs[best]));
+      dot.setAttribute("cy", Y(ys[best]));
+      dot.setAttribute("visibility", "visible");
+      tip.textContent = `${opts.x} ${round(xs[best], 2)}°: ${opts.y} ${round(ys[best], opts.angle ? 2 : 3)}${opts.angle ? "°" : ""}`;
+    };
+  };
+  svg.onwheel = (evt) => {
+    evt.preventDefault();
+    const mid = (lo + hi) / 2, half = ((hi - lo) / 2) * (evt.deltaY > 0 ? 1.25 : 0.8);
+    lo = Math.max(xs[0], mid - half);
+    hi = Math.min(xs[xs.length - 1], mid + half);
+    draw();
+  };
+  svg.ondblclick = () => { lo = xs[0]; hi = xs[xs.length - 1]; draw(); };
+  draw();
+}
+
+const FUNCTION_NAMES = {
+  diameter: ["diameter d(θ)", false],
+  squeeze: ["squeeze s(θ)", true],
+  radius: ["radius r(θ)", false],
+  push: ["push p(θ)", true],
+  push_grasp: ["push-grasp g(θ)", true],
+};
+
+async function loadFunctions(part, o, gen) {
+  try {
+    const doc = await post("/views/functions", { part, ...o });
+    if (gen !== generation) return;
+    state.functions = doc;
+    const box = $("functions");
+    box.replaceChildren();
+    for (const [key, [label, angle]] of Object.entries(FUNCTION_NAMES)) {
+      if (!doc.functions[key]) continue;
+      const fig = document.createElement("figure");
+      const cap = document.createElement("figcaption");
+      cap.textContent = label;
+      const svg = el("svg", { class: "chart", "data-function": key, role: "img", "aria-label": label });
+      fig.append(cap, svg);
+      box.appendChild(fig);
+      chart(svg, doc.theta_deg, doc.functions[key], { x: "θ", y: label.split(" ")[0], angle });
+    }
+    drawBelief(doc);
+  } catch (err) {
+    if (gen === generation) $("functions").textContent = String(err.message || err);
+  }
+}
+
+function drawBelief(doc) {
+  // one bar chart a step: the probability of each orientation after the step
+  const box = $("belief");
+  box.replaceChildren();
+  doc.belief.forEach((atoms, k) => {
+    const st = doc.plan.steps[k];
+    const W = 640, H = 120, L = 40, B = 26, T = 8;
+    const svg = el("svg", { viewBox: `0 0 ${W} ${H}`, class: "chart belief", "data-step": k + 1 });
+    const cap = document.createElement("figcaption");
+    const exact = Object.keys(noise()).length ? ", the noise-free Bayes plan (the table's plan is noise-aware)" : "";
+    cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°${exact})`;
+    const fig = document.createElement("figure");
+    fig.append(cap, svg);
+    box.appendChild(fig);
+    const X = (a) => L + ((W - L - 10) * (((a % 360) + 360) % 360)) / 360;
+    el("line", { x1: L, y1: H - B, x2: W - 10, y2: H - B, stroke: "#555" }, svg);
+    for (let a = 0; a <= 360; a += 90)
+      el("text", { x: X(a === 360 ? 359.999 : a), y: H - 8, "text-anchor": "middle", "font-size": 13 }, svg).textContent = `${a}`;
+    for (const { orientation_deg: a, probability: p } of atoms) {
+      const h = (H - B - T) * p;
+      const goal = Math.abs(((a - doc.plan.final_deg + 540) % 360) - 180) < 1e-6 && k === doc.belief.length - 1;
+      const bar = el("rect", { x: X(a) - 4, y: H - B - h, width: 8, height: Math.max(h, 0.5), fill: goal ? "#2a9a2a" : "#2f4b6e", "data-p": p }, svg);
+      el("title", {}, bar).textContent = `${round(a, 2)}°: p = ${round(p, 4)}`;
+    }
+  });
+}
+
+// ---- the policy as a collapsible tree ---------------------------------------------------------
+
+function policyNode(node, first, unit) {
+  // an action node: <details> whose summary is the action and whose children are its readings
+  const d = document.createElement("details");
+  d.open = true;
+  d.className = "policy-node";
+  const act = node.action;
+  const sum = document.createElement("summary");
+  const a = round((act.alpha_rad * 180) / Math.PI, 2);
+  sum.textContent = first ? `${act.type} with the gripper at ${a}°` : `turn ${a}°, ${act.type}`;
+  d.appendChild(sum);
+  const ul = document.createElement("ul");
+  for (const b of node.branches) {
+    const li = document.createElement("li");
+    const [lo, hi] = b.reading;
+    const reads =
+      lo === null && hi === null ? "any width"
+      : lo === null ? `width below ${round(hi, 2)}${unit}`
+      : hi === null ? `width ${round(lo, 2)}${unit} or more`
+      : `width in [${round(lo, 2)}, ${round(hi, 2)})${unit}`;
+    const head = `${reads} (p = ${prob(b.probability)})`;
+    const n = b.next;
+    if (n.action) {
+      li.append(document.createTextNode(head + ":"), policyNode(n, false, unit));
+    } else if (n.reject) li.textContent = `${head}: reject`;
+    else li.textContent = `${head}: declare ${round((n.declare.orientation_rad * 180) / Math.PI, 2)}° (success ${round(n.success_probability, 3)})`;
+    ul.appendChild(li);
+  }
+  d.appendChild(ul);
+  return d;
+}
