@@ -57,6 +57,7 @@ from ..errors import BayesGraspError, NoPlanError
 from . import views
 from .gallery import Gallery
 from .models import (
+    ERRORS,
     ErrorBody,
     FigureRequest,
     PartIn,
@@ -728,6 +729,7 @@ WORK: dict[str, Callable[..., Any]] = {
     "policy": policy_document_of,
     "simulate": simulate_document,
     "figure": figure_bytes,
+    "functions": lambda service, req: views.function_samples(service, req),
 }
 
 
@@ -760,22 +762,6 @@ def lane_of(name: str, req: Any) -> LaneName:
     return "figures" if name == "figure" else "quick"
 
 
-ERRORS: dict[int | str, dict[str, Any]] = {
-    413: {"model": ErrorBody, "description": "The request body is over the server's limit."},
-    422: {
-        "model": ErrorBody,
-        "description": "Bad input or over a limit of the request (vertices, trials, "
-        "timeout): `detail` is the command line's one-line message.",
-    },
-    503: {
-        "model": ErrorBody,
-        "description": "The queue is full, the work timed out (its worker was stopped) or "
-        "reached the worker's memory limit; a `Retry-After` header says when to try again.",
-        "headers": {
-            "Retry-After": {"description": "Seconds to wait.", "schema": {"type": "integer"}}
-        },
-    },
-}
 TIMEOUT = Query(
     None,
     ge=0.01,

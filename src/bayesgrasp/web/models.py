@@ -350,3 +350,22 @@ class ErrorBody(BaseModel):
         "memory-limit, body-too-large, http, or the name of the library's error."
     )
     status: int = Field(description="The HTTP status again.")
+
+
+#: The error answers every POST (and every endpoint with parameters) declares.
+ERRORS: dict[int | str, dict[str, Any]] = {
+    413: {"model": ErrorBody, "description": "The request body is over the server's limit."},
+    422: {
+        "model": ErrorBody,
+        "description": "Bad input or over a limit of the request (vertices, trials, "
+        "timeout): `detail` is the command line's one-line message.",
+    },
+    503: {
+        "model": ErrorBody,
+        "description": "The queue is full, the work timed out (its worker was stopped) or "
+        "reached the worker's memory limit; a `Retry-After` header says when to try again.",
+        "headers": {
+            "Retry-After": {"description": "Seconds to wait.", "schema": {"type": "integer"}}
+        },
+    },
+}

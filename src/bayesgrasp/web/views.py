@@ -18,7 +18,7 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field
 
-from .models import FigureRequest
+from .models import ERRORS, FigureRequest
 
 __all__ = ["SaveRequest", "belief_steps", "function_samples", "router"]
 
@@ -47,7 +47,7 @@ def _no_gallery() -> JSONResponse:
     )
 
 
-@router.post("/saved")
+@router.post("/saved", responses=ERRORS)
 async def save(req: SaveRequest, request: Request) -> Any:
     """Save a view to the gallery (saving it again refreshes its time)."""
     gallery = request.app.state.service.gallery
@@ -57,7 +57,7 @@ async def save(req: SaveRequest, request: Request) -> Any:
     return {"id": key}
 
 
-@router.get("/saved")
+@router.get("/saved", responses=ERRORS)
 async def saved(
     request: Request,
     page: Annotated[int, Query(ge=1, le=100_000)] = 1,
@@ -168,8 +168,8 @@ def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str
     }
 
 
-@router.post("/views/functions")
+@router.post("/views/functions", responses=ERRORS)
 async def functions(req: FigureRequest, request: Request) -> Any:
     """The part's functions sampled over a turn and the belief after each step of the plan."""
     service = request.app.state.service
-    return await service.run(lambda: function_samples(service, req))
+    return await service.answer("functions", req)  # in a worker of the quick lane
