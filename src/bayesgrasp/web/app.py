@@ -440,7 +440,7 @@ def build_problem(part: Part, opts: ProblemOptions, spec: Any) -> Problem:
     )
 
 
-def _chosen(
+def chosen_option(
     which: str, opts: ProblemOptions, part: Part, spec: Any
 ) -> tuple[Problem, PlanOption, str]:
     """The problem and the plan ``which`` names (as ``--plan`` does)."""
@@ -620,7 +620,7 @@ def simulate_document(
         res_n = plan_noisy(pb, noise, pay, spec.max_actions)
         option = res_n.options[res_n.bayes if req.plan == "bayes" else res_n.most_certain].option
     else:
-        pb, option, _ = _chosen(req.plan, req, p, spec)
+        pb, option, _ = chosen_option(req.plan, req, p, spec)
     u = None if pay is None else as_vector(pay, pb.states)
     if engine == "mujoco":
         res = _mujoco(pb, option, trials, noise, req.seed, offset_mm, u, progress)
@@ -684,7 +684,7 @@ def figure_bytes(service: Service, req: FigureRequest, name: str, fmt: str) -> b
 
     spec = problem_spec(req)
     p = service.part(req.part)
-    pb, option, label = _chosen(req.plan, req, p, spec)
+    pb, option, label = chosen_option(req.plan, req, p, spec)
     with service.figure_lock:  # matplotlib's font cache and text engine are shared
         if name == "part":
             fig = part_figure(pb.part)

@@ -123,11 +123,11 @@ def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str
 
     from ..errors import BayesGraspError
     from ..geometry.curved import CurvedPart, curved_radius, push_model, squeeze_model
-    from .app import _chosen, problem_spec
+    from .app import chosen_option, problem_spec
 
     spec = problem_spec(req)
     part = service.part(req.part)
-    pb, option, label = _chosen(req.plan, req, part, spec)
+    pb, option, label = chosen_option(req.plan, req, part, spec)
     theta = np.linspace(0.0, 2 * math.pi, n)
     deg = np.degrees
 
