@@ -109,3 +109,25 @@ def test_progress_reports_the_seconds_of_the_time_bound() -> None:
     assert calls and all(total == 30 and 0 <= used <= 30 for used, total in calls)
     plan_policy(HOUSE, "width", 2, time_limit_s=None, progress=lambda *a: calls.append((-1, -1)))
     assert (-1, -1) not in calls  # no time bound: nothing to show
+
+
+@pytest.mark.parametrize(
+    "noise", [["--turn-noise", "normal:2"], ["--contact-noise", "0.1"]], ids=["turn", "contact"]
+)
+@pytest.mark.parametrize("command", ["plan", "simulate", "plot"])
+def test_the_time_bound_is_refused_where_it_cannot_apply(
+    command: str, noise: list[str], capsys: pytest.CaptureFixture[str], tmp_path
+) -> None:
+    # The noise-aware policy search has the memory bound only: the option is not ignored.
+    argv = [command, "house", "--sense", "width", *noise, "--time-limit", "5"]
+    argv += ["--out", str(tmp_path / "f")] if command == "plot" else []
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--time-limit" in err and "bounded by --max-memory" in err
+
+
+def test_solve_refuses_a_time_bound_under_noise() -> None:
+    from bayesgrasp.planning.strategy import solve
+
+    with pytest.raises(PlanningError, match="`time_limit_s` bounds the exact policy search"):
+        solve(HOUSE, sensor="width", noise=NoiseModel(TurnNoise("normal", 0.03)), time_limit_s=5)

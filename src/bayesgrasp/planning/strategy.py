@@ -911,6 +911,11 @@ def solve(
         else:
             from .noisy_policy import plan_noisy_policy
 
+            if time_limit_s is not None:
+                raise PlanningError(
+                    "`time_limit_s` bounds the exact policy search; a policy under noisy actions "
+                    "or a payoff is bounded by `max_memory_mb`"
+                )
             if payoff is not None and len(pbs) > 1:
                 raise PlanningError("a payoff is for one part")
             pol = plan_noisy_policy(
