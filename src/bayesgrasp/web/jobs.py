@@ -114,6 +114,10 @@ class Jobs:
                 job.result = await run(job)
                 job.done = job.total
                 job.status = "done"
+            except asyncio.CancelledError:  # the server stops: the job ends, failed
+                job.error = {"status": 503, "error": "worker-stopped", "detail": "cancelled"}
+                job.status = "failed"
+                raise
             except Exception as exc:
                 status, kind, reason = failure_of(exc)
                 job.error = {"status": status, "error": kind, "detail": reason}
