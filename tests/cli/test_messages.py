@@ -194,3 +194,8 @@ def test_a_huge_part_reports_only_what_a_user_reads(
     assert len(full["options"]) > short
     best = full["options"][full["bayes"]]
     assert doc["options"][doc["bayes"]]["expected_cost"] == pytest.approx(best["expected_cost"])
+
+
+def test_the_von_mises_mean_is_echoed_in_degrees(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "plan", "house", "--prior", "vonmises:30,-1")
+    assert code == 2 and "mean 30 deg, kappa -1" in err

@@ -246,7 +246,10 @@ def von_mises(mean: float, kappa: float, bins: int = 3600) -> HistogramPrior:
         if isinstance(v, bool) or not isinstance(v, int | float | np.floating | np.integer):
             raise PriorError(f"von Mises `{name}` must be a number; got {v!r}")
     if not (math.isfinite(mean) and math.isfinite(kappa)) or kappa < 0:
-        raise PriorError(f"von Mises needs a finite mean and kappa >= 0; got {mean}, {kappa}")
+        shown = f"{math.degrees(mean):g} deg" if math.isfinite(mean) else f"{mean}"
+        raise PriorError(
+            f"von Mises needs a finite mean and kappa >= 0; got mean {shown}, kappa {kappa:g}"
+        )
     name = f"von-mises({math.degrees(mean):g}deg,{kappa:g})"  # people read degrees
     hist = DensityPrior(lambda t: np.exp(kappa * (np.cos(t - mean) - 1.0)), bins, name)
     recipe = (("kind", "von-mises"), ("mean_rad", float(mean)), ("kappa", float(kappa)))
