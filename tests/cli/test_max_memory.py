@@ -115,19 +115,23 @@ def test_progress_reports_the_seconds_of_the_time_bound() -> None:
     "noise", [["--turn-noise", "normal:2"], ["--contact-noise", "0.1"]], ids=["turn", "contact"]
 )
 @pytest.mark.parametrize("command", ["plan", "simulate", "plot"])
-def test_the_time_bound_is_refused_where_it_cannot_apply(
+def test_the_time_bound_holds_under_noise(
     command: str, noise: list[str], capsys: pytest.CaptureFixture[str], tmp_path
 ) -> None:
-    # The noise-aware policy search has the memory bound only: the option is not ignored.
-    argv = [command, "house", "--sense", "width", *noise, "--time-limit", "5"]
+    # The noise-aware policy search keeps the time bound too: past it, one line.
+    argv = [command, "house", "--sense", "width:0.5,0.1", *noise, "--time-limit", "0.001"]
     argv += ["--out", str(tmp_path / "f")] if command == "plot" else []
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert "--time-limit" in err and "bounded by --max-memory" in err
+    assert "the policy search stopped: it ran for 0.001 s" in err
+    assert len(err.strip().splitlines()) == 1
 
 
-def test_solve_refuses_a_time_bound_under_noise() -> None:
+def test_solve_passes_the_time_bound_to_the_noisy_policy_search() -> None:
     from bayesgrasp.planning.strategy import solve
 
-    with pytest.raises(PlanningError, match="`time_limit_s` bounds the exact policy search"):
-        solve(HOUSE, sensor="width", noise=NoiseModel(TurnNoise("normal", 0.03)), time_limit_s=5)
+    noise = NoiseModel(TurnNoise("normal", 0.03))
+    with pytest.raises(SearchStopped, match="ran for 1e-06 s"):
+        solve(HOUSE, sensor="width:0.5,0.1", noise=noise, time_limit_s=1e-6)
+    found = solve(HOUSE, sensor="width", noise=noise, max_actions=2, time_limit_s=60)
+    assert found.source.noise == noise

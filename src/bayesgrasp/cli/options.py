@@ -216,8 +216,7 @@ TimeLimitOpt = Annotated[
         metavar="S",
         min=0.001,
         callback=bound_value,
-        help="With --sense (exact actions): the most seconds the policy search may take "
-        "(default 60; a policy under noise or a payoff is bounded by --max-memory). Past "
+        help="With --sense: the most seconds the policy search may take (default 60). Past "
         "it (or --max-memory) the search plans again within the same bounds, one action more "
         "at a time, and answers with the deepest policy that finished, saying so and giving "
         "a lower bound on the cost of any policy of --max-actions.",
@@ -412,13 +411,3 @@ def sense_spec(
         if v is not None
     }
     return SenseSpec(sense, tuple(also), part_prior, depth, **bounds)
-
-
-def check_time_limit(time_limit: float | None, noisy: bool) -> None:
-    """``--time-limit`` bounds the exact policy search: refused beside noise or a payoff."""
-    if time_limit is not None and noisy:
-        raise typer.BadParameter(
-            "bounds the exact policy search; a policy under noisy actions or a payoff is "
-            "bounded by --max-memory",
-            param_hint="--time-limit",
-        )

@@ -29,7 +29,6 @@ from .options import (
     SenseOpt,
     TimeLimitOpt,
     TurnNoiseOpt,
-    check_time_limit,
     command_app,
     part_options,
     problem_options,
@@ -225,9 +224,6 @@ def plan(
         if refused:
             raise typer.BadParameter(f"--sense plans a policy; it takes no {', '.join(refused)}")
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
-        check_time_limit(
-            time_limit, turn_noise is not None or contact_noise is not None or payoff is not None
-        )
         sensing = sense_spec(sense, more, part_prior, spec, max_memory, time_limit)
         if is_mesh_part(part):  # the candidates are the mesh's resting poses
             sensing, spec = pose_sensing(part, sensing, spec, goal_pose, pose_prior)

@@ -28,7 +28,6 @@ from .options import (
     SenseOpt,
     TimeLimitOpt,
     TurnNoiseOpt,
-    check_time_limit,
     command_app,
     part_options,
     problem_options,
@@ -127,9 +126,6 @@ def plot(
         from .sensing import plot_policy_command, sense_noise
 
         check_outputs([out / f"policy.{f}" for f in formats], inputs, force, "--out")
-        check_time_limit(
-            time_limit, turn_noise is not None or contact_noise is not None or payoff is not None
-        )
         sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
         from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
 

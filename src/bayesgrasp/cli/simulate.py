@@ -32,7 +32,6 @@ from .options import (
     SenseOpt,
     TimeLimitOpt,
     TurnNoiseOpt,
-    check_time_limit,
     command_app,
     part_options,
     problem_options,
@@ -222,7 +221,6 @@ def simulate(
         model, _, _ = _noise_model(noise, noise_kind, turn_noise, contact_noise)
         asked = not model.exact or payoff is not None
         action = ActionModel(model, payoff) if asked else None
-        check_time_limit(time_limit, asked)
         sensing = sense_spec(sense, also or (), part_prior, spec, max_memory, time_limit)
         from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
 

@@ -91,7 +91,7 @@ class StrategyRun:
                     max_actions=sensing.max_actions,
                     part_prior=sensing.part_prior,
                     max_memory_mb=sensing.max_memory_mb,
-                    time_limit_s=sensing.time_limit_s if exact else None,
+                    time_limit_s=sensing.time_limit_s,
                     progress=progress if exact else None,
                 ),
             )

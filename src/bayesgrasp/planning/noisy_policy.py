@@ -107,6 +107,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, cast
@@ -139,6 +140,7 @@ from .policy import (
     policy_space,
     search_policy,
     start_ratio,
+    time_seconds,
 )
 from .result import PlanStep
 from .strategy import Evaluation, evaluate_tree
@@ -559,6 +561,7 @@ def plan_noisy_policy(
     max_first_angles: int = 512,
     max_iterations: int = 50,
     max_memory_mb: float = DEFAULT_MAX_MEMORY_MB,
+    time_limit_s: float | None = None,
     refine: bool = True,
     sensorless: bool = True,
     _always: bool = False,
@@ -590,6 +593,9 @@ def plan_noisy_policy(
     max_memory_mb : float
         About the most memory (MB) the programme's kept beliefs may take (their images,
         reading masses and bounds; > 0): past it the search stops with a PlanningError.
+    time_limit_s : float or None
+        Most seconds the search may take (``None``: no bound); past it the search stops with
+        a :class:`~bayesgrasp.planning.policy.SearchStopped` saying so.
     refine : bool
         Refine the turns (see the module notes); ``False`` keeps the candidate turns.
     sensorless : bool
@@ -622,6 +628,7 @@ def plan_noisy_policy(
     """
     sens = parse_sensor(sensor)
     memory_bytes(max_memory_mb)  # a bad bound: refused before any work
+    seconds = time_seconds(time_limit_s)
     if noise is not None and not isinstance(noise, NoiseModel):
         raise PlanningError(f"`noise` must be a NoiseModel; got {type(noise).__name__}")
     if payoff is None and (noise is None or (noise.exact and not _always)):
@@ -652,6 +659,7 @@ def plan_noisy_policy(
         solver.goal_is_identity = False
         solver.use_pairs = False
     solver.max_bytes = memory_bytes(max_memory_mb)
+    solver.deadline, solver.time_limit = time.monotonic() + seconds, seconds
     for k in solver.kinds:
         mid, half = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
         if main.accuracy > 0:  # only turns that keep their class under the accuracy

@@ -911,11 +911,6 @@ def solve(
         else:
             from .noisy_policy import plan_noisy_policy
 
-            if time_limit_s is not None:
-                raise PlanningError(
-                    "`time_limit_s` bounds the exact policy search; a policy under noisy actions "
-                    "or a payoff is bounded by `max_memory_mb`"
-                )
             if payoff is not None and len(pbs) > 1:
                 raise PlanningError("a payoff is for one part")
             pol = plan_noisy_policy(
@@ -926,6 +921,7 @@ def solve(
                 payoff=payoff,
                 part_prior=part_prior,
                 max_memory_mb=memory,
+                time_limit_s=policy.DEFAULT_TIME_LIMIT_S if time_limit_s is None else time_limit_s,
             )
         return StrategyResult(pbs, pol)
     if len(pbs) > 1:
