@@ -572,6 +572,7 @@ def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
             "document.querySelectorAll('#belief svg.belief').length === "
             f"{len(want['options'][want['bayes']]['steps'])}"
         )
+        page.wait_for_function("() => state.functions !== null")  # its request may lag
         steps = page.evaluate("() => state.functions.plan.steps.map((s) => s.alpha_deg)")
         bayes = want["options"][want["bayes"]]
         assert steps == pytest.approx([math.degrees(s["alpha_rad"]) for s in bayes["steps"]])
