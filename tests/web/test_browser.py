@@ -572,8 +572,10 @@ def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
             "document.querySelectorAll('#belief svg.belief').length === "
             f"{len(want['options'][want['bayes']]['steps'])}"
         )
-        page.wait_for_function("() => state.functions !== null")  # its request may lag
-        steps = page.evaluate("() => state.functions.plan.steps.map((s) => s.alpha_deg)")
+        # read in the same task that sees the view (a later run may clear it again)
+        steps = page.wait_for_function(
+            "() => state.functions && state.functions.plan.steps.map((s) => s.alpha_deg)"
+        ).json_value()
         bayes = want["options"][want["bayes"]]
         assert steps == pytest.approx([math.degrees(s["alpha_rad"]) for s in bayes["steps"]])
         # the shared link gives the same table in a fresh page

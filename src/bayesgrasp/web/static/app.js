@@ -323,6 +323,7 @@ function schedule() {
 }
 
 async function run() {
+  clearTimeout(timer); // a click on Plan replaces the run an input change scheduled
   const part = partBody();
   if (!state.catalogue && !state.file && state.vertices.length < 3) {
     setStatus("add at least three vertices (or choose a part)");
