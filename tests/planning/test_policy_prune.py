@@ -20,7 +20,8 @@ from numpy.testing import assert_allclose
 from bayesgrasp.model import CostModel, HistogramPrior, Problem
 from bayesgrasp.model.sensing import StateSpace, WidthSensor
 from bayesgrasp.paper.study import random_polygon
-from bayesgrasp.planning.policy import Policy, _Solver, make_solver, plan_policy
+from bayesgrasp.planning.policy import Policy, make_solver, plan_policy
+from bayesgrasp.planning.programme import Solver
 
 ALL = frozenset({"cut", "floor", "deepen"})
 SUBSETS = [frozenset(), frozenset({"cut"}), frozenset({"floor"}), frozenset({"deepen"}), ALL]
@@ -108,7 +109,7 @@ def test_prunings_visit_fewer_beliefs() -> None:
 # -- the bounds themselves ----------------------------------------------------------------
 
 
-def programme(seed: int, rel: float, prune: frozenset[str]) -> _Solver:
+def programme(seed: int, rel: float, prune: frozenset[str]) -> Solver:
     pb = Problem.build(random_polygon(seed, 8))
     space = StateSpace.build([pb])
     return make_solver(space, noisy(pb, rel, 0.5), prune)

@@ -105,7 +105,10 @@ from ..model.noise import NoiseModel, NoisyTransitions
 from ..model.payoff import Payoff, as_vector
 from ..model.prior import UniformPrior
 from ..model.problem import Problem, nearest_state
+from ..model.sensing import StateSpace
+from .evaluation import NoisyJointTransitions, evaluate_tree, linear_strategy
 from .exact import plan_exact
+from .policy_tree import Reject
 from .result import (
     PlanOption,
     PlanResult,
@@ -304,7 +307,7 @@ class PlanEvaluator:
     ``q_k = q_1(a) M_{t_2}(alpha_2) ... M_{t_k}(alpha_k)`` of :meth:`forward` and
     :meth:`step` (only the states of positive mass, and many turns at once), and the choice
     of the final state a plan aims at (:meth:`targets`). The same propagation as
-    :func:`~bayesgrasp.planning.strategy.evaluate_tree`, which evaluates any strategy (the
+    :func:`~bayesgrasp.planning.evaluation.evaluate_tree`, which evaluates any strategy (the
     tests hold the two equal); this one is batched over the turns a search tries.
 
     Parameters
@@ -411,7 +414,7 @@ def evaluate_plan(
 ) -> NoisyEvaluation:
     """Evaluate a plan exactly under a noise model (and a payoff).
 
-    The final distribution is :func:`~bayesgrasp.planning.strategy.evaluate_tree`'s (the
+    The final distribution is :func:`~bayesgrasp.planning.evaluation.evaluate_tree`'s (the
     evaluator of every strategy) of the plan as the strategy that never branches; the
     payoff is scored on it as the noise-aware planner scores its candidates
     (:meth:`PlanEvaluator.finish`).
@@ -440,10 +443,6 @@ def evaluate_plan(
     >>> round(ev.success_probability, 6) == round(plan.success_probability, 6)
     True
     """
-    from ..model.sensing import StateSpace
-    from .policy import Reject
-    from .strategy import NoisyJointTransitions, evaluate_tree, linear_strategy
-
     if not steps:
         raise PlanningError("a plan needs at least one step")
     kinds = [s.kind for s in steps]

@@ -122,6 +122,7 @@ from ..model.payoff import Payoff, as_vector
 from ..model.problem import Problem
 from ..model.sensing import StateSpace, WidthSensor, parse_sensor
 from ..model.states import nearest_state
+from .evaluation import Evaluation, evaluate_tree
 from .noisy import plan_noisy
 from .policy import (
     DEFAULT_MAX_ACTIONS,
@@ -143,7 +144,6 @@ from .policy import (
     time_seconds,
 )
 from .result import PlanStep
-from .strategy import Evaluation, evaluate_tree
 from .turns import FLAT_SIGMAS, GRID_PER_SIGMA, free_arcs, margin, turn_grid
 
 __all__ = ["MAX_SWEEPS", "evaluate_policy", "plan_noisy_policy"]
@@ -368,7 +368,7 @@ def _frozen(node: _Node, model: _Model) -> PolicyNode:
 
 
 def _exact(model: _Model, root: _Node, first_angle: float) -> Evaluation:
-    """Exact figures of a tree: :func:`.strategy.evaluate_tree` under the model's matrices."""
+    """Exact figures of a tree: :func:`.evaluation.evaluate_tree` under the model's matrices."""
     tree = _frozen(root, model)
     tree = dataclasses.replace(tree, step=PlanStep(tree.step.kind, first_angle))
     return evaluate_tree(model.space, tree, model, model.bins, model.payoff)
