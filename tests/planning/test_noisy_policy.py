@@ -335,7 +335,7 @@ def test_bad_input() -> None:
     pb = Problem.build(HOUSE)
     nm = NOISES["normal"]
     with pytest.raises(PlanningError, match="the memory bound: --max-memory MB"):
-        plan_noisy_policy(pb, "width:0.05,0.025", 3, nm, max_memory_mb=0.001)
+        plan_noisy_policy(pb, "width:0.05,0.025", 3, nm, max_memory_mb=0.001, best_so_far=False)
     with pytest.raises(PlanningError, match="`max_memory_mb` must be a number of MB > 0"):
         plan_noisy_policy(pb, "width", 2, nm, max_memory_mb=0)
     with pytest.raises(PlanningError, match="`noise` must be a NoiseModel"):

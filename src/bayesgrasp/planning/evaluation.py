@@ -58,7 +58,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Protocol, cast
 
@@ -270,8 +270,10 @@ class _Walk:
         model: Transitions,
         bins: ReadingBins | None,
         payoff: FloatArray | None,
+        check: Callable[[], None] | None = None,
     ) -> None:
         self.space, self.model, self.bins, self.payoff = space, model, bins, payoff
+        self.check = check  # called before each node's and branch's work (it may raise)
         # ``hist @ M(alpha)`` computed by the model itself, when it can (only the rows of
         # states with mass, say); else by its matrix
         self.propagate = getattr(model, "propagate", None)
@@ -302,12 +304,27 @@ class _Walk:
         owner = np.searchsorted(his[:-1], b.lo, side="right")
         return b.likelihood, [np.flatnonzero(owner == k) for k in range(len(branches))]
 
+    def blocks(self, rows: int, width: int) -> Iterator[slice]:
+        """Slices of ``rows`` rows of ``width`` numbers each, :attr:`check` before each.
+
+        One slice of all rows without a check (then nothing is gained by blocks).
+        """
+        if self.check is None:
+            yield slice(0, rows)
+            return
+        step = max(1, _BLOCK // max(width, 1))
+        for lo in range(0, max(rows, 1), step):
+            self.check()
+            yield slice(lo, min(lo + step, rows))
+
     def node(self, node: PolicyNode, hist: FloatArray, level: int, first: bool) -> PolicyNode:
         """The node with its exact probabilities, given the beliefs ``hist`` (H, N) reaching it.
 
         Each row of ``hist`` is the unnormalised belief of one reading history before the
         node's action (the root: after it, as the first action is the prior's).
         """
+        if self.check is not None:
+            self.check()
         if first:
             img = hist
         elif self.propagate is not None:
@@ -322,15 +339,25 @@ class _Walk:
         out: list[Branch] = []
         for br, ix in zip(node.branches, bins, strict=True):
             # (H * bins, N): every history continued by every reading of the branch (without
-            # a sensor, nothing is read: the histories go on as they are)
-            per = (
-                img if self.bins is None else (img[:, None, :] * lik[:, ix].T[None]).reshape(-1, n)
-            )
+            # a sensor, nothing is read: the histories go on as they are); the histories of
+            # mass. Row by row, so a check may come between blocks of rows.
+            if self.bins is None:
+                parts = [img]
+            else:
+                lik_b = lik[:, ix].T[None]
+                parts = [
+                    (img[s, None, :] * lik_b).reshape(-1, n)
+                    for s in self.blocks(len(img), len(ix) * n)
+                ]
+            per = np.concatenate(parts) if len(parts) > 1 else parts[0]
             w = per.sum(axis=1)
             keep = w > 0
             per, w = per[keep], w[keep]
             pb = float(w.sum())
-            h = float((w * entropies(per / w[:, None])).sum()) if len(w) else 0.0
+            h = 0.0
+            if len(w):
+                ent = [entropies(per[s] / w[s, None]) for s in self.blocks(len(w), n)]
+                h = float((w * (np.concatenate(ent) if len(ent) > 1 else ent[0])).sum())
             nxt: PolicyNode | Leaf
             if isinstance(br.next, PolicyNode):
                 self.passing[level] = self.passing.get(level, 0.0) + h
@@ -367,6 +394,9 @@ class _Walk:
                 out[x - 1] += h
         return tuple(out)
 
+
+# Numbers of a belief array computed between two checks of a time bound (``_Walk.blocks``).
+_BLOCK = 1 << 21
 
 # Without a sensor: no likelihood (the walk reads nothing), and one bin.
 _NO_READING = np.ones((0, 1))
@@ -406,13 +436,15 @@ def evaluate_tree(
     model: Transitions,
     bins: ReadingBins | None = None,
     payoff: FloatArray | None = None,
+    check: Callable[[], None] | None = None,
 ) -> Evaluation:
     """:func:`evaluate` on a built state space, action model and reading bins.
 
     For planners that evaluate many trees of one problem (the matrices of ``model`` may be
-    kept between calls).
+    kept between calls). ``check`` is called before the work of each node and branch: a
+    planner's time bound may stop the evaluation there by raising.
     """
-    walk = _Walk(space, model, bins, payoff)
+    walk = _Walk(space, model, bins, payoff, check)
     q = model.initial(strategy.step.kind, strategy.step.alpha)[None, :]
     root = walk.node(strategy, q, 1, True)
     p = walk.success

@@ -186,6 +186,7 @@ __all__ = [
     "PolicyNode",
     "Reject",
     "SearchStopped",
+    "best_policy_within",
     "candidate_first_angles",
     "joint_transition",
     "lower_bound",
@@ -196,6 +197,7 @@ __all__ = [
     "policy_text",
     "root_beliefs",
     "search_policy",
+    "search_root",
     "start_ratio",
     "time_seconds",
 ]
@@ -332,40 +334,96 @@ def plan_policy(
 
         return plan_exact(main, max_actions=depth).bayes_plan.expected_cost
 
-    def attempt(depth: int, known: float | None, deadline: float) -> Policy:
-        """The best policy within ``depth`` actions; ``known``: a known plan's cost."""
-        solver = make_solver(space, sens, _prune)
-        solver.max_bytes, solver.deadline, solver.time_limit = max_bytes, deadline, seconds
-        solver.progress = progress if math.isfinite(seconds) else None
-        roots, root_kind, root_angle = root_beliefs(space, solver.kinds, angles)
-        # A known policy's ratio starts the parametric search: one action then declare the
-        # likeliest state on every reading, or the sensorless Bayes plan (one part).
-        lam = start_ratio(solver, roots, root_kind)
-        if known is not None and math.isfinite(known):
-            lam = min(lam, known)
-        deepen = "deepen" in _prune and sens.sigma > 0
-        best_pick, it = search_policy(solver, roots, root_kind, lam, depth, max_iterations, deepen)
-        builder = PolicyBuilder(solver, depth)
-        k = solver.kinds[root_kind[best_pick]]
-        root = builder.node(
-            k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, depth - 1, 0.0, 1, True
-        )
-        return finish_policy(builder, root, space, sens, depth, sensorless_cost, it, angles_exact)
-
     sensorless_cost = sensorless_within(max_actions)
 
-    def attempt_at(depth: int, deadline: float) -> Policy:
-        known = sensorless_cost if depth == max_actions else sensorless_within(depth)
-        return attempt(depth, known, deadline)
+    def attempt(depth: int, deadline: float) -> Policy:
+        return best_policy_within(
+            space,
+            sens,
+            angles,
+            depth,
+            deadline,
+            known=sensorless_cost if depth == max_actions else sensorless_within(depth),
+            sensorless_cost=sensorless_cost,
+            angles_exact=angles_exact,
+            max_iterations=max_iterations,
+            max_bytes=max_bytes,
+            seconds=seconds,
+            progress=progress,
+            prune=_prune,
+        )
 
     return deepest_within_bounds(
-        attempt_at,
+        attempt,
         max_actions,
         seconds,
         lambda: _lower_bound(space, sens, angles),
         best_so_far=best_so_far,
         complete_bound=lambda pol: pol.expected_cost,  # a finished search: the optimum
     )
+
+
+def best_policy_within(
+    space: StateSpace,
+    sens: WidthSensor,
+    angles: Sequence[float],
+    depth: int,
+    deadline: float,
+    *,
+    known: float | None = None,
+    sensorless_cost: float | None = None,
+    angles_exact: bool = True,
+    max_iterations: int = 50,
+    max_bytes: int = 0,
+    seconds: float = math.inf,
+    progress: Callable[[int, int], None] | None = None,
+    prune: Collection[str] = DEFAULT_PRUNE,
+) -> Policy:
+    """The best policy of at most ``depth`` actions with exact actions (one search).
+
+    The first action at one of ``angles``; ``known``: a known policy's cost (it may start
+    the parametric search); ``sensorless_cost``, ``angles_exact``: as the policy reports
+    them. Raises :class:`SearchStopped` past ``deadline`` (``time.monotonic()``; the bound
+    of ``seconds``) or ``max_bytes`` of kept beliefs (0: no bound).
+    """
+    solver = make_solver(space, sens, prune)
+    solver.max_bytes, solver.deadline, solver.time_limit = max_bytes, deadline, seconds
+    solver.progress = progress if math.isfinite(seconds) else None
+    roots, root_kind, root_angle = root_beliefs(space, solver.kinds, angles)
+    # A known policy's ratio starts the parametric search: one action then declare the
+    # likeliest state on every reading, or the sensorless Bayes plan (one part).
+    lam = start_ratio(solver, roots, root_kind)
+    if known is not None and math.isfinite(known):
+        lam = min(lam, known)
+    deepen = "deepen" in prune and sens.sigma > 0
+    root, builder, it = search_root(
+        solver, roots, root_kind, root_angle, lam, depth, max_iterations, deepen
+    )
+    return finish_policy(builder, root, space, sens, depth, sensorless_cost, it, angles_exact)
+
+
+def search_root(
+    solver: Solver,
+    roots: FloatArray,
+    root_kind: Sequence[int],
+    root_angle: Sequence[float],
+    lam: float,
+    depth: int,
+    max_iterations: int,
+    deepen: bool,
+) -> tuple[PolicyNode, PolicyBuilder, int]:
+    """The parametric search from ``lam`` (:func:`search_policy`) and the tree it found.
+
+    Returns the root of the best policy of at most ``depth`` actions, its builder (with the
+    tallied figures) and the number of parametric steps.
+    """
+    best_pick, it = search_policy(solver, roots, root_kind, lam, depth, max_iterations, deepen)
+    builder = PolicyBuilder(solver, depth)
+    k = solver.kinds[root_kind[best_pick]]
+    root = builder.node(
+        k, root_angle[best_pick], math.inf, roots[best_pick], 1.0, depth - 1, 0.0, 1, True
+    )
+    return root, builder, it
 
 
 def root_beliefs(

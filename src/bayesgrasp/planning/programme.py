@@ -441,20 +441,14 @@ class Solver:
         hit = self.prep_cache.get((key, ti))
         if hit is None:
             if self.max_bytes and self.prep_bytes > self.max_bytes:
-                raise SearchStopped(
-                    f"its beliefs took more than {self.max_bytes / 2**20:,.0f} MB (the memory "
-                    "bound: --max-memory MB, `max_memory_mb` in the library)"
-                )
+                raise SearchStopped.out_of_memory(self.max_bytes)
             now = time.monotonic()
             if self.progress is not None and now - self.shown > 0.25:
                 self.shown = now
                 used = self.time_limit - max(self.deadline - now, 0.0)
                 self.progress(int(used), math.ceil(self.time_limit))
             if now > self.deadline:
-                raise SearchStopped(
-                    f"it ran for {self.time_limit:g} s (the time bound: --time-limit S, "
-                    "`time_limit_s` in the library)"
-                )
+                raise SearchStopped.out_of_time(self.time_limit)
             imgs, rows = self.images(q, self.kinds[ti])
             hit = (self.prepare(imgs), rows)
             self.prep_cache[(key, ti)] = hit

@@ -29,6 +29,7 @@ __all__ = [
     "DEFAULT_MAX_MEMORY_MB",
     "DEFAULT_TIME_LIMIT_S",
     "SearchStopped",
+    "check_deadline",
     "deepest_within_bounds",
     "memory_bytes",
     "time_seconds",
@@ -49,6 +50,31 @@ class SearchStopped(PlanningError):
             f"the policy search stopped: {reason}; raise the bound, or plan fewer actions"
         )
         self.reason = reason
+
+    @classmethod
+    def out_of_time(cls, seconds: float) -> SearchStopped:
+        """The search ran past its bound of ``seconds``."""
+        return cls(
+            f"it ran for {seconds:g} s (the time bound: --time-limit S, "
+            "`time_limit_s` in the library)"
+        )
+
+    @classmethod
+    def out_of_memory(cls, max_bytes: int) -> SearchStopped:
+        """The search's kept beliefs took more than ``max_bytes``."""
+        return cls(
+            f"its beliefs took more than {max_bytes / 2**20:,.0f} MB (the memory "
+            "bound: --max-memory MB, `max_memory_mb` in the library)"
+        )
+
+
+def check_deadline(deadline: float, seconds: float) -> None:
+    """Raise :meth:`SearchStopped.out_of_time` past ``deadline`` (``time.monotonic()``).
+
+    ``seconds``: the bound the deadline allows (for the message).
+    """
+    if time.monotonic() > deadline:
+        raise SearchStopped.out_of_time(seconds)
 
 
 def time_seconds(time_limit_s: float | None) -> float:
