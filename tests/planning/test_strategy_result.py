@@ -32,8 +32,14 @@ from bayesgrasp.model import Problem
 from bayesgrasp.model.noise import NoiseModel, TurnNoise
 from bayesgrasp.model.payoff import read_payoff
 from bayesgrasp.model.sensing import StateSpace, parse_sensor
-from bayesgrasp.planning import StrategyResult, plan_bfs, plan_exact, plan_guaranteed, solve
-from bayesgrasp.planning import noisy_policy as npol
+from bayesgrasp.planning import (
+    StrategyResult,
+    noisy_model,
+    plan_bfs,
+    plan_exact,
+    plan_guaranteed,
+    solve,
+)
 from bayesgrasp.planning.noisy import PlanEvaluator, evaluate_plan, plan_noisy
 from bayesgrasp.planning.policy import DEFAULT_PRUNE, make_solver, plan_policy
 from bayesgrasp.planning.result import PlanStep
@@ -266,11 +272,11 @@ def test_each_candidate_turn_is_one_action_once(name: str, noise: str) -> None:
     pb = _pb(name)
     space = StateSpace.build(pb)
     sensor = parse_sensor("width")
-    model = npol._Model(space, sensor, NOISES[noise])
+    model = noisy_model.NoisyModel(space, sensor, NOISES[noise])
     for k in make_solver(space, sensor, DEFAULT_PRUNE).kinds:
         mid, _ = model.candidates(k.name, np.asarray(k.mid), np.asarray(k.half_width))
         mats = model.matrices(k.name, mid)
-        kept = mats[npol._first_of_each_matrix(mats)]
+        kept = mats[noisy_model.first_of_each_matrix(mats)]
         flat = {m.tobytes() for m in kept}
         assert len(flat) == len(kept)
         turns = np.mod(mid, 2 * math.pi)
