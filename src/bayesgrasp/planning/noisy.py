@@ -289,6 +289,10 @@ class _Planner:
             crit = self.ev.nt.critical(kind, left, right)
             pts = (crit[:, None] + np.array([-turn.scale, turn.scale])).ravel()
             kinks = np.unique(np.mod(pts + period / 2, period)) - period / 2
+            if kinks.size == 0:
+                # No state meets a basin boundary within the error's reach: the error spans
+                # the whole period, so every turn leaves the same distribution.
+                return current, f0
             vals = self._line(kind, left, right, kinks)
             top = vals.max()
             at = np.flatnonzero(vals >= top - self.p_tol)
