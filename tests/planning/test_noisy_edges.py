@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from bayesgrasp import shapes
@@ -142,6 +142,7 @@ def test_contact_plans_keep_off_the_equilibria(seed: int, points: int, q: float)
     name=st.sampled_from(["key", "house", "example", "triangle"]),
     atoms=st.lists(st.floats(0.0, TWO_PI, exclude_max=True), min_size=1, max_size=8),
 )
+@example(name="triangle", atoms=[0.0, 2.0])  # the first squeeze once put the atom 0 on a boundary
 def test_the_first_angle_keeps_atoms_off_the_boundaries(name: str, atoms: list[float]) -> None:
     """Under a sample prior an atom on a first-action boundary would be an equilibrium too."""
     pb = Problem.build(shapes.load(name), prior=SamplePrior(atoms))

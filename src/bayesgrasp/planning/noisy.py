@@ -198,16 +198,30 @@ class _Planner:
         """The turns, each moved off the unstable equilibria of the states it meets.
 
         A turn (exact turns) within the angle tolerance of a boundary turn of a state of
-        positive probability is moved to the middle of one of the two arcs beside that
+        positive probability (for the first action: of an atom of a sample prior) is moved to the middle of one of the two arcs beside that
         boundary, the one whose plan (the other turns as they are) earns more. Returns the
         turns, whether any moved, and the final distribution of the plan they make.
         """
         out = list(angles)
         periods = _periods(self.problem, kinds)
-        q = self.ev.nt.initial(kinds[0], out[0])
+        atoms = getattr(self.problem.prior, "angles", None)  # a sample prior's atoms
         moved = False
-        for m in range(1, len(kinds)):
-            bounds = self.ev.boundary_turns(kinds[m], np.flatnonzero(q > 0))
+        q = np.zeros(0)
+        for m in range(len(kinds)):
+            if m == 0:
+                # The first action meets the prior itself: only atoms can sit on a boundary
+                # (a density puts no mass on a point), at world angles ``x - o - B``.
+                if atoms is None:
+                    q = self.ev.nt.initial(kinds[0], out[0])
+                    continue
+                bounds = np.concatenate(
+                    [
+                        (np.asarray(atoms)[:, None] - c.offset - c.hi[None, :]).ravel()
+                        for c in self.ev.nt.components(kinds[0])
+                    ]
+                )
+            else:
+                bounds = self.ev.boundary_turns(kinds[m], np.flatnonzero(q > 0))
             if margin(out[m], bounds, periods[m]) <= self.a_tol:
                 starts, mids, _ = free_arcs(bounds, periods[m], self.a_tol)
                 d = np.abs(np.mod(starts - out[m] + periods[m] / 2, periods[m]) - periods[m] / 2)
@@ -219,7 +233,10 @@ class _Planner:
                     if v > best_v + self.p_tol:
                         best_v, out = v, trial
                 moved = True
-            q = self.ev.step(q, kinds[m], np.array([out[m]]))[0]
+            if m == 0:
+                q = self.ev.nt.initial(kinds[0], out[0])
+            else:
+                q = self.ev.step(q, kinds[m], np.array([out[m]]))[0]
         return out, moved, q
 
     def search_turns(self, kind: str, mids: FloatArray, period: float) -> FloatArray:
