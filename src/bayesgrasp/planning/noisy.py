@@ -200,8 +200,8 @@ class _Planner:
         A turn (exact turns) within the angle tolerance of a boundary turn of a state of
         positive probability (for the first action: of an atom of a sample prior) is moved
         to the middle of one of the two arcs beside that boundary, the one whose plan (the
-        other turns as they are) earns more. Returns the
-        turns, whether any moved, and the final distribution of the plan they make.
+        other turns as they are) earns more. Returns the turns, whether any moved, and the
+        final distribution of the plan they make.
         """
         out = list(angles)
         periods = _periods(self.problem, kinds)
