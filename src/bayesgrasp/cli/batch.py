@@ -311,15 +311,19 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
     if batch is None:
         return
     stream = sys.stdin if str(batch) == "-" else None
+    if stream is None:
+        _regular(batch)
     try:  # a byte that is not UTF-8 is kept (as a lone surrogate) for its line to report
         handle = stream or batch.open(encoding="utf-8", errors="surrogateescape")
     except OSError as exc:
         raise BatchFileError(f"cannot read {batch}: {exc.strerror or exc}") from None
+    lines = 0
     with handle:
         for number, line in enumerate(handle, start=1):
             text = line.strip()
             if not text:
                 continue
+            lines += 1
             label = f"{batch}:{number}"
 
             def load(text: str = text, label: str = label) -> Part:
@@ -343,6 +347,28 @@ def _batch_parts(part: PartSpec, more: list[str], batch: Path | None) -> Iterato
                 )
 
             yield label, load
+    if not lines:
+        where = "standard input" if stream is not None else str(batch)
+        raise BatchFileError(f"{where} holds no part (every line is empty)")
+
+
+def _regular(batch: Path) -> None:
+    """Refuse a batch file that is not a regular file, before it can block or read forever."""
+    import stat
+
+    try:
+        mode = batch.stat().st_mode
+    except FileNotFoundError:
+        raise BatchFileError(f"cannot read {batch}: no such file") from None
+    except OSError as exc:
+        raise BatchFileError(f"cannot read {batch}: {exc.strerror or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise BatchFileError(f"{batch} is a folder, not a batch file")
+    if not stat.S_ISREG(mode):
+        raise BatchFileError(
+            f"{batch} is not a regular file (a FIFO, device or socket): to stream lines, "
+            "pipe them into --batch -"
+        )
 
 
 def _utf8(text: str) -> bool:
