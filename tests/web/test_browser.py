@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -202,17 +203,32 @@ def outcomes(page: Any) -> list[tuple[float, bool]]:
     return [(float(a), bool(b)) for a, b in cells]
 
 
-def library_outcomes(page: Any, vertices: Any, prior: str) -> list[tuple[float, bool]]:
-    """The same starts run through the library's transfer functions and goal."""
+def library_outcomes(
+    page: Any,
+    vertices: Any,
+    prior: str,
+    index: int | None = None,
+    actions: tuple[str, ...] = ("squeeze",),
+) -> list[tuple[float, bool]]:
+    """The same starts run through the library's transfer functions and goal.
+
+    ``vertices`` is a list of points or a catalogue name; ``index`` the plan's row (Bayes when
+    None).
+    """
     import numpy as np
 
+    from bayesgrasp import shapes
     from bayesgrasp.cli.specs import ProblemSpec
     from bayesgrasp.geometry import Part
     from bayesgrasp.model.problem import nearest_state
 
-    spec = ProblemSpec(prior=prior)
-    pb = spec.build(Part.from_points(np.array(vertices)))
-    option = spec.plan(pb).bayes_plan
+    spec = ProblemSpec(prior=prior, actions=actions)
+    part = (
+        shapes.load(vertices) if isinstance(vertices, str) else Part.from_points(np.array(vertices))
+    )
+    pb = spec.build(part)
+    result = spec.plan(pb)
+    option = result.bayes_plan if index is None else result.options[index]
     starts = np.array([a for a, _ in outcomes(page)])
     theta = starts.copy()
     for s in option.steps:
@@ -584,3 +600,185 @@ def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
             other.goto(page.url)
             wait_rows(other, expected_rows(want))
             other.close()
+
+
+def _finish_animation(page: Any) -> None:
+    """Draw the animation's last frame at once (Play draws the same frames on a timer)."""
+    page.evaluate("() => drawAnimationFrame(1e9)")
+    page.wait_for_selector("#anim[data-done=true]")
+
+
+def test_plan_selector_animates_each_row_with_pushes(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    """Every row of the table can be animated; a push-grasp is a push, then a close."""
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze,push-grasp")
+    _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
+    wait_rows(page, expected_rows(want))
+    values = page.eval_on_selector_all("#anim-plan option", "(os) => os.map((o) => o.value)")
+    assert values == [str(i) for i in range(len(want["options"]))]
+    assert page.locator("#anim-plan").input_value() == str(want["bayes"])
+    acts = ("squeeze", "push-grasp")
+    for i, option in enumerate(want["options"]):
+        page.select_option("#anim-plan", str(i))
+        page.click("#play")
+        page.wait_for_selector("#anim[data-done=true]", timeout=60_000)
+        steps = option["steps"]
+        assert page.locator("#anim").get_attribute("data-steps") == str(len(steps))
+        kinds = [
+            k
+            for s in steps
+            for k in (("turn", "squeeze") if s["type"] == "squeeze" else ("turn", "push", "close"))
+        ]
+        assert page.locator("#anim").get_attribute("data-segments") == ",".join(kinds)
+        assert outcomes(page) == library_outcomes(page, "house", "uniform", i, acts)
+
+    # a push frame: the pushing jaw and its arrow in every cell; a squeeze frame: neither
+    page.select_option("#anim-plan", "1")  # push-grasp, squeeze
+    cells = 8
+    push_frame = 1 * 12 + 6  # the second segment (turn, push, close, turn, squeeze)
+    page.evaluate(f"() => drawAnimationFrame({push_frame})")
+    assert page.locator("#anim").get_attribute("data-kind") == "push"
+    assert page.locator("#anim line.jaw.pusher").count() == cells
+    assert page.locator("#anim .push-arrow").count() == cells
+    assert "push" in page.locator("#anim-status").text_content()
+    squeeze_frame = 4 * 12 + 6
+    page.evaluate(f"() => drawAnimationFrame({squeeze_frame})")
+    assert page.locator("#anim").get_attribute("data-kind") == "squeeze"
+    assert page.locator("#anim line.jaw.pusher").count() == 0
+    assert page.locator("#anim .push-arrow").count() == 0
+    assert page.locator("#anim line.jaw.closing").count() == 2 * cells
+
+
+def _binomial_ok(k: int, n: int, p: float) -> bool:
+    """k successes of n near n p: within four standard deviations (about 6e-5 to fail)."""
+    return abs(k - n * p) <= 4 * math.sqrt(n * p * (1 - p)) + 1
+
+
+def test_random_starts_succeed_as_often_as_predicted(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze,push-grasp")
+    _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
+    wait_rows(page, expected_rows(want))
+    page.select_option("#anim-starts", "random")
+    page.fill("#anim-n", "400")
+    page.fill("#anim-seed", "7")
+    acts = ("squeeze", "push-grasp")
+    for i in (0, 2):
+        page.select_option("#anim-plan", str(i))
+        _finish_animation(page)
+        got = outcomes(page)
+        assert len(got) == 400
+        assert got == library_outcomes(page, "house", "uniform", i, acts)
+        k = sum(ok for _, ok in got)
+        p = want["options"][i]["success_probability"]
+        assert _binomial_ok(k, 400, p), (k, p)
+        assert page.locator("#anim").get_attribute("data-oriented") == str(k)
+        assert f"{k} of 400 oriented" in page.locator("#anim-status").text_content()
+    # the same seed gives the same starts; another seed others
+    first = [a for a, _ in outcomes(page)]
+    _finish_animation(page)
+    assert [a for a, _ in outcomes(page)] == first
+    page.fill("#anim-seed", "8")
+    _finish_animation(page)
+    assert [a for a, _ in outcomes(page)] != first
+
+    # a von Mises prior: the starts gather at its mean, and the Bayes plan succeeds as predicted
+    page.goto("about:blank")
+    page.goto(server + "/#v=25,25;75,25;40,70&prior=vonmises:30,4&actions=squeeze")
+    page.wait_for_selector("#plans tbody tr")
+    page.wait_for_function("() => state.last && state.last.plan.part.n_sides === 3")
+    page.select_option("#anim-starts", "random")
+    page.fill("#anim-n", "400")
+    page.fill("#anim-seed", "3")
+    _finish_animation(page)
+    got = outcomes(page)
+    starts = [a for a, _ in got]
+    mean = math.degrees(
+        math.atan2(sum(math.sin(a) for a in starts), sum(math.cos(a) for a in starts))
+    )
+    assert abs(mean - 30) < 6  # the circular standard error is about 1.6 deg
+    resultant = math.hypot(sum(math.sin(a) for a in starts), sum(math.cos(a) for a in starts))
+    # E cos(theta - mu) = I1(4) / I0(4) = 0.8635 for kappa 4
+    assert abs(resultant / 400 - 0.8635) < 0.03
+    assert got == library_outcomes(page, TRIANGLE, "vonmises:30,4")
+    bayes = page.evaluate(
+        "() => state.last.plan.options[state.last.plan.bayes].success_probability"
+    )
+    assert _binomial_ok(sum(ok for _, ok in got), 400, bayes)
+
+
+def test_guaranteed_plan_in_the_table_and_the_selector(
+    server: str, page: Any, cli_json: CliJson, tmp_path: Path
+) -> None:
+    page.goto(server + "/")
+    draw_triangle(page)
+    page.wait_for_selector("#plans tbody tr")
+    page.check("#guaranteed")
+    page.click("#plan")
+    page.wait_for_selector("#plans tr.guaranteed")
+    doc = cli_plan(cli_json, tmp_path, TRIANGLE, "--guaranteed")
+    g = doc["guaranteed"]
+    assert "guaranteed=1" in page.url
+    row = page.locator("#plans tr.guaranteed td").all_text_contents()
+    assert row[0] == f"{g['squeezes']} " + "S" * len(g["steps"])
+    assert row[3] == f"{g['success_probability']:.4f}"
+    page.select_option("#anim-plan", "guaranteed")
+    _finish_animation(page)
+    assert page.locator("#anim").get_attribute("data-steps") == str(len(g["steps"]))
+    # the link keeps the guaranteed plan
+    other = page.context.new_page()
+    other.goto(page.url)
+    other.wait_for_selector("#plans tr.guaranteed")
+    assert other.locator("#guaranteed").is_checked()
+    other.close()
+
+
+def test_policy_nodes_draw_the_part(server: str, page: Any, cli_json: CliJson) -> None:
+    """Each node of the tree draws the part: declarations at the declared orientation,
+    the others at the belief's most probable orientation (a stable one whose width fits)."""
+    page.goto(server + "/#part=house")
+    page.wait_for_selector("#plans tbody tr")
+    page.click("#policy")
+    page.wait_for_function("document.body.dataset.policy === 'done'")
+    nodes = page.locator("#policy-nodes details").count()
+    leaves = page.locator("#policy-nodes li").count() - (nodes - 1)
+    drawings = page.locator("#policy-nodes svg.policy-part polygon")
+    assert drawings.count() == nodes + leaves
+    declared = page.evaluate(
+        """() => [...document.querySelectorAll('#policy-nodes li')]
+            .filter((li) => !li.querySelector('details') && /declare/.test(li.textContent))
+            .map((li) => [Number(li.querySelector('svg').dataset.orientation),
+                          Number(/declare (-?[0-9.]+)°/.exec(li.textContent)[1])])"""
+    )
+    assert declared
+    for drawn, said in declared:
+        assert drawn == pytest.approx(said, abs=0.006)
+    # the second level's orientations are stable orientations of a squeeze whose jaw width
+    # lies in the branch's reading interval
+    _, sq = cli_json("squeeze", "house")
+    hull = sq["part"]["vertices"]
+    stable = [math.degrees(t) for t in sq["stable_orientations_rad"]]
+
+    def width(theta: float) -> float:
+        t = math.radians(theta)
+        xs = [math.cos(t) * x - math.sin(t) * y for x, y in hull]
+        return max(xs) - min(xs)
+
+    second = page.evaluate(
+        """() => [...document.querySelectorAll('#policy-nodes > details > ul > li > details')]
+            .map((d) => [Number(d.querySelector('summary svg').dataset.orientation),
+                         d.parentElement.firstChild.textContent])"""
+    )
+    assert second
+    for theta, reads in second:
+        assert min(abs((theta - s + 180) % 360 - 180) for s in stable) < 1e-6
+        nums = [float(x) for x in re.findall(r"[0-9]+\.?[0-9]*", reads.split("(p =")[0])]
+        w = width(theta)
+        if "below" in reads:
+            assert w < nums[0] + 0.01
+        elif "or more" in reads:
+            assert w >= nums[0] - 0.01
+        elif "in [" in reads:
+            assert nums[0] - 0.01 <= w < nums[1] + 0.01
