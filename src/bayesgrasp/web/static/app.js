@@ -525,7 +525,6 @@ function chosenPlan() {
 
 function fillPlanSelector(plan) {
   const sel = $("anim-plan");
-  const keep = sel.value;
   sel.replaceChildren();
   const add = (value, text) => {
     const o = document.createElement("option");
@@ -542,8 +541,7 @@ function fillPlanSelector(plan) {
     add(String(i), marks ? `${marks}: ${label(o)}` : label(o));
   });
   if (plan.guaranteed) add("guaranteed", `guaranteed: ${label(plan.guaranteed)}`);
-  const values = [...sel.options].map((o) => o.value);
-  sel.value = values.includes(keep) ? keep : String(plan.bayes);
+  sel.value = String(plan.bayes); // a new plan's rows are other plans: start from its Bayes plan
 }
 
 // a small seeded generator (mulberry32), so a seed gives the same starts in every browser
@@ -679,7 +677,8 @@ function drawAnimationFrame(frame) {
   const stepOf = runs[0].segs.slice(0, seg + 1).filter((s) => s.kind === "turn").length;
   const what = { turn: "turn", squeeze: "squeeze", push: "push", close: "the other jaw closes" }[kind];
   $("anim-status").textContent = done
-    ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%)`
+    ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%` +
+      `${Object.keys(noise()).length ? ", which counts the noise and payoff the animation leaves out" : ""})`
     : `step ${stepOf} of ${o.steps.length}: ${what}`;
   svg.dataset.frame = String(f);
   svg.dataset.done = String(done);
