@@ -192,6 +192,15 @@ function noise() {
   return o;
 }
 
+// the gripper's opening limits (plan and policy requests, and the robot files)
+function stroke() {
+  const o = {};
+  if ($("max-opening").value.trim() !== "") o.max_opening = Number($("max-opening").value);
+  if ($("min-opening").value.trim() !== "") o.min_opening = Number($("min-opening").value);
+  if ($("within-stroke").checked) o.within_stroke = true;
+  return o;
+}
+
 function partBody() {
   if (state.catalogue) return { catalogue: state.catalogue };
   if (state.file) return { file: { format: state.file.format, data_base64: state.file.data_base64 }, name: state.file.name };
@@ -212,6 +221,9 @@ function writeHash() {
   for (const k of ["verify_cost", "retry_cost", "accuracy", "goal", "method", "max_actions"])
     if (o[k] !== undefined) q.set(k, o[k]);
   if ($("guaranteed").checked) q.set("guaranteed", "1");
+  const g = stroke();
+  for (const k of ["max_opening", "min_opening"]) if (g[k] !== undefined) q.set(k, g[k]);
+  if (g.within_stroke) q.set("within_stroke", "1");
   q.set("squeeze_cost", $("cost-squeeze").value);
   q.set("push_grasp_cost", $("cost-push-grasp").value);
   const n = noise();
@@ -257,6 +269,9 @@ async function readHash() {
   set("method", "method");
   set("max-actions", "max_actions");
   $("guaranteed").checked = q.get("guaranteed") === "1";
+  $("max-opening").value = q.get("max_opening") || "";
+  $("min-opening").value = q.get("min_opening") || "";
+  $("within-stroke").checked = q.get("within_stroke") === "1";
   set("cost-squeeze", "squeeze_cost");
   set("cost-push-grasp", "push_grasp_cost");
   set("sense", "sense");
@@ -344,7 +359,7 @@ async function run() {
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
-      postWhenFree("/plan", { part, ...o, ...noise(), ...($("guaranteed").checked ? { guaranteed: true } : {}) }, gen),
+      postWhenFree("/plan", { part, ...o, ...noise(), ...stroke(), ...($("guaranteed").checked ? { guaranteed: true } : {}) }, gen),
       post("/squeeze", { part, prior: o.prior }),
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
@@ -780,7 +795,7 @@ function policyLines(node, depth, first, unit, lines) {
 async function showPolicy() {
   if (!validate()) return;
   const o = options();
-  const body = { part: partBody(), ...o, sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
+  const body = { part: partBody(), ...o, ...policyStroke(), sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
   $("policy-summary").textContent = "planning the policy...";
   $("policy-tree").textContent = "";
   $("policy-nodes").replaceChildren();
@@ -812,6 +827,50 @@ async function showPolicy() {
     $("policy-summary").textContent = String(err.message || err);
     $("policy-summary").classList.add("error");
     document.body.dataset.policy = "error";
+  }
+}
+
+// ---- robot files (POST /export: the bytes of plan --export FILE.csv|json) ----------------
+
+function policyStroke() {
+  // a policy is checked against the stroke; "within the stroke" plans linear plans only
+  const g = stroke();
+  delete g.within_stroke;
+  return g;
+}
+
+async function downloadRobotFile(policy) {
+  if (!validate()) return;
+  const format = $("export-format").value;
+  const body = { part: partBody(), ...options(), format };
+  if (policy) Object.assign(body, policyStroke(), { sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 });
+  else Object.assign(body, noise(), stroke(), $("guaranteed").checked ? { guaranteed: true } : {});
+  const where = policy ? $("policy-summary") : $("status");
+  where.textContent = "writing the robot file...";
+  where.classList.remove("error");
+  try {
+    const r = await fetch(`${API}/export`, { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
+    if (!r.ok) {
+      let msg = `HTTP ${r.status}`;
+      try {
+        msg = (await r.json()).detail || msg;
+      } catch (err) {
+        /* not JSON */
+      }
+      throw new Error(msg);
+    }
+    const m = /filename="?([^";]+)"?/.exec(r.headers.get("content-disposition") || "");
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(await r.blob());
+    a.download = m ? m[1] : `robot.${format}`;
+    document.body.appendChild(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
+    where.textContent = `downloaded ${a.download}`;
+  } catch (err) {
+    where.textContent = String(err.message || err);
+    where.classList.add("error");
   }
 }
 
@@ -951,9 +1010,13 @@ function start() {
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
   $("save").addEventListener("click", saveView);
+  $("export").addEventListener("click", () => downloadRobotFile(false));
+  $("export-policy").addEventListener("click", () => downloadRobotFile(true));
   $("gallery-prev").addEventListener("click", () => loadGallery(galleryPage - 1));
   $("gallery-next").addEventListener("click", () => loadGallery(galleryPage + 1));
-  $("options").addEventListener("change", schedule);
+  $("options").addEventListener("change", (evt) => {
+    if (evt.target.id !== "export-format") schedule(); // the file's format plans nothing
+  });
   window.addEventListener("hashchange", async () => { await readHash(); drawCanvas(); schedule(); });
   Promise.all([ready, loadCatalogue()]).then(() => {
     if (state.catalogue || state.file || state.vertices.length >= 3) run();
@@ -1039,6 +1102,16 @@ function validate() {
   number("accuracy", "accuracy", 0, 180, true);
   number("max-actions", "max actions", 1, 1000, false);
   number("contact-noise", "contact noise", 0, 1, false);
+  number("max-opening", "max opening", 0, undefined, false);
+  number("min-opening", "min opening", 0, undefined, false);
+  const [hiO, loO] = [$("max-opening").value.trim(), $("min-opening").value.trim()];
+  if (hiO !== "" && loO !== "" && Number(loO) > Number(hiO) && !$("min-opening").getAttribute("aria-invalid")) {
+    fieldError("min-opening", "min opening: must be at most the max opening");
+    ok = false;
+  }
+  const needs = $("within-stroke").checked && hiO === "" && loO === "";
+  fieldError("within-stroke", needs ? "plan within the stroke: give the max and/or min opening" : "");
+  if (needs) ok = false;
   if ($("turn-kind").value) number("turn-deg", "turn error", 0, undefined, true);
   else fieldError("turn-deg", "");
   if ($("prior-kind").value === "vonmises") {
