@@ -782,3 +782,68 @@ def test_policy_nodes_draw_the_part(server: str, page: Any, cli_json: CliJson) -
             assert w >= nums[0] - 0.01
         elif "in [" in reads:
             assert nums[0] - 0.01 <= w < nums[1] + 0.01
+
+
+def _cli_export(tmp_path: Path, name: str, *args: str) -> bytes:
+    """The bytes ``bayesgrasp plan ARGS --export NAME`` writes."""
+    from bayesgrasp.cli import main
+
+    path = tmp_path / name
+    assert main(["plan", *args, "--export", str(path)]) == 0
+    return path.read_bytes()
+
+
+def _download(page: Any, button: str) -> tuple[str, bytes]:
+    with page.expect_download(timeout=60_000) as info:
+        page.click(button)
+    d = info.value
+    return d.suggested_filename, Path(d.path()).read_bytes()
+
+
+def test_robot_file_downloads_are_the_cli_export(
+    server: str, page: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze&min_opening=20")
+    page.wait_for_selector("#plans tbody tr")
+    for fmt in ("csv", "json"):
+        page.select_option("#export-format", fmt)
+        name, got = _download(page, "#export")
+        assert name == f"key-plan.{fmt}"
+        assert got == _cli_export(tmp_path, f"plan.{fmt}", "key", "--min-opening", "20")
+    # the policy's state machine, as plan --sense writes it
+    page.fill("#sense-depth", "2")
+    name, got = _download(page, "#export-policy")
+    assert name == "key-policy.json"
+    want = _cli_export(tmp_path, "policy.json", "key", "--sense", "width", "--max-actions", "2")
+    assert got == want
+    capsys.readouterr()
+
+
+def test_gripper_limits_in_the_url_plan_as_the_cli(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze&min_opening=20&within_stroke=1")
+    code, want = cli_json("plan", "key", "--min-opening", "20", "--within-stroke")
+    assert code == 0
+    _, free = cli_json("plan", "key")
+    assert expected_rows(want) != expected_rows(free)
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#min-opening").input_value() == "20"
+    assert page.locator("#within-stroke").is_checked()
+    # the inputs write the address; a stroke the part does not fit is refused in one line
+    page.goto("about:blank")
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    wait_rows(page, expected_rows(free))
+    page.fill("#max-opening", "2.6")
+    page.click("#plan")
+    page.wait_for_selector("#status.error")
+    code, err = cli_json("plan", "key", "--max-opening", "2.6")
+    assert code != 0 and "stroke" in err
+    assert "stroke" in page.locator("#status").text_content()
+    assert "max_opening=2.6" in page.url
+    # within the stroke with no limit is marked at the checkbox, not sent
+    page.fill("#max-opening", "")
+    page.check("#within-stroke")
+    page.click("#plan")
+    page.wait_for_selector("#within-stroke-error")
+    assert "opening" in page.locator("#within-stroke-error").text_content()
