@@ -267,7 +267,8 @@ def test_draw_change_prior_share_and_play(
     bayes = parsed(table(page))[peaked["bayes"]]
     assert bayes["angles"][0] == peaked["first_squeeze_rad"]
 
-    # the animation of the Bayes plan on eight starting orientations
+    # the animation of the Bayes plan on eight evenly spaced starting orientations
+    page.select_option("#anim-starts", "even")
     page.click("#play")
     page.wait_for_selector("#anim[data-done=true]", timeout=60_000)
     ok = page.locator("#anim rect.cell-ok").count()
@@ -275,6 +276,8 @@ def test_draw_change_prior_share_and_play(
     assert ok >= 1
     assert outcomes(page) == library_outcomes(page, TRIANGLE, "vonmises:30,4")
     assert "oriented" in page.locator("#anim-status").text_content()
+    page.select_option("#anim-starts", "random")
+    _finish_animation(page)
     SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SCREENSHOT), full_page=True)
     assert SCREENSHOT.stat().st_size > 10_000
@@ -463,7 +466,6 @@ def test_curved_upload_round_trip_through_the_shared_url(
     other.wait_for_selector("body[data-policy=done]")
     assert "sensorless Bayes plan 4.0000" in other.locator("#policy-summary").text_content()
     assert other.locator("#policy-nodes details.policy-node").count() >= 1
-    other.locator("#policy-nodes").screenshot(path=str(SCREENSHOT.with_name("web-policy.png")))
     # choosing a catalogue part forgets the file: its label and the URL follow
     other.select_option("#catalogue", "house")
     _, house = cli_json("plan", "house")
@@ -618,6 +620,7 @@ def test_plan_selector_animates_each_row_with_pushes(
     values = page.eval_on_selector_all("#anim-plan option", "(os) => os.map((o) => o.value)")
     assert values == [str(i) for i in range(len(want["options"]))]
     assert page.locator("#anim-plan").input_value() == str(want["bayes"])
+    page.select_option("#anim-starts", "even")
     acts = ("squeeze", "push-grasp")
     for i, option in enumerate(want["options"]):
         page.select_option("#anim-plan", str(i))
@@ -746,6 +749,7 @@ def test_policy_nodes_draw_the_part(server: str, page: Any, cli_json: CliJson) -
     leaves = page.locator("#policy-nodes li").count() - (nodes - 1)
     drawings = page.locator("#policy-nodes svg.policy-part polygon")
     assert drawings.count() == nodes + leaves
+    page.locator("#policy-nodes").screenshot(path=str(SCREENSHOT.with_name("web-policy.png")))
     declared = page.evaluate(
         """() => [...document.querySelectorAll('#policy-nodes li')]
             .filter((li) => !li.querySelector('details') && /declare/.test(li.textContent))

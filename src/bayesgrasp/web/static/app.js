@@ -693,7 +693,8 @@ function drawAnimationFrame(frame) {
   const what = { turn: "turn", squeeze: "squeeze", push: "push", close: "the other jaw closes" }[kind];
   $("anim-status").textContent = done
     ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%` +
-      `${Object.keys(noise()).length ? ", which counts the noise and payoff the animation leaves out" : ""})`
+      `${Object.keys(noise()).length ? ", which counts the noise and payoff the animation leaves out" : ""}` +
+      `${$("anim-starts").value === "even" ? "; evenly spaced starts are not weighted by the prior" : ""})`
     : `step ${stepOf} of ${o.steps.length}: ${what}`;
   svg.dataset.frame = String(f);
   svg.dataset.done = String(done);
