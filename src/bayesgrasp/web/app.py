@@ -59,6 +59,7 @@ from .gallery import Gallery
 from .models import (
     ERRORS,
     ErrorBody,
+    ExportRequest,
     FigureRequest,
     PartIn,
     PartRequest,
@@ -67,13 +68,16 @@ from .models import (
     ProblemOptions,
     SimulateJobRequest,
     SimulateRequest,
+    StrokeOptions,
 )
 from .workers import Lane, LimitError, failure_of
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..io.export import Stroke
     from ..model.problem import Problem
     from ..planning.result import PlanOption
+    from ..planning.strategy import StrategyResult
 
 __all__ = ["API", "Limits", "create_app"]
 
@@ -484,24 +488,88 @@ def push_document(service: Service, req: PartRequest) -> dict[str, Any]:
 
 
 def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
-    """``bayesgrasp plan PART [options] [--guaranteed] --json``."""
-    from ..cli.specs import guaranteed_plan, run_inputs
-    from ..io.plans import plan_document
+    """``bayesgrasp plan PART [options] [--guaranteed] [--max-opening W ...] --json``."""
+    from ..cli.specs import run_inputs
+    from ..cli.strategies import document
 
     spec = problem_spec(req)
-    part = service.part(req.part)
-    pb = build_problem(part, req, spec)
-    if req.noisy:
-        doc = noisy_plan_document(pb, req, run_inputs(None, spec))
-    else:
-        result = spec.plan(pb)
-        found = guaranteed_plan(pb) if req.guaranteed else None
-        sure, missing = (None, found) if isinstance(found, str) else (found, None)
-        inputs = run_inputs(None, spec)  # the provenance the command line writes
-        doc = plan_document(result, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
+    result = plan_strategy(service, req, spec)
+    doc = document(result, run_inputs(None, spec))
     if service.gallery is not None:
         remember_plan(service.gallery, req, doc)
     return doc
+
+
+def stroke_of(req: StrokeOptions) -> Stroke | None:
+    """The gripper's stroke of ``max_opening`` and ``min_opening`` (``None``: neither given)."""
+    if req.max_opening is None and req.min_opening is None:
+        return None
+    from ..io.export import Stroke
+
+    hi = math.inf if req.max_opening is None else req.max_opening
+    return Stroke(req.min_opening or 0.0, hi)
+
+
+def check_within_stroke(req: StrokeOptions, stroke: Stroke | None, policy: bool) -> None:
+    """Refuse ``within_stroke`` where it cannot plan (the command line's reasons)."""
+    if not req.within_stroke:
+        return
+    why = None
+    if stroke is None:
+        why = "needs the stroke: `max_opening` and/or `min_opening`"
+    elif policy:
+        why = "plans linear plans; a policy is checked against the stroke (drop `within_stroke`)"
+    elif req.noisy:
+        why = (
+            "searches noise-free plans; a noise-aware plan is checked against the stroke "
+            "(drop `within_stroke`)"
+        )
+    elif req.method != "exact":
+        why = "is its own planner; drop `method`"
+    elif req.accuracy:
+        why = "takes exact turns; drop `accuracy`"
+    if why is not None:
+        raise LimitError(422, f"`within_stroke`: {why}")
+
+
+def plan_strategy(service: Service, req: PlanRequest, spec: Any) -> StrategyResult:
+    """The plans of ``plan`` (:func:`bayesgrasp.planning.solve`, as the command line plans).
+
+    The noise-aware plans with the noise or payoff options; with ``within_stroke`` only plans
+    the stroke allows; with ``max_opening`` or ``min_opening`` a Bayes plan outside the stroke
+    is refused (:func:`~bayesgrasp.cli.strategies.check_stroke`).
+    """
+    from ..cli.strategies import check_stroke
+    from ..planning.strategy import solve
+
+    stroke = stroke_of(req)
+    check_within_stroke(req, stroke, policy=False)
+    pb = build_problem(service.part(req.part), req, spec)
+    if req.noisy:
+        from ..planning.robust import UNBOUNDED_GUARANTEE
+
+        _exact_method(req)
+        noise = req.noise_model()
+        if req.guaranteed and not noise.turn.exact and noise.turn.kind == "normal":
+            raise LimitError(422, f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
+        result = solve(
+            pb,
+            noise=noise,
+            payoff=req.payoff_model(),
+            max_actions=spec.max_actions,
+            guaranteed=req.guaranteed,
+        )
+    else:
+        within = None if stroke is None or not req.within_stroke else stroke
+        result = solve(
+            pb,
+            method=spec.method.value,
+            max_actions=spec.max_actions,
+            guaranteed=req.guaranteed,
+            stroke=None if within is None else (within.min_opening, within.max_opening),
+        )
+    check_stroke(result, stroke)
+    return result
 
 
 def remember_plan(gallery: Gallery, req: PlanRequest, doc: dict[str, Any]) -> None:
@@ -514,26 +582,6 @@ def gallery_entry(req: PlanRequest, doc: dict[str, Any]) -> tuple[Any, ...]:
     options = req.model_dump(exclude={"part"}, exclude_defaults=True)
     bayes = doc["options"][doc["bayes"]] if doc.get("options") else {}
     return doc["part"]["name"], doc["part"]["vertices"], options, bayes
-
-
-def noisy_plan_document(
-    pb: Problem, req: PlanRequest, inputs: dict[str, Any] | None = None
-) -> dict[str, Any]:
-    """``bayesgrasp plan PART --turn-noise ... --contact-noise ... --payoff FILE --json``.
-
-    The command line's run (:class:`bayesgrasp.cli.noisy.NoisyRun`: the noise-aware plans,
-    and with ``guaranteed`` the guaranteed plan under a bounded turn error), with the payoff
-    given inline; ``inputs`` the provenance the command line writes.
-    """
-    from ..cli.noisy import NoisyRun
-    from ..planning.robust import UNBOUNDED_GUARANTEE
-
-    _exact_method(req)
-    noise = req.noise_model()
-    if req.guaranteed and not noise.turn.exact and noise.turn.kind == "normal":
-        raise LimitError(422, f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
-    run = NoisyRun(noise, req.payoff_model(), req.max_actions, False, req.guaranteed)
-    return run.document(run.plan(pb), inputs)
 
 
 def _exact_method(req: PlanRequest | SimulateRequest) -> None:
@@ -549,28 +597,86 @@ def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
     With the noise or payoff options, the policy under the noisy actions
     (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`), as the command line plans it.
     """
-    from ..io.policies import policy_document
-    from ..planning.noisy_policy import plan_noisy_policy
-    from ..planning.policy import plan_policy
+    from ..cli.strategies import document
 
+    return document(policy_strategy(service, req))
+
+
+def policy_strategy(service: Service, req: PolicyRequest) -> StrategyResult:
+    """The Bayes policy of ``policy`` as a strategy; refused if outside the stroke given."""
+    from ..cli.strategies import check_stroke
+    from ..planning.noisy_policy import plan_noisy_policy
+    from ..planning.policy import Policy, plan_policy
+    from ..planning.strategy import StrategyResult
+
+    stroke = stroke_of(req)
+    check_within_stroke(req, stroke, policy=True)
     spec = problem_spec(req)
     parts = [service.part(p) for p in (req.part, *req.also)]
     problems = [build_problem(p, req, spec) for p in parts]
     prior = None if req.part_prior is None else ",".join(map(repr, req.part_prior))
+    pol: Policy
     if not req.noisy:
         pol = plan_policy(problems, sensor=req.sense, max_actions=req.max_actions, part_prior=prior)
-        return policy_document(pol)
-    if req.payoff is not None and len(problems) > 1:
-        raise LimitError(422, "`payoff`: a payoff is for one part: drop `also`")
-    pol = plan_noisy_policy(
-        problems,
-        req.sense,
-        req.max_actions,
-        req.noise_model(),
-        payoff=req.payoff_model(),
-        part_prior=prior,
-    )
-    return policy_document(pol)
+    else:
+        if req.payoff is not None and len(problems) > 1:
+            raise LimitError(422, "`payoff`: a payoff is for one part: drop `also`")
+        pol = plan_noisy_policy(
+            problems,
+            req.sense,
+            req.max_actions,
+            req.noise_model(),
+            payoff=req.payoff_model(),
+            part_prior=prior,
+        )
+    result = StrategyResult(tuple(problems), pol)
+    check_stroke(result, stroke)
+    return result
+
+
+def export_file(service: Service, req: ExportRequest) -> tuple[str, bytes]:
+    """``bayesgrasp plan PART [options] --export FILE.csv|json``: the file's name and bytes.
+
+    The Bayes plan (or with ``sense`` the policy's state machine) for a robot, written by the
+    command line's own writer (:func:`bayesgrasp.io.export.write_robot`, with the noise and
+    payoff of :func:`bayesgrasp.cli.strategies.robot_metadata`); the name is
+    ``PART-plan.FORMAT`` or ``PART-policy.FORMAT``.
+    """
+    import tempfile
+
+    from ..cli.strategies import robot_metadata
+    from ..io.export import write_robot
+
+    result = export_strategy(service, req)
+    problems: Any = result.problem if result.kind == "plan" else list(result.problems)
+    name = f"{result.problem.part.name}-{result.kind}.{req.format}"
+    with tempfile.TemporaryDirectory(prefix="bayesgrasp-export-") as tmp:
+        path = write_robot(
+            Path(tmp) / f"robot.{req.format}",
+            problems,
+            result.robot_strategy,
+            robot_metadata(result),
+        )
+        return name, path.read_bytes()
+
+
+def export_strategy(service: Service, req: ExportRequest) -> StrategyResult:
+    """The strategy an export writes: the plans of ``plan``, or with ``sense`` the policy."""
+    if req.sense is None:
+        if req.also or req.part_prior is not None:
+            raise LimitError(422, "`also` and `part_prior` need `sense`")
+        return plan_strategy(service, req, problem_spec(req))
+    if req.guaranteed:
+        raise LimitError(422, "`sense` plans a policy; it takes no `guaranteed`")
+    if req.method != "exact":
+        raise LimitError(422, "`sense` plans a policy; it takes no `method`")
+    body = req.model_dump(exclude={"format", "guaranteed"}, exclude_none=True)
+    body.setdefault("max_actions", 3)
+    try:
+        policy = PolicyRequest.model_validate(body)
+    except ValidationError as exc:
+        raise LimitError(422, _one_line(exc)) from None
+    return policy_strategy(service, policy)
 
 
 def simulate_document(
@@ -729,6 +835,7 @@ WORK: dict[str, Callable[..., Any]] = {
     "policy": policy_document_of,
     "simulate": simulate_document,
     "figure": figure_bytes,
+    "export": export_file,
     "functions": lambda service, req: views.function_samples(service, req),
 }
 
@@ -755,7 +862,7 @@ def lane_of(name: str, req: Any) -> LaneName:
     ``heavy``: policies, simulations, noise-aware plans and the ``bfs`` method; ``figures``:
     figures (about a second of drawing each); ``quick``: the rest.
     """
-    if name in ("policy", "simulate"):
+    if name in ("policy", "simulate") or getattr(req, "sense", None) is not None:
         return "heavy"
     if bool(getattr(req, "noisy", False)) or getattr(req, "method", "exact") != "exact":
         return "heavy"
@@ -898,6 +1005,33 @@ def create_app(data_dir: str | Path | None = None, limits: Limits | None = None)
     async def policy(req: PolicyRequest, timeout: float | None = TIMEOUT) -> Response:
         """The Bayes policy that branches on jaw widths (``plan --sense ... --json``)."""
         return await answer("policy", req, timeout)
+
+    @app.post(
+        f"{API}/export",
+        tags=["plans"],
+        response_class=Response,
+        responses={
+            200: {
+                "content": {"text/csv": {}, "application/json": {}},
+                "description": "The robot file, as an attachment named PART-plan.FORMAT "
+                "(PART-policy.FORMAT with `sense`).",
+            },
+            **ERRORS,
+        },
+    )
+    async def export(req: ExportRequest, timeout: float | None = TIMEOUT) -> Response:
+        """The robot file of ``bayesgrasp plan ... --export FILE.csv|json``, byte for byte.
+
+        The Bayes plan, one row a step (with the noise options: the noise-aware plan and its
+        noise model); with ``sense``: the policy's state machine.
+        """
+        name, data = await service.run("export", req, timeout=timeout)
+        media = "text/csv" if req.format == "csv" else "application/json"
+        return Response(
+            data,
+            media_type=media,
+            headers={"Content-Disposition": f'attachment; filename="{name}"'},
+        )
 
     @app.post(f"{API}/simulate", tags=["plans"], responses=ERRORS)
     async def simulate(req: SimulateRequest, timeout: float | None = TIMEOUT) -> Response:
