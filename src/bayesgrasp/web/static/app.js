@@ -1243,6 +1243,17 @@ async function loadFunctions(part, o, gen) {
   }
 }
 
+function sameAsTable(shown) {
+  // whether the figures' plan is the table's Bayes plan (same actions at the same angles)
+  if (!state.last) return true;
+  const { plan } = state.last;
+  const steps = plan.options[plan.bayes].steps;
+  return (
+    steps.length === shown.steps.length &&
+    steps.every((s, i) => s.type === shown.steps[i].type && Math.abs(deg(s.alpha_rad) - shown.steps[i].alpha_deg) < 1e-3)
+  );
+}
+
 function drawBelief(doc) {
   // one bar chart a step: the probability of each orientation after the step
   const box = $("belief");
@@ -1252,7 +1263,7 @@ function drawBelief(doc) {
     const W = 640, H = 120, L = 40, B = 26, T = 8;
     const svg = el("svg", { viewBox: `0 0 ${W} ${H}`, class: "chart belief", "data-step": k + 1 });
     const cap = document.createElement("figcaption");
-    const exact = Object.keys(noise()).length ? ", the noise-free Bayes plan (the table's plan is noise-aware)" : "";
+    const exact = sameAsTable(doc.plan) ? "" : ", the Bayes plan without the noise, payoff or stroke limits (the table's Bayes plan differs)";
     cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°${exact})`;
     const fig = document.createElement("figure");
     fig.append(cap, svg);
