@@ -851,3 +851,32 @@ def test_gripper_limits_in_the_url_plan_as_the_cli(
     page.click("#plan")
     page.wait_for_selector("#within-stroke-error")
     assert "opening" in page.locator("#within-stroke-error").text_content()
+
+
+def test_belief_figures_name_the_tables_plan(server: str, page: Any, cli_json: CliJson) -> None:
+    """With noise the belief figures show the table's noise-aware Bayes plan, or say so."""
+    for url, args in (
+        ("", ()),
+        (
+            "&turn_noise=normal:2&contact_noise=0.1",
+            ("--turn-noise", "normal:2", "--contact-noise", "0.1"),
+        ),
+    ):
+        page.goto("about:blank")
+        page.goto(server + "/#part=key&prior=uniform&actions=squeeze" + url)
+        _, want = cli_json("plan", "key", *args)
+        wait_rows(page, expected_rows(want))
+        shown = page.wait_for_function(
+            "() => state.functions && document.querySelectorAll('#belief svg.belief').length"
+            " === state.functions.plan.steps.length"
+            " && [state.functions.plan.steps.map((s) => s.alpha_deg),"
+            " [...document.querySelectorAll('#belief figcaption')].map((c) => c.textContent)]"
+        ).json_value()
+        steps, captions = shown
+        bayes = [math.degrees(s["alpha_rad"]) for s in want["options"][want["bayes"]]["steps"]]
+        same = len(steps) == len(bayes) and all(
+            abs(a - b) < 1e-3 for a, b in zip(steps, bayes, strict=True)
+        )
+        assert all(("differs" in c) != same for c in captions), (steps, bayes, captions)
+        if not args:
+            assert same
