@@ -123,7 +123,7 @@ def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str
 
     from ..errors import BayesGraspError
     from ..geometry.curved import CurvedPart, curved_radius, push_model, squeeze_model
-    from .app import chosen_option, problem_spec
+    from .problems import chosen_option, problem_spec
 
     spec = problem_spec(req)
     part = service.part(req.part)
