@@ -1,13 +1,12 @@
-"""The server's own routes: health, limits and the record of planned parts."""
+"""The server's own routes: health and limits."""
 
 from __future__ import annotations
 
 from typing import Any
 
-from fastapi import APIRouter, Query, Request
+from fastapi import APIRouter, Request
 
 from .limits import limits_document
-from .models import ErrorBody
 
 __all__ = ["router"]
 
@@ -32,11 +31,3 @@ async def health(request: Request) -> dict[str, Any]:
 async def limits(request: Request) -> dict[str, Any]:
     """The limits a request must keep to."""
     return limits_document(request.app.state.service.limits)
-
-
-@router.get("/gallery", responses={422: {"model": ErrorBody}})
-async def gallery_rows(request: Request, limit: int = Query(50, ge=1, le=10_000)) -> dict[str, Any]:
-    """The parts planned on this server, newest first."""
-    gallery = request.app.state.service.gallery
-    rows = gallery.rows(limit) if gallery is not None else []
-    return {"schema": "bayesgrasp.gallery/1", "rows": rows}

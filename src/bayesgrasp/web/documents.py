@@ -42,7 +42,6 @@ if TYPE_CHECKING:
     from ..model.problem import Problem
     from ..planning.result import PlanOption
     from ..planning.strategy import StrategyResult
-    from .gallery import Gallery
     from .service import Service
 
 __all__ = [
@@ -50,14 +49,12 @@ __all__ = [
     "export_file",
     "export_strategy",
     "figure_bytes",
-    "gallery_entry",
     "mujoco_result",
     "plan_result_document",
     "plan_strategy",
     "policy_document_of",
     "policy_strategy",
     "push_document",
-    "remember_plan",
     "simulate_document",
     "squeeze_document",
 ]
@@ -92,10 +89,7 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
 
     spec = problem_spec(req)
     result = plan_strategy(service, req, spec)
-    doc = document(result, run_inputs(None, spec))
-    if service.gallery is not None:
-        remember_plan(service.gallery, req, doc)
-    return doc
+    return document(result, run_inputs(None, spec))
 
 
 def plan_strategy(service: Service, req: PlanRequest, spec: Any) -> StrategyResult:
@@ -136,18 +130,6 @@ def plan_strategy(service: Service, req: PlanRequest, spec: Any) -> StrategyResu
         )
     check_stroke(result, stroke)
     return result
-
-
-def remember_plan(gallery: Gallery, req: PlanRequest, doc: dict[str, Any]) -> None:
-    """Add a planned part to the gallery (its name, outline, options and Bayes plan)."""
-    gallery.add(*gallery_entry(req, doc))
-
-
-def gallery_entry(req: PlanRequest, doc: dict[str, Any]) -> tuple[Any, ...]:
-    """The arguments of :meth:`Gallery.add` for a plan: name, outline, options, Bayes plan."""
-    options = req.model_dump(exclude={"part"}, exclude_defaults=True)
-    bayes = doc["options"][doc["bayes"]] if doc.get("options") else {}
-    return doc["part"]["name"], doc["part"]["vertices"], options, bayes
 
 
 def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:

@@ -8,7 +8,6 @@ files), a lane for figures and a heavy lane (policies, noise-aware plans, simula
 
 from __future__ import annotations
 
-import asyncio
 import base64
 import binascii
 import json
@@ -76,12 +75,12 @@ class Service:
         return await lane.run(run_work, (name, self.limits, req, *extra), self.timeout(timeout))
 
     async def answer(self, name: str, req: Any, timeout: float | None = None) -> Response:
-        """The JSON answer of the work ``name`` on ``req`` (a plan is added to the gallery)."""
+        """The JSON answer of the work ``name`` on ``req``.
+
+        Nothing is recorded: the gallery keeps only the views a user saves.
+        """
         lane = self.lane(lane_of(name, req))
-        args = (name, self.limits, req)
-        body, entry = await lane.run(work_json, args, self.timeout(timeout))
-        if entry is not None and self.gallery is not None:
-            await asyncio.to_thread(self.gallery.add, *entry)  # off the event loop
+        body = await lane.run(work_json, (name, self.limits, req), self.timeout(timeout))
         return Response(body, media_type="application/json")
 
     def lanes_status(self) -> dict[str, Any]:
@@ -192,15 +191,15 @@ def run_work(name: str, limits: Limits, req: Any, *extra: Any, **kwargs: Any) ->
     return WORK[name](Service(limits, None), req, *extra, **kwargs)
 
 
-def work_json(name: str, limits: Limits, req: Any) -> tuple[bytes, tuple[Any, ...] | None]:
-    """``WORK[name]``'s document as JSON bytes, and for a plan its gallery entry.
+def work_json(name: str, limits: Limits, req: Any) -> bytes:
+    """``WORK[name]``'s document as JSON bytes.
 
     The document is encoded in the worker, as the server's JSON answers are encoded, so that
     the server's event loop only passes the bytes on.
     """
     doc = run_work(name, limits, req)
     body = json.dumps(doc, ensure_ascii=False, allow_nan=False, separators=(",", ":")).encode()
-    return body, (documents.gallery_entry(req, doc) if name == "plan" else None)
+    return body
 
 
 def lane_of(name: str, req: Any) -> LaneName:
