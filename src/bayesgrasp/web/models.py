@@ -19,6 +19,7 @@ __all__ = [
     "ExportRequest",
     "FigureRequest",
     "FileIn",
+    "FunctionsRequest",
     "PartIn",
     "PartRequest",
     "PayoffIn",
@@ -308,6 +309,17 @@ class SimulateRequest(NoiseOptions):
 
 class FigureRequest(ProblemOptions):
     """The body of ``figures``: the figures ``plot`` makes."""
+
+    plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
+
+
+class FunctionsRequest(NoiseOptions):
+    """The body of ``views/functions``: the part's functions and the chosen plan's beliefs.
+
+    With ``turn_noise``, ``contact_noise`` or ``payoff``: the plan is the noise-aware one
+    ``plan`` gives under them (``guaranteed``: the plan guaranteed under a bounded turn error)
+    and the beliefs are the exact distributions under the noise.
+    """
 
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
 
