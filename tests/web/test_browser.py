@@ -854,7 +854,8 @@ def test_gripper_limits_in_the_url_plan_as_the_cli(
 
 
 def test_belief_figures_name_the_tables_plan(server: str, page: Any, cli_json: CliJson) -> None:
-    """With noise the belief figures show the table's noise-aware Bayes plan, or say so."""
+    """With noise the belief figures show the table's noise-aware Bayes plan; the last
+    belief's mass at the goal is its success probability; a plan that differs says so."""
     for url, args in (
         ("", ()),
         (
@@ -878,5 +879,18 @@ def test_belief_figures_name_the_tables_plan(server: str, page: Any, cli_json: C
             abs(a - b) < 1e-3 for a, b in zip(steps, bayes, strict=True)
         )
         assert all(("differs" in c) != same for c in captions), (steps, bayes, captions)
-        if not args:
-            assert same
+        assert same  # the noise-aware plan's beliefs, under the noise
+        goal = page.evaluate(
+            "() => [...document.querySelectorAll('#belief svg.belief')].pop()"
+            ".querySelectorAll('rect[fill=\"#2a9a2a\"]').length"
+        )
+        mass = page.evaluate(
+            "() => { const last = state.functions.belief[state.functions.belief.length - 1];"
+            " const f = state.functions.plan.final_deg;"
+            " return last.filter((a) => Math.abs(((a.orientation_deg - f + 540) % 360) - 180)"
+            " < 1e-6).reduce((t, a) => t + a.probability, 0); }"
+        )
+        assert goal >= 1
+        assert mass == pytest.approx(
+            want["options"][want["bayes"]]["success_probability"], abs=1e-6
+        )

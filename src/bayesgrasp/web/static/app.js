@@ -1222,7 +1222,8 @@ const FUNCTION_NAMES = {
 
 async function loadFunctions(part, o, gen) {
   try {
-    const doc = await post("/views/functions", { part, ...o });
+    // the noise and payoff too: the beliefs of the table's noise-aware Bayes plan
+    const doc = await postWhenFree("/views/functions", { part, ...o, ...noise() }, gen);
     if (gen !== generation) return;
     state.functions = doc;
     const box = $("functions");
@@ -1263,7 +1264,7 @@ function drawBelief(doc) {
     const W = 640, H = 120, L = 40, B = 26, T = 8;
     const svg = el("svg", { viewBox: `0 0 ${W} ${H}`, class: "chart belief", "data-step": k + 1 });
     const cap = document.createElement("figcaption");
-    const exact = sameAsTable(doc.plan) ? "" : ", the Bayes plan without the noise, payoff or stroke limits (the table's Bayes plan differs)";
+    const exact = sameAsTable(doc.plan) ? "" : ", the Bayes plan without the stroke limits (the table's Bayes plan differs)";
     cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°${exact})`;
     const fig = document.createElement("figure");
     fig.append(cap, svg);
