@@ -561,6 +561,7 @@ MATRIX = [
     (("select", "#goal", "symmetry"), ["--goal", "symmetry"], "goal=symmetry"),
     (("fill", "#max-actions", "2"), ["--max-actions", "2"], "max_actions=2"),
     (("check", "#act-push-grasp", ""), ["--actions", "squeeze,push-grasp"], "push-grasp"),
+    (("fill", "#min-opening", "1"), ["--min-opening", "1"], "min_opening=1"),
 ]
 
 
@@ -597,7 +598,7 @@ def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
         bayes = want["options"][want["bayes"]]
         assert steps == pytest.approx([math.degrees(s["alpha_rad"]) for s in bayes["steps"]])
         # the shared link gives the same table in a fresh page
-        if in_url in ("goal=symmetry", "push-grasp"):
+        if in_url in ("goal=symmetry", "push-grasp", "min_opening=1"):
             other = page.context.new_page()
             other.goto(page.url)
             wait_rows(other, expected_rows(want))
