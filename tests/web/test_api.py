@@ -238,7 +238,7 @@ def test_catalogue_endpoint(client: TestClient) -> None:
 
 def test_openapi_lists_the_api(client: TestClient) -> None:
     paths = client.get("/openapi.json").json()["paths"]
-    for p in ("squeeze", "push", "plan", "simulate", "catalogue", "gallery"):
+    for p in ("squeeze", "push", "plan", "policy", "export", "simulate", "catalogue", "saved"):
         assert f"/api/v1/{p}" in paths
     assert "/api/v1/figures/{name}.{fmt}" in paths
 
@@ -250,15 +250,22 @@ def test_page_and_assets(client: TestClient) -> None:
         assert client.get(f"/static/{asset}").status_code == 200
 
 
-def test_gallery_keeps_planned_parts_bounded(make_client: Any) -> None:
+def test_plans_are_not_recorded_and_a_curved_part_keeps_its_model(make_client: Any) -> None:
+    """Planning stores nothing (no hull of a curved upload); the gallery is what users save."""
     client = make_client(gallery_rows=3)
-    for k in range(5):
-        verts = [[0, 0], [10 + k, 0], [0, 7]]
-        assert client.post("/api/v1/plan", json={"part": {"vertices": verts}}).status_code == 200
-    client.post("/api/v1/plan", json={"part": {"vertices": [[0, 0], [14, 0], [0, 7]]}})
-    rows = client.get("/api/v1/gallery").json()["rows"]
-    assert len(rows) == 3
-    assert [r["vertices"][1][0] for r in rows] == [14.0, 13.0, 12.0]
+    peanut = (Path(__file__).resolve().parents[2] / "examples" / "peanut.svg").read_bytes()
+    data = base64.b64encode(peanut).decode()
+    part = {"name": "peanut", "file": {"format": "svg", "data_base64": data}}
+    for body in ({"part": part}, {"part": {"vertices": [[0, 0], [10, 0], [0, 7]]}}):
+        assert client.post("/api/v1/plan", json=body).status_code == 200
+    service = client.app.state.service  # type: ignore[attr-defined]
+    assert len(service.gallery) == 0
+    assert client.get("/api/v1/saved").json()["total"] == 0
+    assert client.get("/api/v1/gallery").status_code == 404  # the automatic record is gone
+    # the curved part planned from its exact model: 1 squeeze, p 0.5, cost 4 (its hull: 2)
+    doc = client.post("/api/v1/plan", json={"part": part}).json()
+    bayes = doc["options"][doc["bayes"]]
+    assert (bayes["squeezes"], bayes["success_probability"]) == (1, 0.5)
 
 
 @pytest.mark.parametrize("command", ["squeeze", "push"])

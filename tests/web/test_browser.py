@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -202,17 +203,32 @@ def outcomes(page: Any) -> list[tuple[float, bool]]:
     return [(float(a), bool(b)) for a, b in cells]
 
 
-def library_outcomes(page: Any, vertices: Any, prior: str) -> list[tuple[float, bool]]:
-    """The same starts run through the library's transfer functions and goal."""
+def library_outcomes(
+    page: Any,
+    vertices: Any,
+    prior: str,
+    index: int | None = None,
+    actions: tuple[str, ...] = ("squeeze",),
+) -> list[tuple[float, bool]]:
+    """The same starts run through the library's transfer functions and goal.
+
+    ``vertices`` is a list of points or a catalogue name; ``index`` the plan's row (Bayes when
+    None).
+    """
     import numpy as np
 
+    from bayesgrasp import shapes
     from bayesgrasp.cli.specs import ProblemSpec
     from bayesgrasp.geometry import Part
     from bayesgrasp.model.problem import nearest_state
 
-    spec = ProblemSpec(prior=prior)
-    pb = spec.build(Part.from_points(np.array(vertices)))
-    option = spec.plan(pb).bayes_plan
+    spec = ProblemSpec(prior=prior, actions=actions)
+    part = (
+        shapes.load(vertices) if isinstance(vertices, str) else Part.from_points(np.array(vertices))
+    )
+    pb = spec.build(part)
+    result = spec.plan(pb)
+    option = result.bayes_plan if index is None else result.options[index]
     starts = np.array([a for a, _ in outcomes(page)])
     theta = starts.copy()
     for s in option.steps:
@@ -251,7 +267,8 @@ def test_draw_change_prior_share_and_play(
     bayes = parsed(table(page))[peaked["bayes"]]
     assert bayes["angles"][0] == peaked["first_squeeze_rad"]
 
-    # the animation of the Bayes plan on eight starting orientations
+    # the animation of the Bayes plan on eight evenly spaced starting orientations
+    page.select_option("#anim-starts", "even")
     page.click("#play")
     page.wait_for_selector("#anim[data-done=true]", timeout=60_000)
     ok = page.locator("#anim rect.cell-ok").count()
@@ -259,6 +276,8 @@ def test_draw_change_prior_share_and_play(
     assert ok >= 1
     assert outcomes(page) == library_outcomes(page, TRIANGLE, "vonmises:30,4")
     assert "oriented" in page.locator("#anim-status").text_content()
+    page.select_option("#anim-starts", "random")
+    _finish_animation(page)
     SCREENSHOT.parent.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SCREENSHOT), full_page=True)
     assert SCREENSHOT.stat().st_size > 10_000
@@ -447,7 +466,6 @@ def test_curved_upload_round_trip_through_the_shared_url(
     other.wait_for_selector("body[data-policy=done]")
     assert "sensorless Bayes plan 4.0000" in other.locator("#policy-summary").text_content()
     assert other.locator("#policy-nodes details.policy-node").count() >= 1
-    other.locator("#policy-nodes").screenshot(path=str(SCREENSHOT.with_name("web-policy.png")))
     # choosing a catalogue part forgets the file: its label and the URL follow
     other.select_option("#catalogue", "house")
     _, house = cli_json("plan", "house")
@@ -543,6 +561,7 @@ MATRIX = [
     (("select", "#goal", "symmetry"), ["--goal", "symmetry"], "goal=symmetry"),
     (("fill", "#max-actions", "2"), ["--max-actions", "2"], "max_actions=2"),
     (("check", "#act-push-grasp", ""), ["--actions", "squeeze,push-grasp"], "push-grasp"),
+    (("fill", "#min-opening", "1"), ["--min-opening", "1"], "min_opening=1"),
 ]
 
 
@@ -579,8 +598,300 @@ def test_stale_state_matrix(server: str, page: Any, cli_json: CliJson) -> None:
         bayes = want["options"][want["bayes"]]
         assert steps == pytest.approx([math.degrees(s["alpha_rad"]) for s in bayes["steps"]])
         # the shared link gives the same table in a fresh page
-        if in_url in ("goal=symmetry", "push-grasp"):
+        if in_url in ("goal=symmetry", "push-grasp", "min_opening=1"):
             other = page.context.new_page()
             other.goto(page.url)
             wait_rows(other, expected_rows(want))
             other.close()
+
+
+def _finish_animation(page: Any) -> None:
+    """Draw the animation's last frame at once (Play draws the same frames on a timer)."""
+    page.evaluate("() => drawAnimationFrame(1e9)")
+    page.wait_for_selector("#anim[data-done=true]")
+
+
+def test_plan_selector_animates_each_row_with_pushes(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    """Every row of the table can be animated; a push-grasp is a push, then a close."""
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze,push-grasp")
+    _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
+    wait_rows(page, expected_rows(want))
+    values = page.eval_on_selector_all("#anim-plan option", "(os) => os.map((o) => o.value)")
+    assert values == [str(i) for i in range(len(want["options"]))]
+    assert page.locator("#anim-plan").input_value() == str(want["bayes"])
+    page.select_option("#anim-starts", "even")
+    acts = ("squeeze", "push-grasp")
+    for i, option in enumerate(want["options"]):
+        page.select_option("#anim-plan", str(i))
+        page.click("#play")
+        page.wait_for_selector("#anim[data-done=true]", timeout=60_000)
+        steps = option["steps"]
+        assert page.locator("#anim").get_attribute("data-steps") == str(len(steps))
+        kinds = [
+            k
+            for s in steps
+            for k in (("turn", "squeeze") if s["type"] == "squeeze" else ("turn", "push", "close"))
+        ]
+        assert page.locator("#anim").get_attribute("data-segments") == ",".join(kinds)
+        assert outcomes(page) == library_outcomes(page, "house", "uniform", i, acts)
+
+    # a push frame: the pushing jaw and its arrow in every cell; a squeeze frame: neither
+    page.select_option("#anim-plan", "1")  # push-grasp, squeeze
+    cells = 8
+    push_frame = 1 * 12 + 6  # the second segment (turn, push, close, turn, squeeze)
+    page.evaluate(f"() => drawAnimationFrame({push_frame})")
+    assert page.locator("#anim").get_attribute("data-kind") == "push"
+    assert page.locator("#anim line.jaw.pusher").count() == cells
+    assert page.locator("#anim .push-arrow").count() == cells
+    assert "push" in page.locator("#anim-status").text_content()
+    squeeze_frame = 4 * 12 + 6
+    page.evaluate(f"() => drawAnimationFrame({squeeze_frame})")
+    assert page.locator("#anim").get_attribute("data-kind") == "squeeze"
+    assert page.locator("#anim line.jaw.pusher").count() == 0
+    assert page.locator("#anim .push-arrow").count() == 0
+    assert page.locator("#anim line.jaw.closing").count() == 2 * cells
+
+
+def _binomial_ok(k: int, n: int, p: float) -> bool:
+    """k successes of n near n p: within four standard deviations (about 6e-5 to fail)."""
+    return abs(k - n * p) <= 4 * math.sqrt(n * p * (1 - p)) + 1
+
+
+def test_random_starts_succeed_as_often_as_predicted(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    page.goto(server + "/#part=house&prior=uniform&actions=squeeze,push-grasp")
+    _, want = cli_json("plan", "house", "--actions", "squeeze,push-grasp")
+    wait_rows(page, expected_rows(want))
+    page.select_option("#anim-starts", "random")
+    page.fill("#anim-n", "400")
+    page.fill("#anim-seed", "7")
+    acts = ("squeeze", "push-grasp")
+    for i in (0, 2):
+        page.select_option("#anim-plan", str(i))
+        _finish_animation(page)
+        got = outcomes(page)
+        assert len(got) == 400
+        assert got == library_outcomes(page, "house", "uniform", i, acts)
+        k = sum(ok for _, ok in got)
+        p = want["options"][i]["success_probability"]
+        assert _binomial_ok(k, 400, p), (k, p)
+        assert page.locator("#anim").get_attribute("data-oriented") == str(k)
+        assert f"{k} of 400 oriented" in page.locator("#anim-status").text_content()
+    # the same seed gives the same starts; another seed others
+    first = [a for a, _ in outcomes(page)]
+    _finish_animation(page)
+    assert [a for a, _ in outcomes(page)] == first
+    page.fill("#anim-seed", "8")
+    _finish_animation(page)
+    assert [a for a, _ in outcomes(page)] != first
+
+    # a von Mises prior: the starts gather at its mean, and the Bayes plan succeeds as predicted
+    page.goto("about:blank")
+    page.goto(server + "/#v=25,25;75,25;40,70&prior=vonmises:30,4&actions=squeeze")
+    page.wait_for_selector("#plans tbody tr")
+    page.wait_for_function("() => state.last && state.last.plan.part.n_sides === 3")
+    page.select_option("#anim-starts", "random")
+    page.fill("#anim-n", "400")
+    page.fill("#anim-seed", "3")
+    _finish_animation(page)
+    got = outcomes(page)
+    starts = [a for a, _ in got]
+    mean = math.degrees(
+        math.atan2(sum(math.sin(a) for a in starts), sum(math.cos(a) for a in starts))
+    )
+    assert abs(mean - 30) < 6  # the circular standard error is about 1.6 deg
+    resultant = math.hypot(sum(math.sin(a) for a in starts), sum(math.cos(a) for a in starts))
+    # E cos(theta - mu) = I1(4) / I0(4) = 0.8635 for kappa 4
+    assert abs(resultant / 400 - 0.8635) < 0.03
+    assert got == library_outcomes(page, TRIANGLE, "vonmises:30,4")
+    bayes = page.evaluate(
+        "() => state.last.plan.options[state.last.plan.bayes].success_probability"
+    )
+    assert _binomial_ok(sum(ok for _, ok in got), 400, bayes)
+
+
+def test_guaranteed_plan_in_the_table_and_the_selector(
+    server: str, page: Any, cli_json: CliJson, tmp_path: Path
+) -> None:
+    page.goto(server + "/")
+    draw_triangle(page)
+    page.wait_for_selector("#plans tbody tr")
+    page.check("#guaranteed")
+    page.click("#plan")
+    page.wait_for_selector("#plans tr.guaranteed")
+    doc = cli_plan(cli_json, tmp_path, TRIANGLE, "--guaranteed")
+    g = doc["guaranteed"]
+    assert "guaranteed=1" in page.url
+    row = page.locator("#plans tr.guaranteed td").all_text_contents()
+    assert row[0] == f"{g['squeezes']} " + "S" * len(g["steps"])
+    assert row[3] == f"{g['success_probability']:.4f}"
+    page.select_option("#anim-plan", "guaranteed")
+    _finish_animation(page)
+    assert page.locator("#anim").get_attribute("data-steps") == str(len(g["steps"]))
+    # the link keeps the guaranteed plan
+    other = page.context.new_page()
+    other.goto(page.url)
+    other.wait_for_selector("#plans tr.guaranteed")
+    assert other.locator("#guaranteed").is_checked()
+    other.close()
+
+
+def test_policy_nodes_draw_the_part(server: str, page: Any, cli_json: CliJson) -> None:
+    """Each node of the tree draws the part: declarations at the declared orientation,
+    the others at the belief's most probable orientation (a stable one whose width fits)."""
+    page.goto(server + "/#part=house")
+    page.wait_for_selector("#plans tbody tr")
+    page.click("#policy")
+    page.wait_for_function("document.body.dataset.policy === 'done'")
+    nodes = page.locator("#policy-nodes details").count()
+    leaves = page.locator("#policy-nodes li").count() - (nodes - 1)
+    drawings = page.locator("#policy-nodes svg.policy-part polygon")
+    assert drawings.count() == nodes + leaves
+    page.locator("#policy-nodes").screenshot(path=str(SCREENSHOT.with_name("web-policy.png")))
+    declared = page.evaluate(
+        """() => [...document.querySelectorAll('#policy-nodes li')]
+            .filter((li) => !li.querySelector('details') && /declare/.test(li.textContent))
+            .map((li) => [Number(li.querySelector('svg').dataset.orientation),
+                          Number(/declare (-?[0-9.]+)°/.exec(li.textContent)[1])])"""
+    )
+    assert declared
+    for drawn, said in declared:
+        assert drawn == pytest.approx(said, abs=0.006)
+    # the second level's orientations are stable orientations of a squeeze whose jaw width
+    # lies in the branch's reading interval
+    _, sq = cli_json("squeeze", "house")
+    hull = sq["part"]["vertices"]
+    stable = [math.degrees(t) for t in sq["stable_orientations_rad"]]
+
+    def width(theta: float) -> float:
+        t = math.radians(theta)
+        xs = [math.cos(t) * x - math.sin(t) * y for x, y in hull]
+        return max(xs) - min(xs)
+
+    second = page.evaluate(
+        """() => [...document.querySelectorAll('#policy-nodes > details > ul > li > details')]
+            .map((d) => [Number(d.querySelector('summary svg').dataset.orientation),
+                         d.parentElement.firstChild.textContent])"""
+    )
+    assert second
+    for theta, reads in second:
+        assert min(abs((theta - s + 180) % 360 - 180) for s in stable) < 1e-6
+        nums = [float(x) for x in re.findall(r"[0-9]+\.?[0-9]*", reads.split("(p =")[0])]
+        w = width(theta)
+        if "below" in reads:
+            assert w < nums[0] + 0.01
+        elif "or more" in reads:
+            assert w >= nums[0] - 0.01
+        elif "in [" in reads:
+            assert nums[0] - 0.01 <= w < nums[1] + 0.01
+
+
+def _cli_export(tmp_path: Path, name: str, *args: str) -> bytes:
+    """The bytes ``bayesgrasp plan ARGS --export NAME`` writes."""
+    from bayesgrasp.cli import main
+
+    path = tmp_path / name
+    assert main(["plan", *args, "--export", str(path)]) == 0
+    return path.read_bytes()
+
+
+def _download(page: Any, button: str) -> tuple[str, bytes]:
+    with page.expect_download(timeout=60_000) as info:
+        page.click(button)
+    d = info.value
+    return d.suggested_filename, Path(d.path()).read_bytes()
+
+
+def test_robot_file_downloads_are_the_cli_export(
+    server: str, page: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze&min_opening=20")
+    page.wait_for_selector("#plans tbody tr")
+    for fmt in ("csv", "json"):
+        page.select_option("#export-format", fmt)
+        name, got = _download(page, "#export")
+        assert name == f"key-plan.{fmt}"
+        assert got == _cli_export(tmp_path, f"plan.{fmt}", "key", "--min-opening", "20")
+    # the policy's state machine, as plan --sense writes it
+    page.fill("#sense-depth", "2")
+    name, got = _download(page, "#export-policy")
+    assert name == "key-policy.json"
+    want = _cli_export(tmp_path, "policy.json", "key", "--sense", "width", "--max-actions", "2")
+    assert got == want
+    capsys.readouterr()
+
+
+def test_gripper_limits_in_the_url_plan_as_the_cli(
+    server: str, page: Any, cli_json: CliJson
+) -> None:
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze&min_opening=20&within_stroke=1")
+    code, want = cli_json("plan", "key", "--min-opening", "20", "--within-stroke")
+    assert code == 0
+    _, free = cli_json("plan", "key")
+    assert expected_rows(want) != expected_rows(free)
+    wait_rows(page, expected_rows(want))
+    assert page.locator("#min-opening").input_value() == "20"
+    assert page.locator("#within-stroke").is_checked()
+    # the inputs write the address; a stroke the part does not fit is refused in one line
+    page.goto("about:blank")
+    page.goto(server + "/#part=key&prior=uniform&actions=squeeze")
+    wait_rows(page, expected_rows(free))
+    page.fill("#max-opening", "2.6")
+    page.click("#plan")
+    page.wait_for_selector("#status.error")
+    code, err = cli_json("plan", "key", "--max-opening", "2.6")
+    assert code != 0 and "stroke" in err
+    assert "stroke" in page.locator("#status").text_content()
+    assert "max_opening=2.6" in page.url
+    # within the stroke with no limit is marked at the checkbox, not sent
+    page.fill("#max-opening", "")
+    page.check("#within-stroke")
+    page.click("#plan")
+    page.wait_for_selector("#within-stroke-error")
+    assert "opening" in page.locator("#within-stroke-error").text_content()
+
+
+def test_belief_figures_name_the_tables_plan(server: str, page: Any, cli_json: CliJson) -> None:
+    """With noise the belief figures show the table's noise-aware Bayes plan; the last
+    belief's mass at the goal is its success probability; a plan that differs says so."""
+    for url, args in (
+        ("", ()),
+        (
+            "&turn_noise=normal:2&contact_noise=0.1",
+            ("--turn-noise", "normal:2", "--contact-noise", "0.1"),
+        ),
+    ):
+        page.goto("about:blank")
+        page.goto(server + "/#part=key&prior=uniform&actions=squeeze" + url)
+        _, want = cli_json("plan", "key", *args)
+        wait_rows(page, expected_rows(want))
+        shown = page.wait_for_function(
+            "() => state.functions && document.querySelectorAll('#belief svg.belief').length"
+            " === state.functions.plan.steps.length"
+            " && [state.functions.plan.steps.map((s) => s.alpha_deg),"
+            " [...document.querySelectorAll('#belief figcaption')].map((c) => c.textContent)]"
+        ).json_value()
+        steps, captions = shown
+        bayes = [math.degrees(s["alpha_rad"]) for s in want["options"][want["bayes"]]["steps"]]
+        same = len(steps) == len(bayes) and all(
+            abs(a - b) < 1e-3 for a, b in zip(steps, bayes, strict=True)
+        )
+        assert all(("differs" in c) != same for c in captions), (steps, bayes, captions)
+        assert same  # the noise-aware plan's beliefs, under the noise
+        goal = page.evaluate(
+            "() => [...document.querySelectorAll('#belief svg.belief')].pop()"
+            ".querySelectorAll('rect[fill=\"#2a9a2a\"]').length"
+        )
+        mass = page.evaluate(
+            "() => { const last = state.functions.belief[state.functions.belief.length - 1];"
+            " const f = state.functions.plan.final_deg;"
+            " return last.filter((a) => Math.abs(((a.orientation_deg - f + 540) % 360) - 180)"
+            " < 1e-6).reduce((t, a) => t + a.probability, 0); }"
+        )
+        assert goal >= 1
+        assert mass == pytest.approx(
+            want["options"][want["bayes"]]["success_probability"], abs=1e-6
+        )

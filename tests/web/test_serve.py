@@ -50,13 +50,15 @@ def test_default_data_dir(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> No
     assert default_data_dir().name == "bayesgrasp"
 
 
-def test_gallery_refreshes_a_repeated_part(tmp_path: Path) -> None:
+def test_gallery_refreshes_a_repeated_view(tmp_path: Path) -> None:
     g = Gallery(tmp_path, max_rows=2)
     tri = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]
-    g.add("a", tri, {}, {"success_probability": 0.5, "expected_cost": 4.0, "squeezes": 1})
-    g.add("b", [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0]], {}, {})
-    g.add("a", tri, {}, {"success_probability": 0.5, "expected_cost": 4.0, "squeezes": 1})
-    assert [r["name"] for r in g.rows()] == ["a", "b"]
+    first = g.save("a", "part=house", tri, {"expected_cost": 4.0})
+    g.save("b", "part=key", tri, {})
+    assert g.save("a", "part=house", tri, {"expected_cost": 4.0}) == first
+    assert [r["name"] for r in g.saved_page(1, 10)["rows"]] == ["a", "b"]
     assert len(g) == 2
+    g.save("c", "part=lever", tri, {})
+    assert [r["name"] for r in g.saved_page(1, 10)["rows"]] == ["c", "a"]
     with pytest.raises(ValueError, match="max_rows"):
         Gallery(tmp_path, max_rows=0)

@@ -1,8 +1,9 @@
-"""The gallery: the parts planned on this server, kept in SQLite, bounded in rows.
+"""The gallery: the views users saved on this server, kept in SQLite, bounded in rows.
 
-One row a distinct (part, options) pair: its name, hull vertices, the options it was planned
-with and the Bayes plan's numbers. Planning the same pair again only refreshes its time; when
-there are more than ``max_rows`` rows the oldest go.
+One row a saved view: its name, the page's address fragment (the part as the user gave it
+and every option, so the entry reproduces the view), the outline for a thumbnail and the
+plan's numbers. Saving the same view again only refreshes its time; when there are more than
+``max_rows`` rows the oldest go. Nothing is recorded unless a user saves it.
 """
 
 from __future__ import annotations
@@ -24,16 +25,6 @@ DEFAULT_MAX_ROWS = 500
 """Rows the gallery keeps by default."""
 
 _SCHEMA = """
-CREATE TABLE IF NOT EXISTS parts (
-    key TEXT PRIMARY KEY,
-    name TEXT NOT NULL,
-    vertices TEXT NOT NULL,
-    options TEXT NOT NULL,
-    success_probability REAL,
-    expected_cost REAL,
-    squeezes INTEGER,
-    updated REAL NOT NULL
-);
 CREATE TABLE IF NOT EXISTS saved (
     key TEXT PRIMARY KEY,
     name TEXT NOT NULL,
@@ -75,10 +66,10 @@ class Gallery:
     --------
     >>> import tempfile
     >>> g = Gallery(tempfile.mkdtemp(), max_rows=1)
-    >>> g.add("a", [[0, 0], [1, 0], [0, 1]], {}, {"success_probability": 1.0})
-    >>> g.add("b", [[0, 0], [2, 0], [0, 1]], {}, {"success_probability": 1.0})
-    >>> [row["name"] for row in g.rows()]
-    ['b']
+    >>> _ = g.save("a", "part=house", [[0, 0], [1, 0], [0, 1]], {})
+    >>> _ = g.save("b", "part=key", [[0, 0], [2, 0], [0, 1]], {})
+    >>> [row["name"] for row in g.saved_page(1, 10)["rows"]], len(g)
+    (['b'], 1)
     """
 
     def __init__(self, data_dir: str | Path, max_rows: int = DEFAULT_MAX_ROWS) -> None:
@@ -102,59 +93,6 @@ class Gallery:
                 yield db
         finally:
             db.close()
-
-    def add(
-        self,
-        name: str,
-        vertices: list[list[float]],
-        options: dict[str, Any],
-        bayes: dict[str, Any],
-    ) -> None:
-        """Record a planned part (or refresh its time), then drop rows beyond ``max_rows``."""
-        verts = json.dumps(vertices, separators=(",", ":"))
-        opts = json.dumps(options, sort_keys=True, separators=(",", ":"))
-        key = hashlib.sha256(f"{verts}\n{opts}".encode()).hexdigest()
-        row = (
-            key,
-            name[:80],
-            verts,
-            opts,
-            bayes.get("success_probability"),
-            bayes.get("expected_cost"),
-            bayes.get("squeezes"),
-            time.time(),
-        )
-        with self._lock, self._connect() as db:
-            db.execute("INSERT OR REPLACE INTO parts VALUES (?, ?, ?, ?, ?, ?, ?, ?)", row)
-            db.execute(
-                "DELETE FROM parts WHERE key NOT IN "
-                "(SELECT key FROM parts ORDER BY updated DESC, rowid DESC LIMIT ?)",
-                (self.max_rows,),
-            )
-
-    def rows(self, limit: int | None = None) -> list[dict[str, Any]]:
-        """The rows, newest first (at most ``limit``)."""
-        n = self.max_rows if limit is None else max(0, min(limit, self.max_rows))
-        with self._lock, self._connect() as db:
-            cur = db.execute(
-                "SELECT key, name, vertices, options, success_probability, expected_cost, "
-                "squeezes, updated FROM parts ORDER BY updated DESC, rowid DESC LIMIT ?",
-                (n,),
-            )
-            found = cur.fetchall()
-        return [
-            {
-                "id": key[:16],
-                "name": name,
-                "vertices": json.loads(verts),
-                "options": json.loads(opts),
-                "success_probability": p,
-                "expected_cost": c,
-                "squeezes": k,
-                "updated": t,
-            }
-            for key, name, verts, opts, p, c, k, t in found
-        ]
 
     def save(
         self, name: str, view: str, outline: list[list[float]], summary: dict[str, Any]
@@ -216,6 +154,7 @@ class Gallery:
         return {"page": page, "per_page": per_page, "total": int(total), "rows": rows}
 
     def __len__(self) -> int:
+        """The number of saved views."""
         with self._lock, self._connect() as db:
-            (n,) = db.execute("SELECT COUNT(*) FROM parts").fetchone()
+            (n,) = db.execute("SELECT COUNT(*) FROM saved").fetchone()
         return int(n)

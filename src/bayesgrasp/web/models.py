@@ -16,8 +16,10 @@ from pydantic_core import PydanticCustomError
 
 __all__ = [
     "ErrorBody",
+    "ExportRequest",
     "FigureRequest",
     "FileIn",
+    "FunctionsRequest",
     "PartIn",
     "PartRequest",
     "PayoffIn",
@@ -26,6 +28,7 @@ __all__ = [
     "ProblemOptions",
     "SimulateJobRequest",
     "SimulateRequest",
+    "StrokeOptions",
 ]
 
 Cost = Annotated[float, Field(ge=0, le=1e12)]
@@ -248,7 +251,32 @@ class NoiseOptions(ProblemOptions):
         return Payoff(np.radians(degs), np.array(values), self.payoff.default, "request")
 
 
-class PlanRequest(NoiseOptions):
+class StrokeOptions(NoiseOptions):
+    """The gripper's stroke (``--max-opening``, ``--min-opening``, ``--within-stroke``)."""
+
+    max_opening: float | None = Field(
+        None,
+        ge=0,
+        le=1e12,
+        description="The widest the gripper opens, in the part's units (--max-opening): a plan "
+        "or policy with a step that needs the jaws open wider is refused (422).",
+    )
+    min_opening: float | None = Field(
+        None,
+        ge=0,
+        le=1e12,
+        description="The narrowest the gripper closes, in the part's units (--min-opening): a "
+        "plan or policy with a step that may close the jaws narrower is refused (422).",
+    )
+    within_stroke: bool = Field(
+        False,
+        description="Plan only actions the stroke allows (--within-stroke): the best plan of "
+        "each length whose every step fits (noise-free plans of one part, exact method, no "
+        "accuracy).",
+    )
+
+
+class PlanRequest(StrokeOptions):
     """The body of ``plan``.
 
     With ``turn_noise``, ``contact_noise`` or ``payoff``: the noise-aware Bayes plan
@@ -285,7 +313,18 @@ class FigureRequest(ProblemOptions):
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
 
 
-class PolicyRequest(NoiseOptions):
+class FunctionsRequest(NoiseOptions):
+    """The body of ``views/functions``: the part's functions and the chosen plan's beliefs.
+
+    With ``turn_noise``, ``contact_noise`` or ``payoff``: the plan is the noise-aware one
+    ``plan`` gives under them (``guaranteed``: the plan guaranteed under a bounded turn error)
+    and the beliefs are the exact distributions under the noise.
+    """
+
+    plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
+
+
+class PolicyRequest(StrokeOptions):
     """The body of ``policy``: ``bayesgrasp plan PART [--also PART ...] --sense ...``.
 
     With ``turn_noise`` or ``contact_noise`` (or ``payoff``, one part): the Bayes policy
@@ -313,6 +352,30 @@ class PolicyRequest(NoiseOptions):
         description="Deepest policy: actions on any path (--max-actions; the server takes at "
         "most 4, and at most 4 candidate parts: a request past its time limit keeps a "
         "worker busy until it ends).",
+    )
+
+
+class ExportRequest(PlanRequest):
+    """The body of ``export``: the robot file ``plan ... --export FILE.csv|json`` writes.
+
+    The members of ``plan``; with ``sense`` (and ``also``, ``part_prior``) those of
+    ``policy``, whose state machine is written instead of the Bayes plan.
+    """
+
+    format: Literal["csv", "json"] = Field(
+        description="The robot file's format (the ending of --export FILE)."
+    )
+    sense: str | None = Field(
+        None,
+        max_length=64,
+        description="Export the Bayes policy that branches on jaw widths (as `policy`): "
+        "`width` or `width:SIGMA,RES` (--sense).",
+    )
+    also: list[PartIn] = Field(
+        default_factory=list, max_length=3, description="With `sense`: more candidate parts."
+    )
+    part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
+        None, max_length=4, description="With `sense`: weights of the candidate parts."
     )
 
 

@@ -2,12 +2,12 @@
 
 ``POST /api/v1/views/functions`` samples the part's diameter, squeeze, radius, push and
 push-grasp functions (the exact models of a curved part) and gives the belief over
-orientations after each step of the chosen plan, for the page to draw.
+orientations after each step of the chosen plan, for the page to draw; with the noise or
+payoff options, of the noise-aware plan, under the noise.
 
-The automatic record of every plan (``GET /api/v1/gallery``) stays as it is; the page shows
-only what the user saved with its *Save* button: the page's address fragment (the part and
-every option, so the entry reproduces the view, costs included), the outline for a
-thumbnail and the plan's numbers.
+The gallery keeps only what the user saved with the page's *Save* button: the page's address
+fragment (the part and every option, so the entry reproduces the view, costs included), the
+outline for a thumbnail and the plan's numbers.
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ from fastapi import APIRouter, Query, Request
 from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field
 
-from .models import ERRORS, FigureRequest
+from .models import ERRORS, FunctionsRequest
 
-__all__ = ["SaveRequest", "belief_steps", "function_samples", "router"]
+__all__ = ["SaveRequest", "belief_steps", "chosen_beliefs", "function_samples", "router"]
 
 router = APIRouter(prefix="/api/v1", tags=["server"])
 
@@ -115,19 +115,73 @@ def belief_steps(problem: Any, steps: Any) -> list[list[tuple[float, float]]]:
     return out
 
 
-def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str, Any]:
-    """The figures' data: functions sampled at ``n`` angles, the plan and its beliefs."""
+def chosen_beliefs(
+    req: FunctionsRequest, part: Any, spec: Any
+) -> tuple[Any, Any, str, list[list[tuple[float, float]]]]:
+    """The problem, the plan ``req.plan`` names, its label, and the belief after each step.
+
+    Without noise options: the noise-free plan (as ``plot --plan``) and its beliefs
+    (:func:`belief_steps`). With them: the plan ``plan`` gives under the noise and payoff
+    (:func:`bayesgrasp.planning.solve`; ``guaranteed``: the plan guaranteed under a bounded
+    turn error) and the exact distribution over the stable orientations after each step under
+    the noise (:func:`~bayesgrasp.planning.noisy.step_distributions_noisy`), whose mass at
+    the goal after the last step is the plan's success probability.
+    """
+    import numpy as np
+
+    from ..cli.common import PLAN_NAMES
+    from ..errors import NoPlanError
+    from .problems import build_problem, chosen_option, exact_method
+
+    if not req.noisy:
+        pb, option, label = chosen_option(req.plan, req, part, spec)
+        return pb, option, label, belief_steps(pb, option.steps)
+    from ..planning.noisy import NoisyPlanResult, step_distributions_noisy
+    from ..planning.robust import UNBOUNDED_GUARANTEE
+    from ..planning.strategy import solve
+    from .workers import LimitError
+
+    exact_method(req)
+    noise = req.noise_model()
+    sure = req.plan == "guaranteed"
+    if sure and not noise.turn.exact and noise.turn.kind == "normal":
+        raise LimitError(422, f"`plan`: guaranteed: {UNBOUNDED_GUARANTEE}")
+    pb = build_problem(part, req, spec)
+    result = solve(
+        pb, noise=noise, payoff=req.payoff_model(), max_actions=spec.max_actions, guaranteed=sure
+    )
+    src = result.source
+    assert isinstance(src, NoisyPlanResult)
+    if sure:
+        if result.guaranteed is None:
+            raise NoPlanError(result.guaranteed_missing or "no guaranteed plan")
+        option = result.guaranteed.option
+    else:
+        option = src.options[src.bayes if req.plan == "bayes" else src.most_certain].option
+    stable = np.asarray(pb.states.stable, dtype=float)
+    qs = step_distributions_noisy(pb, noise, option.steps)
+    beliefs = [[(float(stable[k]), float(q[k])) for k in np.flatnonzero(q > 0)] for q in qs]
+    return pb, option, PLAN_NAMES[req.plan], beliefs
+
+
+def function_samples(service: Any, req: FunctionsRequest, n: int = 721) -> dict[str, Any]:
+    """The figures' data: functions sampled at ``n`` angles, the plan and its beliefs.
+
+    ``plan.planner`` says which plan the beliefs follow: ``noise-aware`` (the plan ``plan``
+    gives under the request's noise and payoff, its beliefs exact under the noise) or
+    ``noise-free``; ``plan.success_probability`` is that plan's, under the noise.
+    """
     import math
 
     import numpy as np
 
     from ..errors import BayesGraspError
     from ..geometry.curved import CurvedPart, curved_radius, push_model, squeeze_model
-    from .app import chosen_option, problem_spec
+    from .problems import problem_spec
 
     spec = problem_spec(req)
     part = service.part(req.part)
-    pb, option, label = chosen_option(req.plan, req, part, spec)
+    _, option, label, beliefs = chosen_beliefs(req, part, spec)
     theta = np.linspace(0.0, 2 * math.pi, n)
     deg = np.degrees
 
@@ -149,7 +203,6 @@ def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str
         stable["push_grasp"] = [round(float(x), 4) for x in deg(g.stable)]
     except BayesGraspError:  # no stable push: the squeeze figures only
         pass
-    beliefs = belief_steps(pb, option.steps)
     return {
         "schema": "bayesgrasp.functions/1",
         "part": part.name,
@@ -158,6 +211,9 @@ def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str
         "stable_deg": stable,
         "plan": {
             "label": label,
+            "planner": "noise-aware" if req.noisy else "noise-free",
+            "noise": req.noise_model().describe() if req.noisy else None,
+            "payoff": req.payoff is not None,
             "steps": [{"type": st.kind, "alpha_deg": float(deg(st.alpha))} for st in option.steps],
             "final_deg": float(deg(option.final_orientation)),
             "success_probability": float(option.success_probability),
@@ -169,7 +225,11 @@ def function_samples(service: Any, req: FigureRequest, n: int = 721) -> dict[str
 
 
 @router.post("/views/functions", responses=ERRORS)
-async def functions(req: FigureRequest, request: Request) -> Any:
-    """The part's functions sampled over a turn and the belief after each step of the plan."""
+async def functions(req: FunctionsRequest, request: Request) -> Any:
+    """The part's functions sampled over a turn and the belief after each step of the plan.
+
+    With ``turn_noise``, ``contact_noise`` or ``payoff``: of the noise-aware plan, under the
+    noise (in the heavy lane); ``plan.planner`` says which.
+    """
     service = request.app.state.service
-    return await service.answer("functions", req)  # in a worker of the quick lane
+    return await service.answer("functions", req)  # in a worker of its lane

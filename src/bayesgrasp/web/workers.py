@@ -40,6 +40,7 @@ __all__ = ["Lane", "LimitError", "failure_of", "start_forkserver"]
 PRELOAD = (
     "numpy",
     "bayesgrasp.web.app",
+    "bayesgrasp.web.documents",
     "bayesgrasp.cli.specs",
     "bayesgrasp.cli.noisy",
     "bayesgrasp.io.plans",

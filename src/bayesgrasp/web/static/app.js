@@ -192,6 +192,15 @@ function noise() {
   return o;
 }
 
+// the gripper's opening limits (plan and policy requests, and the robot files)
+function stroke() {
+  const o = {};
+  if ($("max-opening").value.trim() !== "") o.max_opening = Number($("max-opening").value);
+  if ($("min-opening").value.trim() !== "") o.min_opening = Number($("min-opening").value);
+  if ($("within-stroke").checked) o.within_stroke = true;
+  return o;
+}
+
 function partBody() {
   if (state.catalogue) return { catalogue: state.catalogue };
   if (state.file) return { file: { format: state.file.format, data_base64: state.file.data_base64 }, name: state.file.name };
@@ -211,6 +220,10 @@ function writeHash() {
   q.set("actions", o.actions);
   for (const k of ["verify_cost", "retry_cost", "accuracy", "goal", "method", "max_actions"])
     if (o[k] !== undefined) q.set(k, o[k]);
+  if ($("guaranteed").checked) q.set("guaranteed", "1");
+  const g = stroke();
+  for (const k of ["max_opening", "min_opening"]) if (g[k] !== undefined) q.set(k, g[k]);
+  if (g.within_stroke) q.set("within_stroke", "1");
   q.set("squeeze_cost", $("cost-squeeze").value);
   q.set("push_grasp_cost", $("cost-push-grasp").value);
   const n = noise();
@@ -255,6 +268,10 @@ async function readHash() {
   set("goal", "goal");
   set("method", "method");
   set("max-actions", "max_actions");
+  $("guaranteed").checked = q.get("guaranteed") === "1";
+  $("max-opening").value = q.get("max_opening") || "";
+  $("min-opening").value = q.get("min_opening") || "";
+  $("within-stroke").checked = q.get("within_stroke") === "1";
   set("cost-squeeze", "squeeze_cost");
   set("cost-push-grasp", "push_grasp_cost");
   set("sense", "sense");
@@ -342,7 +359,7 @@ async function run() {
   const o = options();
   try {
     const [plan, squeeze, push] = await Promise.all([
-      postWhenFree("/plan", { part, ...o, ...noise() }, gen),
+      postWhenFree("/plan", { part, ...o, ...noise(), ...stroke(), ...($("guaranteed").checked ? { guaranteed: true } : {}) }, gen),
       post("/squeeze", { part, prior: o.prior }),
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
@@ -356,6 +373,8 @@ async function run() {
     drawHull(plan.part);
     drawDiameter(plan.part, squeeze);
     drawTable(plan);
+    fillPlanSelector(plan);
+    clearInterval(animTimer);
     drawAnimationFrame(0);
     loadFunctions(part, o, gen);
     const n = plan.options.length;
@@ -462,9 +481,34 @@ function drawTable(plan) {
     tr.appendChild(mark);
     body.appendChild(tr);
   });
+  if (plan.guaranteed) {
+    // the guaranteed plan (plan --guaranteed): every start ends at its final orientation
+    const g = plan.guaranteed;
+    const tr = document.createElement("tr");
+    tr.className = "guaranteed";
+    tr.dataset.index = "guaranteed";
+    const cells = [
+      [g.squeezes, `${g.squeezes} ${g.steps.map((s) => (s.type === "squeeze" ? "S" : "P")).join("")}`],
+      [null, g.steps.map((s) => deg(s.alpha_rad).toFixed(2)).join(", ")],
+      [null, deg(g.final_orientation_rad).toFixed(2)],
+      [null, g.success_probability.toFixed(4)],
+      [null, g.expected_cost == null ? "-" : g.expected_cost.toFixed(3)],
+      [null, g.tolerance_rad == null ? "-" : deg(g.tolerance_rad).toFixed(2)],
+    ];
+    for (const [, text] of cells) {
+      const td = document.createElement("td");
+      td.textContent = text;
+      tr.appendChild(td);
+    }
+    const mark = document.createElement("td");
+    mark.className = "mark";
+    mark.textContent = "guaranteed";
+    tr.appendChild(mark);
+    body.appendChild(tr);
+  }
 }
 
-// ---- animation of the Bayes plan -------------------------------------------------------------
+// ---- animation of a chosen plan from starting orientations ------------------------------------
 
 function transfer(theta, doc) {
   // the step function of a transfer document: the stable orientation of theta's basin
@@ -480,68 +524,186 @@ function wrap(a) {
   return a - TWO_PI * Math.round(a / TWO_PI);
 }
 
-function trajectories() {
-  const { plan, squeeze, push } = state.last;
-  const o = plan.options[plan.bayes];
+function near(a, ref, period) {
+  // the copy of a (modulo period) nearest to ref: the part turns the short way
+  return a - period * Math.round((a - ref) / period);
+}
+
+function chosenPlan() {
+  // the plan the selector names: a row of the table (its index) or "guaranteed"
+  const { plan } = state.last;
+  const v = $("anim-plan").value;
+  if (v === "guaranteed" && plan.guaranteed) return plan.guaranteed;
+  const i = Number(v);
+  return Number.isInteger(i) && plan.options[i] ? plan.options[i] : plan.options[plan.bayes];
+}
+
+function fillPlanSelector(plan) {
+  const sel = $("anim-plan");
+  sel.replaceChildren();
+  const add = (value, text) => {
+    const o = document.createElement("option");
+    o.value = value;
+    o.textContent = text;
+    sel.appendChild(o);
+  };
+  const label = (o) => {
+    const n = o.steps.length;
+    return `${n} ${n === 1 ? "action" : "actions"} ${o.steps.map((s) => (s.type === "squeeze" ? "S" : "P")).join("")}, p = ${o.success_probability.toFixed(3)}`;
+  };
+  plan.options.forEach((o, i) => {
+    const marks = [i === plan.bayes ? "Bayes" : "", i === plan.most_certain ? "most certain" : ""].filter(Boolean).join(", ");
+    add(String(i), marks ? `${marks}: ${label(o)}` : label(o));
+  });
+  if (plan.guaranteed) add("guaranteed", `guaranteed: ${label(plan.guaranteed)}`);
+  sel.value = String(plan.bayes); // a new plan's rows are other plans: start from its Bayes plan
+}
+
+// a small seeded generator (mulberry32), so a seed gives the same starts in every browser
+function rng(seed) {
+  let a = seed >>> 0;
+  return () => {
+    a = (a + 0x6d2b79f5) >>> 0;
+    let t = a;
+    t = Math.imul(t ^ (t >>> 15), t | 1);
+    t ^= t + Math.imul(t ^ (t >>> 7), t | 61);
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  };
+}
+
+function vonMises(rand, mu, kappa) {
+  // Best and Fisher (1979), "Efficient simulation of the von Mises distribution", Appl. Stat. 28
+  if (kappa < 1e-8) return rand() * TWO_PI;
+  const tau = 1 + Math.sqrt(1 + 4 * kappa * kappa);
+  const rho = (tau - Math.sqrt(2 * tau)) / (2 * kappa);
+  const r = (1 + rho * rho) / (2 * rho);
+  for (;;) {
+    const z = Math.cos(Math.PI * rand());
+    const f = (1 + r * z) / (r + z);
+    const c = kappa * (r - f);
+    const u2 = rand();
+    if (c * (2 - c) - u2 > 0 || Math.log(c / u2) + 1 - c >= 0) {
+      const th = mu + (rand() > 0.5 ? Math.acos(f) : -Math.acos(f));
+      return ((th % TWO_PI) + TWO_PI) % TWO_PI;
+    }
+  }
+}
+
+function startOrientations() {
+  // eight evenly spaced starts, or N drawn from the prior with the seed
+  if ($("anim-starts").value !== "random") {
+    const starts = [];
+    for (let i = 0; i < 8; i++) starts.push((i + 0.5) * (TWO_PI / 8) + 0.05);
+    return starts;
+  }
+  const n = Math.max(1, Math.min(400, Math.floor(Number($("anim-n").value)) || 1));
+  const rand = rng(Math.floor(Number($("anim-seed").value)) || 0);
+  const prior = options().prior;
+  const [mean, kappa] = prior.startsWith("vonmises:") ? prior.slice(9).split(",").map(Number) : [0, 0];
   const starts = [];
-  for (let i = 0; i < 8; i++) starts.push((i + 0.5) * (TWO_PI / 8) + 0.05);
+  for (let i = 0; i < n; i++) starts.push(kappa > 0 ? vonMises(rand, (mean * Math.PI) / 180, kappa) : rand() * TWO_PI);
+  return starts;
+}
+
+function trajectories() {
+  // each start's segments: a turn, then a squeeze (both jaws close) or, for a push-grasp, a
+  // push (one jaw turns the part to the push function's rest) and a close (the other jaw)
+  const { plan, squeeze, push } = state.last;
+  const o = chosenPlan();
   const order = plan.part.symmetry_order || 1;
   const goalPeriod = $("goal").value === "symmetry" ? TWO_PI / order : TWO_PI;
-  return starts.map((t0) => {
-    const keys = [t0];
+  return startOrientations().map((t0) => {
+    const segs = [];
     let t = t0;
     for (const s of o.steps) {
-      const doc = s.type === "squeeze" ? squeeze : push.push_grasp;
       const turned = t - s.alpha_rad;
-      keys.push(turned);
-      t = transfer(turned, doc);
-      keys.push(t);
+      segs.push({ kind: "turn", from: t, to: turned });
+      if (s.type === "squeeze") {
+        t = transfer(turned, squeeze);
+        segs.push({ kind: "squeeze", from: turned, to: t });
+      } else {
+        const rest = near(transfer(turned, push), turned, TWO_PI);
+        const grasped = transfer(turned, push.push_grasp);
+        segs.push({ kind: "push", from: turned, to: rest });
+        segs.push({ kind: "close", from: rest, to: near(grasped, rest, TWO_PI) });
+        t = grasped;
+      }
     }
     const gap = (t - o.final_orientation_rad) / goalPeriod;
     const ok = Math.abs(gap - Math.round(gap)) * goalPeriod < 1e-6;
-    return { keys, ok };
+    return { start: t0, segs, final: t, ok };
   });
 }
 
 const FRAMES = 12;
+const COLS = 8;
 let animTimer = null;
 
 function drawAnimationFrame(frame) {
-  if (!state.last) return;
+  if (!state.last) return false;
   const svg = $("anim");
   svg.replaceChildren();
   const runs = trajectories();
-  const segs = runs[0].keys.length - 1;
-  const last = segs * FRAMES;
+  const o = chosenPlan();
+  const nseg = runs[0].segs.length;
+  const last = nseg * FRAMES;
   const f = Math.min(frame, last);
-  const seg = Math.min(Math.floor(f / FRAMES), segs - 1);
-  const u = f >= last ? 1 : (f % FRAMES) / FRAMES;
+  const done = f >= last;
+  const seg = Math.min(Math.floor(f / FRAMES), nseg - 1);
+  const u = done ? 1 : (f % FRAMES) / FRAMES;
+  const kind = runs[0].segs[seg].kind;
   const verts = state.last.plan.part.vertices;
   const cx = verts.reduce((a, p) => a + p[0], 0) / verts.length;
   const cy = verts.reduce((a, p) => a + p[1], 0) / verts.length;
   const centred = verts.map(([x, y]) => [x - cx, y - cy]);
   const r = Math.max(...centred.map(([x, y]) => Math.hypot(x, y)));
   const k = 30 / r;
+  const rows = Math.ceil(runs.length / COLS);
+  svg.setAttribute("viewBox", `0 0 640 ${rows * 160 + 10}`);
+  svg.setAttribute("height", String(rows * 160 + 10));
   runs.forEach((run, i) => {
-    const ox = 40 + i * 78, oy = 80;
-    const done = f >= last;
-    el("rect", { x: ox - 36, y: oy - 70, width: 72, height: 150, rx: 6, class: done ? (run.ok ? "cell-ok" : "cell-fail") : "cell", "data-ok": run.ok, "data-start": run.keys[0], "data-final": run.keys[run.keys.length - 1] }, svg);
-    const t = run.keys[seg] + (run.keys[seg + 1] - run.keys[seg]) * u;
+    const ox = 40 + (i % COLS) * 78, oy = 80 + Math.floor(i / COLS) * 160;
+    el("rect", { x: ox - 36, y: oy - 70, width: 72, height: 150, rx: 6, class: done ? (run.ok ? "cell-ok" : "cell-fail") : "cell", "data-ok": run.ok, "data-start": run.start, "data-final": run.final }, svg);
+    const sg = done ? { kind: "end", from: run.final, to: run.final } : run.segs[seg];
+    const t = sg.from + (sg.to - sg.from) * u;
     const pts = rotate(centred, t);
     const xs = pts.map((p) => p[0]);
-    const squeezing = seg % 2 === 1; // odd segments close the jaws
     const lo = Math.min(...xs), hi = Math.max(...xs);
-    const open = squeezing ? 1 - u : 1;
-    const gap = 8 * open;
+    let left = 8, right = 8; // the jaws' gaps to the part
+    if (sg.kind === "squeeze") left = right = 8 * (1 - u);
+    else if (sg.kind === "push") left = 0;
+    else if (sg.kind === "close") [left, right] = [0, 8 * (1 - u)];
+    else if (sg.kind === "end") left = right = 0;
     el("polygon", { points: pts.map(([x, y]) => `${ox + x * k},${oy - y * k}`).join(" "), fill: "#9fb8d6", stroke: "#2f4b6e" }, svg);
-    for (const xj of [lo * k - gap, hi * k + gap]) el("line", { x1: ox + xj, y1: oy - 45, x2: ox + xj, y2: oy + 45, stroke: "#555", "stroke-width": 3 }, svg);
+    const pushing = sg.kind === "push" || sg.kind === "close";
+    const jaw = (x, cls) => el("line", { x1: ox + x, y1: oy - 45, x2: ox + x, y2: oy + 45, class: cls }, svg);
+    jaw(lo * k - left, pushing ? "jaw pusher" : sg.kind === "squeeze" ? "jaw closing" : "jaw");
+    jaw(hi * k + right, sg.kind === "close" || sg.kind === "squeeze" ? "jaw closing" : "jaw");
+    if (sg.kind === "push") {
+      // the push: an arrow on the pushing jaw
+      const x = ox + lo * k - left - 4;
+      el("path", { d: `M${x - 10},${oy - 52} L${x},${oy - 52} M${x - 4},${oy - 56} L${x},${oy - 52} L${x - 4},${oy - 48}`, class: "push-arrow" }, svg);
+    }
     const label = el("text", { x: ox, y: oy + 70, "text-anchor": "middle", "font-size": 11 }, svg);
-    label.textContent = done ? (run.ok ? "✓ oriented" : "✗ other") : `${deg(run.keys[0]).toFixed(0)}°`;
+    const fin = round(((deg(run.final) % 360) + 360) % 360, 0);
+    label.textContent = done ? `${run.ok ? "✓" : "✗"} ${fin}°` : `${round(((deg(run.start) % 360) + 360) % 360, 0)}°`;
   });
-  $("anim-status").textContent = f >= last ? `${runs.filter((x) => x.ok).length} of ${runs.length} oriented` : `step ${Math.floor(seg / 2) + 1}`;
+  const ok = runs.filter((x) => x.ok).length;
+  const stepOf = runs[0].segs.slice(0, seg + 1).filter((s) => s.kind === "turn").length;
+  const what = { turn: "turn", squeeze: "squeeze", push: "push", close: "the other jaw closes" }[kind];
+  $("anim-status").textContent = done
+    ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%` +
+      `${Object.keys(noise()).length ? ", which counts the noise and payoff the animation leaves out" : ""}` +
+      `${$("anim-starts").value === "even" ? "; evenly spaced starts are not weighted by the prior" : ""})`
+    : `step ${stepOf} of ${o.steps.length}: ${what}`;
   svg.dataset.frame = String(f);
-  svg.dataset.done = String(f >= last);
-  return f < last;
+  svg.dataset.done = String(done);
+  svg.dataset.kind = done ? "end" : kind;
+  svg.dataset.steps = String(o.steps.length);
+  svg.dataset.segments = runs[0].segs.map((s) => s.kind).join(",");
+  svg.dataset.oriented = String(ok);
+  svg.dataset.success = String(o.success_probability);
+  return !done;
 }
 
 function play() {
@@ -634,18 +796,28 @@ function policyLines(node, depth, first, unit, lines) {
 async function showPolicy() {
   if (!validate()) return;
   const o = options();
-  const body = { part: partBody(), ...o, sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
+  const body = { part: partBody(), ...o, ...policyStroke(), sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
   $("policy-summary").textContent = "planning the policy...";
   $("policy-tree").textContent = "";
   $("policy-nodes").replaceChildren();
   try {
-    const doc = await post("/policy", body);
+    const part = partBody();
+    const [doc, squeeze, push] = await Promise.all([
+      post("/policy", body),
+      post("/squeeze", { part, prior: o.prior }),
+      o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
+    ]);
     state.policyParts = doc.parts.length;
+    const hullVerts = squeeze.part.vertices;
+    const drawn = state.vertices.length >= 3 ? state.vertices : state.outline || hullVerts;
+    const [mu] = o.prior.startsWith("vonmises:") ? o.prior.slice(9).split(",").map(Number) : [0];
+    // the part drawings (one part only: several parts' trees name the part at each leaf)
+    state.policyDraw = doc.parts.length === 1 ? { hull: hullVerts, outline: drawn, squeeze, push, mode: (mu * Math.PI) / 180 } : null;
     // the units of the last plan, when it was of this part (the policy document has none)
     const last = state.last && state.last.plan ? state.last.plan.part : null;
     const units = last && last.name === doc.parts[0] ? last.units : null;
     $("policy-tree").textContent = policyLines(doc.root, 0, true, units ? ` ${units}` : "", []).join("\n");
-    $("policy-nodes").replaceChildren(policyNode(doc.root, true, units ? ` ${units}` : ""));
+    $("policy-nodes").replaceChildren(policyNode(doc.root, true, units ? ` ${units}` : "", []));
     const blind = doc.sensorless_cost === null ? "" : ` (sensorless Bayes plan ${doc.sensorless_cost.toFixed(4)})`;
     $("policy-summary").textContent =
       `expected cost ${doc.expected_cost.toFixed(4)}${blind}, success ${doc.success_probability.toFixed(4)} a cycle, ` +
@@ -656,6 +828,50 @@ async function showPolicy() {
     $("policy-summary").textContent = String(err.message || err);
     $("policy-summary").classList.add("error");
     document.body.dataset.policy = "error";
+  }
+}
+
+// ---- robot files (POST /export: the bytes of plan --export FILE.csv|json) ----------------
+
+function policyStroke() {
+  // a policy is checked against the stroke; "within the stroke" plans linear plans only
+  const g = stroke();
+  delete g.within_stroke;
+  return g;
+}
+
+async function downloadRobotFile(policy) {
+  if (!validate()) return;
+  const format = $("export-format").value;
+  const body = { part: partBody(), ...options(), format };
+  if (policy) Object.assign(body, policyStroke(), { sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 });
+  else Object.assign(body, noise(), stroke(), $("guaranteed").checked ? { guaranteed: true } : {});
+  const where = policy ? $("policy-summary") : $("status");
+  where.textContent = "writing the robot file...";
+  where.classList.remove("error");
+  try {
+    const r = await fetch(`${API}/export`, { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
+    if (!r.ok) {
+      let msg = `HTTP ${r.status}`;
+      try {
+        msg = (await r.json()).detail || msg;
+      } catch (err) {
+        /* not JSON */
+      }
+      throw new Error(msg);
+    }
+    const m = /filename="?([^";]+)"?/.exec(r.headers.get("content-disposition") || "");
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(await r.blob());
+    a.download = m ? m[1] : `robot.${format}`;
+    document.body.appendChild(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
+    where.textContent = `downloaded ${a.download}`;
+  } catch (err) {
+    where.textContent = String(err.message || err);
+    where.classList.add("error");
   }
 }
 
@@ -787,12 +1003,21 @@ function start() {
   drawCanvas();
   $("plan").addEventListener("click", run);
   $("play").addEventListener("click", play);
+  for (const id of ["anim-plan", "anim-starts", "anim-n", "anim-seed"])
+    $(id).addEventListener("change", () => {
+      clearInterval(animTimer);
+      drawAnimationFrame(0);
+    });
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
   $("save").addEventListener("click", saveView);
+  $("export").addEventListener("click", () => downloadRobotFile(false));
+  $("export-policy").addEventListener("click", () => downloadRobotFile(true));
   $("gallery-prev").addEventListener("click", () => loadGallery(galleryPage - 1));
   $("gallery-next").addEventListener("click", () => loadGallery(galleryPage + 1));
-  $("options").addEventListener("change", schedule);
+  $("options").addEventListener("change", (evt) => {
+    if (evt.target.id !== "export-format") schedule(); // the file's format plans nothing
+  });
   window.addEventListener("hashchange", async () => { await readHash(); drawCanvas(); schedule(); });
   Promise.all([ready, loadCatalogue()]).then(() => {
     if (state.catalogue || state.file || state.vertices.length >= 3) run();
@@ -878,6 +1103,16 @@ function validate() {
   number("accuracy", "accuracy", 0, 180, true);
   number("max-actions", "max actions", 1, 1000, false);
   number("contact-noise", "contact noise", 0, 1, false);
+  number("max-opening", "max opening", 0, undefined, false);
+  number("min-opening", "min opening", 0, undefined, false);
+  const [hiO, loO] = [$("max-opening").value.trim(), $("min-opening").value.trim()];
+  if (hiO !== "" && loO !== "" && Number(loO) > Number(hiO) && !$("min-opening").getAttribute("aria-invalid")) {
+    fieldError("min-opening", "min opening: must be at most the max opening");
+    ok = false;
+  }
+  const needs = $("within-stroke").checked && hiO === "" && loO === "";
+  fieldError("within-stroke", needs ? "plan within the stroke: give the max and/or min opening" : "");
+  if (needs) ok = false;
   if ($("turn-kind").value) number("turn-deg", "turn error", 0, undefined, true);
   else fieldError("turn-deg", "");
   if ($("prior-kind").value === "vonmises") {
@@ -915,6 +1150,7 @@ function clearResults() {
   $("diameter").replaceChildren();
   $("anim").replaceChildren();
   $("anim-status").textContent = "";
+  $("anim-plan").replaceChildren();
   $("functions").replaceChildren();
   $("belief").replaceChildren();
   state.functions = null;
@@ -986,7 +1222,8 @@ const FUNCTION_NAMES = {
 
 async function loadFunctions(part, o, gen) {
   try {
-    const doc = await post("/views/functions", { part, ...o });
+    // the noise and payoff too: the beliefs of the table's noise-aware Bayes plan
+    const doc = await postWhenFree("/views/functions", { part, ...o, ...noise() }, gen);
     if (gen !== generation) return;
     state.functions = doc;
     const box = $("functions");
@@ -1007,6 +1244,17 @@ async function loadFunctions(part, o, gen) {
   }
 }
 
+function sameAsTable(shown) {
+  // whether the figures' plan is the table's Bayes plan (same actions at the same angles)
+  if (!state.last) return true;
+  const { plan } = state.last;
+  const steps = plan.options[plan.bayes].steps;
+  return (
+    steps.length === shown.steps.length &&
+    steps.every((s, i) => s.type === shown.steps[i].type && Math.abs(deg(s.alpha_rad) - shown.steps[i].alpha_deg) < 1e-3)
+  );
+}
+
 function drawBelief(doc) {
   // one bar chart a step: the probability of each orientation after the step
   const box = $("belief");
@@ -1016,7 +1264,7 @@ function drawBelief(doc) {
     const W = 640, H = 120, L = 40, B = 26, T = 8;
     const svg = el("svg", { viewBox: `0 0 ${W} ${H}`, class: "chart belief", "data-step": k + 1 });
     const cap = document.createElement("figcaption");
-    const exact = Object.keys(noise()).length ? ", the noise-free Bayes plan (the table's plan is noise-aware)" : "";
+    const exact = sameAsTable(doc.plan) ? "" : ", the Bayes plan without the stroke limits (the table's Bayes plan differs)";
     cap.textContent = `after step ${k + 1} (${st.type} at ${round(st.alpha_deg, 2)}°${exact})`;
     const fig = document.createElement("figure");
     fig.append(cap, svg);
@@ -1036,16 +1284,66 @@ function drawBelief(doc) {
 
 // ---- the policy as a collapsible tree ---------------------------------------------------------
 
-function policyNode(node, first, unit) {
-  // an action node: <details> whose summary is the action and whose children are its readings
+function partAt(theta, title) {
+  // the part's outline, small, at orientation theta (radians) as the jaws see it
+  const ctx = state.policyDraw;
+  const svg = el("svg", { viewBox: "0 0 40 40", width: 40, height: 40, class: "policy-part", "data-orientation": deg(theta) });
+  const pts = rotate(ctx.outline, theta);
+  const f = fit(rotate(ctx.hull, theta), 40, 3);
+  el("polygon", { points: pts.map((p) => f(p).join(",")).join(" "), class: "poly" }, svg);
+  el("title", {}, svg).textContent = title;
+  return svg;
+}
+
+function afterAction(atoms, act, first) {
+  // the belief after an action: the prior's mass per stable orientation for the first one,
+  // else each atom turned by the action's angle and sent through its transfer function
+  const ctx = state.policyDraw;
+  const doc = act.type === "squeeze" ? ctx.squeeze : ctx.push && ctx.push.push_grasp;
+  if (!doc) return atoms;
+  const out = first
+    ? doc.stable_orientations_rad.map((t, i) => [t, doc.probabilities[i]])
+    : atoms.map(([t, p]) => [transfer(t - act.alpha_rad, doc), p]);
+  const merged = [];
+  for (const [t, p] of out) {
+    const hit = merged.find((m) => Math.abs(wrap(m[0] - t)) < 1e-9);
+    if (hit) hit[1] += p;
+    else merged.push([t, p]);
+  }
+  return merged;
+}
+
+function givenReading(atoms, reading) {
+  // the atoms whose jaw width lies in the reading's interval (all of them when none does,
+  // as with a noisy sensor, where the tree's probabilities carry the update)
+  const [lo, hi] = reading;
+  const hull = state.policyDraw.hull;
+  const keep = atoms.filter(([t]) => {
+    const w = width(hull, t);
+    return (lo === null || w >= lo - 1e-9) && (hi === null || w < hi - 1e-9);
+  });
+  return keep.length ? keep : atoms;
+}
+
+function mostProbable(atoms) {
+  return atoms.reduce((a, b) => (b[1] > a[1] ? b : a))[0];
+}
+
+function policyNode(node, first, unit, belief) {
+  // an action node: <details> whose summary is the action and whose children are its readings;
+  // each node draws the part at the belief's most probable orientation, a declaration at its
+  // declared orientation
   const d = document.createElement("details");
   d.open = true;
   d.className = "policy-node";
   const act = node.action;
   const sum = document.createElement("summary");
   const a = round((act.alpha_rad * 180) / Math.PI, 2);
-  sum.textContent = first ? `${act.type} with the gripper at ${a}°` : `turn ${a}°, ${act.type}`;
+  const here = !state.policyDraw ? 0 : first ? state.policyDraw.mode : mostProbable(belief);
+  if (state.policyDraw) sum.appendChild(partAt(here, `most probable orientation here: ${round(((deg(here) % 360) + 360) % 360, 2)}°`));
+  sum.append(first ? `${act.type} with the gripper at ${a}°` : `turn ${a}°, ${act.type}`);
   d.appendChild(sum);
+  const after = state.policyDraw ? afterAction(belief, act, first) : null;
   const ul = document.createElement("ul");
   for (const b of node.branches) {
     const li = document.createElement("li");
@@ -1057,10 +1355,17 @@ function policyNode(node, first, unit) {
       : `width in [${round(lo, 2)}, ${round(hi, 2)})${unit}`;
     const head = `${reads} (p = ${prob(b.probability)})`;
     const n = b.next;
+    const given = after ? givenReading(after, b.reading) : null;
     if (n.action) {
-      li.append(document.createTextNode(head + ":"), policyNode(n, false, unit));
-    } else if (n.reject) li.textContent = `${head}: reject`;
-    else li.textContent = `${head}: declare ${round((n.declare.orientation_rad * 180) / Math.PI, 2)}° (success ${round(n.success_probability, 3)})`;
+      li.append(document.createTextNode(head + ":"), policyNode(n, false, unit, given));
+    } else if (n.reject) {
+      if (given) li.appendChild(partAt(mostProbable(given), "most probable orientation here"));
+      li.append(`${head}: reject`);
+    } else {
+      const t = n.declare.orientation_rad;
+      if (given) li.appendChild(partAt(t, `declared orientation ${round(((deg(t) % 360) + 360) % 360, 2)}°`));
+      li.append(`${head}: declare ${round((t * 180) / Math.PI, 2)}° (success ${round(n.success_probability, 3)})`);
+    }
     ul.appendChild(li);
   }
   d.appendChild(ul);

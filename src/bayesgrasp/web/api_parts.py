@@ -1,0 +1,89 @@
+"""The routes of parts: the catalogue, squeeze and push functions, commands on uploads."""
+
+from __future__ import annotations
+
+import asyncio
+import base64
+import functools
+import json
+from pathlib import Path
+from typing import Any, Literal
+
+from fastapi import APIRouter, File, Form, Request, UploadFile
+from fastapi.responses import JSONResponse, Response
+from pydantic import BaseModel, ValidationError
+
+from .common import TIMEOUT, error_response, one_line
+from .documents import catalogue_document
+from .models import ERRORS, PartRequest, PlanRequest, PolicyRequest, SimulateRequest
+from .service import service_of
+from .workers import LimitError
+
+__all__ = ["router"]
+
+router = APIRouter(prefix="/api/v1", tags=["parts"])
+
+
+@functools.cache
+def cached_catalogue() -> dict[str, Any]:
+    """:func:`~bayesgrasp.web.documents.catalogue_document`, made once."""
+    return catalogue_document()
+
+
+@router.get("/catalogue")
+async def catalogue() -> JSONResponse:
+    """The catalogue parts (:func:`bayesgrasp.shapes.names`)."""
+    return JSONResponse(await asyncio.to_thread(cached_catalogue))
+
+
+@router.post("/squeeze", responses=ERRORS)
+async def squeeze(req: PartRequest, request: Request, timeout: float | None = TIMEOUT) -> Response:
+    """Stable orientations of a squeeze (``bayesgrasp squeeze --json``)."""
+    return await service_of(request).answer("squeeze", req, timeout)
+
+
+@router.post("/push", responses=ERRORS)
+async def push(req: PartRequest, request: Request, timeout: float | None = TIMEOUT) -> Response:
+    """Stable orientations of a push and a push-grasp (``bayesgrasp push --json``)."""
+    return await service_of(request).answer("push", req, timeout)
+
+
+#: The request body of each command on an uploaded part.
+UPLOAD_MODELS: dict[str, type[BaseModel]] = {
+    "squeeze": PartRequest,
+    "push": PartRequest,
+    "plan": PlanRequest,
+    "policy": PolicyRequest,
+    "simulate": SimulateRequest,
+}
+
+
+@router.post("/{command}/upload", responses=ERRORS)
+async def upload(
+    command: Literal["squeeze", "push", "plan", "policy", "simulate"],
+    request: Request,
+    file: UploadFile = File(description="A part file (read in memory)."),  # noqa: B008
+    format: str = Form(description="json, csv, wkt, geojson, svg or dxf."),
+    options: str = Form("{}", description="The other members of the command's body, JSON."),
+    timeout: float | None = TIMEOUT,
+) -> Response:
+    """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``."""
+    service = service_of(request)
+    data = await file.read(service.limits.max_body_bytes + 1)
+    try:
+        extra = json.loads(options)
+    except ValueError:
+        raise LimitError(422, "`options` must be a JSON object") from None
+    if not isinstance(extra, dict) or "part" in extra:
+        raise LimitError(422, "`options` must be a JSON object without `part`")
+    stem = Path(file.filename or "part").stem
+    safe = "".join(c for c in stem if c.isalnum() or c in "_.- ")[:64] or "part"
+    part = {
+        "name": safe,
+        "file": {"format": format, "data_base64": base64.b64encode(data).decode()},
+    }
+    try:
+        req: Any = UPLOAD_MODELS[command].model_validate({**extra, "part": part})
+    except ValidationError as exc:
+        return error_response(422, one_line(exc), "invalid-request")
+    return await service.answer(command, req, timeout)

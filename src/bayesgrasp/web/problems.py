@@ -1,0 +1,159 @@
+"""From a request's options to the problem the command line would build.
+
+:func:`problem_spec` makes the :class:`~bayesgrasp.cli.specs.ProblemSpec` of ``plan``'s
+options, :func:`build_problem` the problem (with an inline histogram or sample prior),
+:func:`chosen_option` the plan ``--plan`` names, :func:`stroke_of` the gripper's stroke.
+Options the command line would refuse are refused here with its reasons (422).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+from ..errors import NoPlanError
+from .models import PartRequest, ProblemOptions, StrokeOptions
+from .workers import LimitError
+
+if TYPE_CHECKING:
+    from ..geometry.polygon import Part
+    from ..io.export import Stroke
+    from ..model.problem import Problem
+    from ..planning.result import PlanOption
+
+__all__ = [
+    "build_problem",
+    "check_within_stroke",
+    "chosen_option",
+    "exact_method",
+    "prior_string",
+    "problem_spec",
+    "stroke_of",
+]
+
+
+def prior_string(opts: PartRequest | ProblemOptions) -> str:
+    """The prior text, refusing the forms that read a file on the server."""
+    kind = opts.prior.partition(":")[0].strip().lower()
+    if kind in ("histogram", "sample"):
+        raise LimitError(
+            422,
+            f"`prior`: {kind}:FILE reads a file, which the server does not do; give the "
+            f"values in `prior_{kind}`",
+        )
+    return opts.prior
+
+
+def problem_spec(opts: ProblemOptions) -> Any:
+    """The :class:`~bayesgrasp.cli.specs.ProblemSpec` the command line makes of these options."""
+    from ..cli.specs import GoalKind, Method, ProblemSpec
+    from ..model.actions import get_action
+
+    for name in (*opts.costs, *opts.first_costs):
+        get_action(name)  # an unknown action: PlanningError naming the known ones
+    if isinstance(opts.actions, str):
+        actions = [a.strip() for a in opts.actions.split(",") if a.strip()]
+    else:
+        actions = [a.strip() for a in opts.actions if a.strip()]
+    return ProblemSpec(
+        prior=prior_string(opts),
+        costs=dict(opts.costs),
+        first=dict(opts.first_costs),
+        verify=opts.verify_cost,
+        retry=opts.retry_cost,
+        goal=GoalKind(opts.goal),
+        actions=tuple(dict.fromkeys(actions)),
+        accuracy_deg=opts.accuracy,
+        method=Method(opts.method),
+        max_actions=opts.max_actions,
+    )
+
+
+def build_problem(part: Part, opts: ProblemOptions, spec: Any) -> Problem:
+    """``spec.build(part)``, or with the inline histogram or sample prior of the request."""
+    if opts.prior_histogram is None and opts.prior_sample is None:
+        return spec.build(part)  # type: ignore[no-any-return]
+    import numpy as np
+
+    from ..model.cost import CostModel
+    from ..model.goal import Goal
+    from ..model.prior import HistogramPrior, Prior, SamplePrior
+    from ..model.problem import Problem
+
+    if opts.prior_histogram is not None and opts.prior_sample is not None:
+        raise LimitError(422, "give at most one of `prior_histogram` and `prior_sample`")
+    if opts.prior != "uniform":
+        raise LimitError(422, "`prior` must stay uniform with `prior_histogram`/`prior_sample`")
+    prior: Prior
+    if opts.prior_histogram is not None:
+        prior = HistogramPrior(np.array(opts.prior_histogram, dtype=float), name="histogram")
+    else:
+        prior = SamplePrior(np.radians(np.array(opts.prior_sample, dtype=float)), name="sample")
+    # the same construction as ProblemSpec.build, with the prior given as a value
+    cost = CostModel(spec.costs or {}, spec.verify, spec.first or {}, spec.retry)
+    return Problem.build(
+        part,
+        prior=prior,
+        cost=cost,
+        goal=Goal(spec.goal.value),
+        actions=spec.actions,
+        accuracy=math.radians(spec.accuracy_deg),
+    )
+
+
+def chosen_option(
+    which: str, opts: ProblemOptions, part: Part, spec: Any
+) -> tuple[Problem, PlanOption, str]:
+    """The problem and the plan ``which`` names (as ``--plan`` does)."""
+    from ..cli.common import PLAN_NAMES
+    from ..cli.specs import guaranteed_plan
+
+    problem = build_problem(part, opts, spec)
+    if which == "guaranteed":
+        found = guaranteed_plan(problem)
+        if isinstance(found, str):
+            raise NoPlanError(found)
+        return problem, found.option, PLAN_NAMES[which]
+    result = spec.plan(problem)
+    plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
+    return problem, plan, PLAN_NAMES[which]
+
+
+def stroke_of(req: StrokeOptions) -> Stroke | None:
+    """The gripper's stroke of ``max_opening`` and ``min_opening`` (``None``: neither given)."""
+    if req.max_opening is None and req.min_opening is None:
+        return None
+    from ..io.export import Stroke
+
+    hi = math.inf if req.max_opening is None else req.max_opening
+    return Stroke(req.min_opening or 0.0, hi)
+
+
+def check_within_stroke(req: StrokeOptions, stroke: Stroke | None, policy: bool) -> None:
+    """Refuse ``within_stroke`` where it cannot plan (the command line's reasons)."""
+    if not req.within_stroke:
+        return
+    why = None
+    if stroke is None:
+        why = "needs the stroke: `max_opening` and/or `min_opening`"
+    elif policy:
+        why = "plans linear plans; a policy is checked against the stroke (drop `within_stroke`)"
+    elif req.noisy:
+        why = (
+            "searches noise-free plans; a noise-aware plan is checked against the stroke "
+            "(drop `within_stroke`)"
+        )
+    elif req.method != "exact":
+        why = "is its own planner; drop `method`"
+    elif req.accuracy:
+        why = "takes exact turns; drop `accuracy`"
+    if why is not None:
+        raise LimitError(422, f"`within_stroke`: {why}")
+
+
+def exact_method(req: ProblemOptions) -> None:
+    """Refuse a planner ``method`` beside the noise options (the noise-aware planner is exact)."""
+    if req.method != "exact":
+        raise LimitError(
+            422, "`method`: the noise-aware planner seeds from the exact planner; drop `method`"
+        )
