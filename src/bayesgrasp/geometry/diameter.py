@@ -11,17 +11,19 @@ where ``(v_i*, v_j*)`` is the antipodal vertex pair touching the two jaws, ``l``
 an edge becomes parallel to the jaws (an *edge alignment*, ``theta = -nu_e mod pi`` for the
 edge's outward normal angle ``nu_e``), so ``d`` is a sinusoid on each interval between
 consecutive alignments (Appendix A). We find each interval's pair by rotating calipers
-done as a binary search of the sorted edge normals: O(n log n) for all pieces.
+(Toussaint, "Solving geometric problems with the rotating calipers", 1983) done as a
+binary search of the sorted edge normals: O(n log n) for all pieces
+(:mod:`~bayesgrasp.geometry.diameter_pieces`).
 
 Extrema: ``d`` is the maximum of sinusoids, so it is concave inside a piece and has convex
 kinks at alignments. Minima can only be kinks whose left slope is negative and right slope
 positive; maxima are the points inside a piece where its chord lies along x, or kinks where
 the slopes on both sides are zero within the angle tolerance. Read around the circle, with
 the slopes that are zero within the tolerance left out, minima and maxima alternate and pair
-up by construction (see ``pieces_numpy``). A minimum less than ``Tolerance.barrier`` times
-the part's size below an adjacent maximum is dropped with that maximum: rounded coordinates
-make parallel edges and perpendicular chords only nearly so, which splits one stable
-orientation into two a hair apart.
+up by construction (see :func:`~bayesgrasp.geometry.diameter_pieces.pieces_numpy`). A
+minimum less than ``Tolerance.barrier`` times the part's size below an adjacent maximum is
+dropped with that maximum: rounded coordinates make parallel edges and perpendicular chords
+only nearly so, which splits one stable orientation into two a hair apart.
 
 Near-symmetric parts: a part whose ``symmetry_order`` is r >= 3 (every vertex lands within
 ``Tolerance.symmetry`` times the size of another under a turn by ``2 pi / r``) is taken to be

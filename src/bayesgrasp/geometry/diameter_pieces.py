@@ -154,15 +154,29 @@ first, real or not), and whether a slope is flat within the tolerance (they are 
 def piece_lists(
     xs: list[float], ys: list[float], tol: float
 ) -> tuple[list[float], list[float], list[float], list[float], list[int], list[int], Events]:
-    """``breaks``, their ends, ``lengths``, ``phases``, ``i_plus``, ``i_minus`` and the events."""
+    """The pieces of ``d`` on Python floats, and the extrema as they come.
+
+    Edge ``i``'s outward normal ``nu_i`` (counter-clockwise polygon: the edge direction
+    less ``pi / 2``) aligns the edge with the jaws at ``theta = -nu_i mod pi``: those
+    angles, sorted, with gaps within ``tol`` merged (parallel edges), are the ``breaks``.
+    On the piece from a break to the next, the jaw at +x touches the vertex of greatest
+    projection on the direction ``-theta``, the vertex whose normal cone (between the
+    normals of its two edges) holds that direction: a binary search of the sorted normals
+    at the piece's midpoint (rotating calipers as a search, Toussaint 1983); likewise the
+    jaw at -x, direction ``pi - theta``. The chord between the two has length ``l`` and
+    angle ``gamma``, and ``d(theta) = l cos(theta + gamma)`` on the piece: ``phase =
+    -gamma``, written within ``pi / 2`` of the midpoint.
+
+    Returns ``breaks``, their ends, ``lengths``, ``phases``, ``i_plus``, ``i_minus`` and
+    the :data:`Events` (:func:`in_order` reads most parts' extrema from them).
+    """
     pi, two_pi, quarter = math.pi, TWO_PI, math.pi / 2
     atan2, hypot, cos, find = math.atan2, math.hypot, math.cos, bisect.bisect_left
     n = len(xs)
     # Edge i runs from vertex i to vertex i + 1; its outward normal, reduced to [0, 2 pi),
     # and the edge's alignment -normal reduced to [0, pi) (the same from 2 pi as from 0).
     normals, b = [], []
-    # (Equal lengths by construction, here and below: zip's strict= would cost a third of
-    # the loop on a few vertices.)
+    # (The lists zipped here and below have equal lengths by construction.)
     for x0, y0, x1, y1 in zip(xs, ys, [*xs[1:], xs[0]], [*ys[1:], ys[0]]):  # noqa: B905
         x = (atan2(y1 - y0, x1 - x0) - quarter) % two_pi
         normals.append(x)
@@ -395,10 +409,11 @@ def drop_shallow(ext: list[Extremum], depth: float) -> list[Extremum]:
     """Cyclic, alternating extrema without the adjacent pairs shallower than ``depth``.
 
     Pairs of neighbours whose values differ by at most ``depth`` are cancelled, shallowest
-    first (a persistence simplification; ties go to the first in angle), keeping at least
-    one minimum and one maximum; cancelling an adjacent pair keeps the alternation. A heap
-    of the neighbours' differences over a cyclic linked list: O(m log m), also when every
-    pair is shallow (a regular 99,999-gon).
+    first (a persistence simplification: Edelsbrunner, Letscher and Zomorodian,
+    "Topological persistence and simplification", 2002; ties go to the first in angle),
+    keeping at least one minimum and one maximum; cancelling an adjacent pair keeps the
+    alternation. A heap of the neighbours' differences over a cyclic linked list:
+    O(m log m), also when every pair is shallow (a regular 99,999-gon).
 
     Examples
     --------
