@@ -230,6 +230,13 @@ class ConvexPolygon:
     def from_points(cls, points: ArrayLike, tol: Tolerance = DEFAULT_TOLERANCE) -> ConvexPolygon:
         """Convex hull of a point list, counter-clockwise, duplicates and collinear points dropped.
 
+        Andrew's monotone chain (:func:`~bayesgrasp.geometry.hull.hull_indices`; on Python
+        floats up to :data:`~bayesgrasp.sizes.SMALL` points,
+        :func:`~bayesgrasp.geometry.hull.hull_of_few`), then the vertices within
+        ``tol.length_for(extent)`` of their neighbours' chord dropped
+        (:func:`~bayesgrasp.geometry.hull.drop_near_collinear`), and the area and centroid by
+        the shoelace formula. The vertices start at the lexicographically least one.
+
         Parameters
         ----------
         points : array_like of shape (N, 2)

@@ -121,25 +121,34 @@ def monotone_chain(points: Sequence[tuple[float, float]]) -> list[int]:
     >>> monotone_chain([(0.0, 0.0), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (1.0, 0.0), (1.0, 1.0)])
     [0, 4, 5, 1]
     """
-
-    def half(order: range) -> list[int]:
-        # The points in `order`, each after popping the chain's last point while the last
-        # two and the new one do not turn strictly left (cross product <= 0).
-        chain: list[int] = []
-        for k in order:
-            x, y = points[k]
-            while len(chain) >= 2:
-                ax, ay = points[chain[-2]]
-                bx, by = points[chain[-1]]
-                if (bx - ax) * (y - ay) - (by - ay) * (x - ax) > 0:
-                    break
-                chain.pop()
-            chain.append(k)
-        return chain
-
     n = len(points)
-    lower, upper = half(range(n)), half(range(n - 1, -1, -1))
+    lower = _half_chain(points, range(n))
+    upper = _half_chain(points, range(n - 1, -1, -1))
     return lower[:-1] + upper[:-1]  # each ends where the other starts
+
+
+def _half_chain(points: Sequence[tuple[float, float]], order: range) -> list[int]:
+    """One half of :func:`monotone_chain`: the points in ``order``, left turns only.
+
+    Each point is pushed after popping the chain's last point while the last two and the
+    new one do not turn strictly left (cross product ``<= 0``). The chain's points are kept
+    beside their indices.
+    """
+    chain: list[tuple[float, float]] = []
+    indices: list[int] = []
+    for k in order:
+        p = points[k]
+        x, y = p
+        while len(chain) >= 2:
+            ax, ay = chain[-2]
+            bx, by = chain[-1]
+            if (bx - ax) * (y - ay) - (by - ay) * (x - ax) > 0:
+                break
+            chain.pop()
+            indices.pop()
+        chain.append(p)
+        indices.append(k)
+    return indices
 
 
 def pruned_half_chain(
