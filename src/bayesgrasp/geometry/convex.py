@@ -339,6 +339,8 @@ class ConvexPolygon:
         symmetric within that tolerance is treated as exactly symmetric everywhere
         downstream: its diameter function's extrema, hence its squeeze function, are those
         of :meth:`symmetrized` (see :func:`~bayesgrasp.geometry.diameter.diameter_function`).
+        Only divisors of the number of vertices can be orders, tested largest first
+        (:mod:`~bayesgrasp.geometry.symmetry`).
 
         Examples
         --------

@@ -270,6 +270,7 @@ class Part:
         return Part.from_points(self.outline * factor, self.name, com, units)
 
 
+# The fields' setters, for _of_hull: the class itself refuses assignment (a frozen value).
 _part_name, _part_hull, _part_outline, _part_center_of_mass, _part_units, _part_holes = (
     Part.__dict__[f.name].__set__ for f in dataclasses.fields(Part)
 )
