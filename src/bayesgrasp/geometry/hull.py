@@ -23,10 +23,11 @@ Two implementations of the chain, held together index for index by a property te
 
 - :func:`monotone_chain`, the reference: the algorithm as written above, one point at a
   time. Plain Python; it also takes the hull of a few points (:func:`hull_of_few`).
-- :func:`monotone_chain_vectorised`, for large parts (2.5x to 4.6x faster on 10^4 to 10^5
-  points): every point that does not turn strictly left between its neighbours is removed
-  at once, by array operations, until none is left (see :func:`pruned_half_chain`);
-  :func:`hull_indices` falls back to the reference when that takes too many rounds.
+- :func:`monotone_chain_vectorised`, for large parts (on 10^4 to 10^5 sorted points the
+  chain is 9x to 15x faster, a large part's hull 2.5x to 4.6x): every point that does not
+  turn strictly left between its neighbours is removed at once, by array operations, until
+  none is left (see :func:`pruned_half_chain`); :func:`hull_indices` falls back to the
+  reference when that takes too many rounds.
 
 **Tolerances.** Rounded coordinates leave hull vertices a hair off the chord of their
 neighbours; :func:`drop_near_collinear` removes those within ``eps`` (``Tolerance.length``
