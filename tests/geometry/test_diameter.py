@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from bayesgrasp.geometry import diameter
+from bayesgrasp.geometry import diameter_pieces
 from bayesgrasp.geometry.diameter import DiameterFunction, diameter_function
 from bayesgrasp.geometry.polygon import ConvexPolygon
 from reference import (
@@ -301,8 +301,8 @@ def test_arrays_are_read_only_and_frozen() -> None:
 @given(pts=st.one_of(convex_points(), lattice_points(max_size=60, bound=8)))
 def test_plain_python_and_numpy_pieces_agree(pts: np.ndarray) -> None:
     poly = ConvexPolygon.from_points(pts)
-    a = diameter._pieces_numpy(poly.vertices, poly.tol.angle)
-    b = diameter._pieces_python(*poly.vertices.T.tolist(), poly.tol.angle)
+    a = diameter_pieces.pieces_numpy(poly.vertices, poly.tol.angle)
+    b = diameter_pieces.pieces_python(*poly.vertices.T.tolist(), poly.tol.angle)
     for x, y in zip(a[:5], b[:5], strict=True):
         assert np.shape(x) == np.shape(y)
         # Chord lengths scale with the part; angles and indices do not.

@@ -22,7 +22,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from bayesgrasp.angles import TWO_PI
 from bayesgrasp.errors import BayesGraspError, PartError, PlanningError
-from bayesgrasp.geometry import diameter, polygon
+from bayesgrasp.geometry import convex, diameter, diameter_pieces, polygon
+from bayesgrasp.geometry import part as part_module
 from bayesgrasp.geometry.curved import squeeze_model
 from bayesgrasp.geometry.diameter import DiameterFunction, diameter_function
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part, hull_contains
@@ -75,12 +76,12 @@ def any_points() -> st.SearchStrategy[FloatArray]:
 @pytest.fixture
 def numpy_everywhere() -> Iterator[None]:
     """The hull, symmetry test and diameter pieces by numpy for every size."""
-    saved = polygon._SMALL, diameter._SMALL
-    polygon._SMALL = diameter._SMALL = 0
+    saved = convex._SMALL, part_module._SMALL, diameter._SMALL
+    convex._SMALL = part_module._SMALL = diameter._SMALL = 0
     try:
         yield
     finally:
-        polygon._SMALL, diameter._SMALL = saved
+        convex._SMALL, part_module._SMALL, diameter._SMALL = saved
 
 
 def model(points: FloatArray) -> tuple[Part, DiameterFunction, TransferFunction] | None:
@@ -100,12 +101,12 @@ def model(points: FloatArray) -> tuple[Part, DiameterFunction, TransferFunction]
 @given(pts=any_points())
 def test_plain_python_set_up_matches_numpy(pts: FloatArray) -> None:
     small = model(pts)
-    saved = polygon._SMALL, diameter._SMALL
-    polygon._SMALL = diameter._SMALL = 0
+    saved = convex._SMALL, part_module._SMALL, diameter._SMALL
+    convex._SMALL = part_module._SMALL = diameter._SMALL = 0
     try:
         general = model(pts)
     finally:
-        polygon._SMALL, diameter._SMALL = saved
+        convex._SMALL, part_module._SMALL, diameter._SMALL = saved
     assert (small is None) == (general is None)
     if small is None or general is None:
         return
@@ -127,7 +128,7 @@ def test_the_study_polygons_match_numpy(numpy_everywhere: None) -> None:
     rng = np.random.default_rng(1)
     clouds = [rng.uniform(size=(10, 2)) for _ in range(200)]
     general = [squeeze_model(Part.from_points(c))[1] for c in clouds]
-    polygon._SMALL, diameter._SMALL = 64, 64
+    convex._SMALL, part_module._SMALL, diameter._SMALL = 64, 64, 64
     for c, s2 in zip(clouds, general, strict=True):
         s1 = squeeze_model(Part.from_points(c))[1]
         assert s1.n_states == s2.n_states and s1.period == s2.period
@@ -137,19 +138,6 @@ def test_the_study_polygons_match_numpy(numpy_everywhere: None) -> None:
 # --------------------------------------------------------------------------- the hull
 
 
-@given(pts=st.one_of(lattice_points(min_size=2, max_size=40, bound=3), convex_points()))
-def test_pair_chain_is_the_index_chain(pts: FloatArray) -> None:
-    """The chain on (x, y) pairs makes the index chain's decisions (duplicates, collinear)."""
-    order = np.lexsort((pts[:, 1], pts[:, 0]))
-    xs, ys = pts[order, 0].tolist(), pts[order, 1].tolist()
-    chain = polygon._monotone_chain(xs, ys)
-    pairs = sorted(zip(pts[:, 0].tolist(), pts[:, 1].tolist(), strict=True))
-    assert pairs == list(zip(xs, ys, strict=True))  # the same order as np.lexsort
-    lower = polygon._chain_python(pairs)
-    upper = polygon._chain_python(pairs[::-1])
-    assert lower[:-1] + upper[:-1] == [(xs[i], ys[i]) for i in chain]
-
-
 @settings(max_examples=200, deadline=None)
 @given(pts=st.one_of(thin_points(), convex_points(), near_regular_points()))
 def test_centroid_shortcut_agrees_with_the_full_test(pts: FloatArray) -> None:
@@ -157,7 +145,7 @@ def test_centroid_shortcut_agrees_with_the_full_test(pts: FloatArray) -> None:
         hull = ConvexPolygon.from_points(pts)
     except PartError:  # a sliver below the tolerance is no part
         return
-    assert polygon._holds_centroid(hull) == hull_contains(hull, hull.centroid)
+    assert part_module.holds_centroid(hull) == hull_contains(hull, hull.centroid)
 
 
 def test_centroid_shortcut_near_its_threshold(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -168,7 +156,7 @@ def test_centroid_shortcut_near_its_threshold(monkeypatch: pytest.MonkeyPatch) -
         full_tests.append(hull)
         return hull_contains(hull, point)
 
-    monkeypatch.setattr(polygon, "hull_contains", counted)
+    monkeypatch.setattr(part_module, "hull_contains", counted)
     rng = np.random.default_rng(5)
     tested = 0
     for height in np.geomspace(1e-11, 1e-6, 400):
@@ -177,7 +165,7 @@ def test_centroid_shortcut_near_its_threshold(monkeypatch: pytest.MonkeyPatch) -
             hull = ConvexPolygon.from_points(pts)
         except PartError:  # too thin to be a part
             continue
-        assert polygon._holds_centroid(hull) == hull_contains(hull, hull.centroid)
+        assert part_module.holds_centroid(hull) == hull_contains(hull, hull.centroid)
         tested += 1
     assert 0 < len(full_tests) < tested > 100  # the shortcut and the full test both ran
 
@@ -260,7 +248,7 @@ def test_diameter_function_lazy_arrays() -> None:
     assert d.pairs.shape == (len(d.breaks), 2) and d.pairs.dtype == np.intp
     for arr in (d.breaks, d.lengths, d.phases, d.pairs, d.minima, d.maxima):
         assert not arr.flags.writeable
-    big = diameter._pieces_numpy(poly.vertices, poly.tol.angle)
+    big = diameter_pieces.pieces_numpy(poly.vertices, poly.tol.angle)
     assert_array_equal(d.pairs, np.stack([big[3], big[4]], axis=1))
     back = pickle.loads(pickle.dumps(d))
     assert_array_equal(back.minima, d.minima)
@@ -335,12 +323,12 @@ def parallel_points(draw: st.DrawFn) -> FloatArray:
 
 def general_diameter(poly: ConvexPolygon) -> DiameterFunction:
     """:func:`diameter_function` with the one-pass extrema (``_in_order``) turned off."""
-    saved = diameter._in_order
-    diameter._in_order = lambda *args: None
+    saved = diameter.in_order
+    diameter.in_order = lambda *args: None
     try:
         return diameter_function(poly)
     finally:
-        diameter._in_order = saved
+        diameter.in_order = saved
 
 
 TOLERANCES = [
@@ -379,18 +367,18 @@ def test_one_pass_extrema_are_the_general_paths(pts: FloatArray, tol: Tolerance)
 def test_the_study_polygons_take_the_one_pass_extrema() -> None:
     """The common case is the fast one: no flat slope, no shallow pair, no symmetry."""
     calls = []
-    saved = diameter._in_order
+    saved = diameter.in_order
 
     def spy(*args: object) -> object:
         calls.append(saved(*args))  # type: ignore[arg-type]
         return calls[-1]
 
-    diameter._in_order = spy  # type: ignore[assignment]
+    diameter.in_order = spy  # type: ignore[assignment]
     try:
         for c in np.random.default_rng(1).uniform(size=(200, 10, 2)):
             diameter_function(ConvexPolygon.from_points(c))
     finally:
-        diameter._in_order = saved
+        diameter.in_order = saved
     assert len(calls) == 200 and all(found is not None for found in calls)
 
 

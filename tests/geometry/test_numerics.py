@@ -26,7 +26,7 @@ from numpy.testing import assert_allclose
 from numpy.typing import NDArray
 
 from bayesgrasp.errors import PartError
-from bayesgrasp.geometry import diameter, polygon
+from bayesgrasp.geometry import diameter_pieces, symmetry
 from bayesgrasp.geometry.diameter import diameter_function
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part, as_points
 from bayesgrasp.geometry.push import push_function, push_grasp_function
@@ -236,8 +236,8 @@ def test_near_regular_12_gons_build_a_problem() -> None:
 
 def _check_paths(v: FloatArray, tol: float, period: float) -> None:
     """Both paths find alternating, paired extrema, and the same ones."""
-    a = diameter._pieces_numpy(v, tol, period)
-    b = diameter._pieces_python(*v.T.tolist(), tol, period)
+    a = diameter_pieces.pieces_numpy(v, tol, period)
+    b = diameter_pieces.pieces_python(*v.T.tolist(), tol, period)
     scale = max(1.0, float(np.max(np.abs(v))))  # lengths scale with the part, angles do not
     for x, y in zip(a[:5], b[:5], strict=True):
         assert_allclose(x, y, atol=1e-13 * scale, rtol=0)
@@ -345,7 +345,7 @@ def test_drop_shallow_cancels_the_shallowest_pair_first(values: list[int], depth
         ext.pop()
     if not ext:
         return
-    got = diameter._drop_shallow(ext, float(depth))
+    got = diameter_pieces.drop_shallow(ext, float(depth))
     assert got == _drop_shallow_reference(ext, float(depth))
     assert len(got) >= 2
     assert all(a[2] != b[2] for a, b in zip(got, got[1:] + got[:1], strict=True))
@@ -462,7 +462,7 @@ def test_symmetry_order_python_and_numpy_agree(n: int) -> None:
         eps = poly.tol.symmetry_for(poly.size)
         orders = [r for r in range(2, n + 1) if n % r == 0][::-1]
         xs, ys = poly.vertices.T.tolist()
-        expected = polygon._symmetry_order_python(xs, ys, poly.centroid, orders, eps)
+        expected = symmetry.symmetry_order_python(xs, ys, poly.centroid, orders, eps)
         assert poly.symmetry_order == expected
         # Asking for the orders from 3 up first, then for all, gives the same answers.
         fresh = ConvexPolygon.from_points(poly.vertices)

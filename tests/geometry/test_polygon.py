@@ -12,7 +12,6 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose, assert_array_equal
 
 from bayesgrasp.errors import BayesGraspError, PartError
-from bayesgrasp.geometry import polygon as geometry
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part, as_points, polygon_area_centroid
 from bayesgrasp.tolerance import Tolerance
 from reference import max_pair_distance, regular_polygon, rotate, round_significant
@@ -421,21 +420,6 @@ def test_part_center_of_mass() -> None:
         Part.from_points(SQUARE, center_of_mass=("a", 0.5))
 
 
-@given(pts=st.one_of(convex_points(), lattice_points(max_size=60, bound=5)))
-def test_plain_python_and_numpy_hulls_agree(pts: np.ndarray) -> None:
-    extent = float(np.max(np.ptp(pts, axis=0)))
-    eps = Tolerance().length_for(extent)
-    xs, ys, area, cx, cy = geometry._hull_python(geometry._sorted_pairs(*pts.T.tolist()), eps)
-    hull = pts[geometry._hull_indices(pts)]
-    if len(hull) > 3:
-        hull = geometry._drop_near_collinear(hull, eps)
-    assert_array_equal(np.array([xs, ys]).T.reshape(-1, 2), hull)
-    if len(hull) >= 3:
-        ref_area, ref_centroid = polygon_area_centroid(hull)
-        assert_allclose(area, ref_area, rtol=1e-12, atol=1e-300)
-        assert_allclose([cx, cy], ref_centroid, rtol=1e-12, atol=1e-12 * extent)
-
-
 def test_many_points(rng: np.random.Generator) -> None:
     t = rng.uniform(0, 2 * math.pi, 5000)
     ring = np.column_stack([3 * np.cos(t), np.sin(t)])
@@ -444,38 +428,3 @@ def test_many_points(rng: np.random.Generator) -> None:
     assert poly.n_sides > 4000
     assert_allclose(poly.area, 3 * math.pi, rtol=1e-4)
     assert_allclose(poly.centroid, [0, 0], atol=1e-3)
-
-
-def sequential_hull(points: np.ndarray) -> np.ndarray:
-    """Andrew's monotone chain, one point at a time (the reference of the array version)."""
-    order = np.lexsort((points[:, 1], points[:, 0]))
-    pts = points[order]
-    chain = geometry._monotone_chain(pts[:, 0].tolist(), pts[:, 1].tolist())
-    return order[np.array(chain, dtype=np.intp)]
-
-
-@given(
-    pts=st.one_of(
-        lattice_points(min_size=3, max_size=300, bound=4),
-        lattice_points(min_size=3, max_size=200, bound=1000),
-        convex_points(),
-    )
-)
-def test_array_hull_is_the_sequential_chain(pts: np.ndarray) -> None:
-    # Duplicates, collinear runs, vertical edges: the same vertices, the same indices.
-    assert_array_equal(geometry._hull_indices(pts), sequential_hull(pts))
-
-
-def test_array_hull_on_large_clouds(rng: np.random.Generator) -> None:
-    t = rng.uniform(0, 2 * math.pi, 20_000)
-    clouds = [
-        rng.random((20_000, 2)),
-        np.column_stack([np.cos(t), np.sin(t)]),
-        np.round(rng.random((20_000, 2)) * 50) / 50,  # many repeated and collinear points
-        np.column_stack([2 * np.cos(np.sort(t)), np.sin(np.sort(t))]),
-    ]
-    for pts in clouds:
-        assert_array_equal(geometry._hull_indices(pts), sequential_hull(pts))
-    # Without rounds the array version gives up and the sequential chain runs.
-    xs, ys = clouds[0][:, 0], clouds[0][:, 1]
-    assert geometry._pruned_chain(xs, ys, np.arange(len(xs)), rounds=0) is None

@@ -1,10 +1,11 @@
 """The parts of a few points, built on plain Python floats, against a reference.
 
 The hull of :data:`~bayesgrasp.sizes.SMALL` points or fewer is taken by
-:func:`polygon._hull_python`; :meth:`Part.from_points` must give its vertices, area, centroid
-and size bit for bit (as float hex), with the size computed here independently. Inputs:
-random, near-collinear, duplicates, thin, huge and tiny clouds, under several tolerances. The
-lazily made arrays of the polygons and parts are compared with the eager construction.
+:func:`~bayesgrasp.geometry.hull.hull_of_few`; :meth:`Part.from_points` must give its
+vertices, area, centroid and size bit for bit (as float hex), with the size computed here
+independently. Inputs: random, near-collinear, duplicates, thin, huge and tiny clouds, under
+several tolerances. The lazily made arrays of the polygons and parts are compared with the
+eager construction.
 """
 
 from __future__ import annotations
@@ -20,7 +21,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_array_equal
 
 from bayesgrasp.errors import PartError
-from bayesgrasp.geometry import polygon
+from bayesgrasp.geometry import hull
+from bayesgrasp.geometry import part as part_module
 from bayesgrasp.geometry.polygon import ConvexPolygon, Part
 from bayesgrasp.tolerance import DEFAULT_TOLERANCE, Tolerance
 from strategies import convex_points, lattice_points
@@ -87,12 +89,12 @@ def hexes(*values: float | list[float]) -> list[object]:
 
 
 def reference(pts: FloatArray, tol: Tolerance) -> tuple[list[object], float] | None:
-    """``_hull_python`` and the size as the hull had them, or None when refused."""
+    """``hull_of_few`` and the size as the hull had them, or None when refused."""
     px, py = pts.T.tolist()
     x0, x1 = min(px), max(px)
     extent = max(x1 - x0, max(py) - min(py))
     eps = tol.length_for(extent)
-    xs, ys, area, cx, cy = polygon._hull_python(polygon._sorted_pairs(px, py), eps)
+    xs, ys, area, cx, cy = hull.hull_of_few(sorted(zip(px, py, strict=True)), eps)
     if len(xs) < 3 or area <= eps * extent:
         return None
     size = math.sqrt(max([(x - cx) ** 2 + (y - cy) ** 2 for x, y in zip(xs, ys, strict=True)]))
@@ -141,7 +143,7 @@ def test_part_from_points_is_the_reference(pts: FloatArray, tol: Tolerance) -> N
     assert part.outline is not pts and not part.outline.flags.writeable
     assert_array_equal(part.center_of_mass, hull.centroid)
     assert not part.center_of_mass.flags.writeable
-    assert polygon._holds_centroid(hull) == polygon.hull_contains(hull, hull.centroid)
+    assert part_module.holds_centroid(hull) == part_module.hull_contains(hull, hull.centroid)
 
 
 def test_lists_and_arrays_give_the_same_part() -> None:

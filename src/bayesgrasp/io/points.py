@@ -36,9 +36,8 @@ from numpy.typing import NDArray
 
 from ..errors import PartError
 from ..files import json_float, json_int, nesting_depth
-from ..geometry import ConvexPolygon, Part, as_points, find_crossing
+from ..geometry import Part, as_points, find_crossing
 from ..sizes import SMALL
-from ..tolerance import DEFAULT_TOLERANCE
 from ._common import (
     MAX_BYTES,
     MAX_COORDINATE,
@@ -276,8 +275,7 @@ def _firm_turn(
     :func:`_small_is_simple` and :func:`_small_is_convex` both return True, found in O(N)
     rather than their O(N^2) pairs of edges. Returns the cross product ``u x w`` (``u`` the
     incoming, ``w`` the outgoing edge) of least magnitude (positive: the ring runs
-    counter-clockwise), for :meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`;
-    ``0.0`` means only "not shown here".
+    counter-clockwise); ``0.0`` means only "not shown here".
 
     Why: a ring that turns one way at every vertex and once in all (exterior angles in
     (0, pi) summing to 2 pi) is a convex polygon. Every vertex R off an edge PQ then lies at
@@ -381,26 +379,13 @@ def _small_point_list_part(
     """:func:`point_list_part` of the coordinates :func:`_small_floats` gave.
 
     ``None`` when a coordinate is beyond ``limit`` (the caller reads the points another
-    way). A firmly convex ring is its own hull, taken without the hull's chains
-    (:meth:`~bayesgrasp.geometry.polygon.ConvexPolygon._of_firm_ring`); its outline is a
-    read-only view of one flat array of the points.
+    way).
     """
     sx, sy = sorted(xs), sorted(ys)  # (cheaper than min and max)
     x0, x1, y0, y1 = sx[0], sx[-1], sy[0], sy[-1]
     if not (-limit <= x0 and x1 <= limit and -limit <= y0 and y1 <= limit):
         return None
-    least = _firm_turn(xs, ys, x0, x1, y0, y1)
-    if least:  # most files: O(N)
-        hull = ConvexPolygon._of_firm_ring(xs, ys, least, x0, x1, y0, y1, DEFAULT_TOLERANCE)
-        if hull is not None:
-            flat = [0.0] * (2 * len(xs))
-            flat[::2], flat[1::2] = xs, ys
-            outline = np.array(flat, dtype=np.float64)
-            outline.setflags(write=False)
-            try:
-                return Part._of_hull(hull, outline.reshape(-1, 2), name, center_of_mass, units)
-            except PartError as exc:
-                raise fail(Path(path), str(exc)) from None
+    least = _firm_turn(xs, ys, x0, x1, y0, y1)  # most files: convex, found in O(N)
     small = list(zip(xs, ys, strict=True))
     pts = np.array(small, dtype=np.float64)
     sring = _small_ring(small)
