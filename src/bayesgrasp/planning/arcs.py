@@ -33,6 +33,17 @@ no more. The front of a transfer function (:func:`arc_front`: at most one arc fo
 sorted by span, widths increasing) is computed once; the widest arc under a span limit is
 then a binary search (:meth:`ArcFront.widest`).
 
+Ties between copies
+-------------------
+A transfer function of period ``P`` has ``2 pi / P`` copies of every arc, shifted by ``P``:
+the same width and span, hence plans of the same probability and cost whose success arcs
+(and final orientations) differ by ``P``. Computed widths of the copies differ in the last
+bits, so the front's rule (of equal arcs the first) would follow the rounding. For a part
+whose diameter function is computed anew at each shape (a curved outline, flattened at a
+chordal tolerance) the planner takes the arcs of one period only (:func:`period_rows`: the
+basins whose stable orientation lies in ``[-tol, P - tol)``), so the same copy wins at
+every tolerance. Polygons keep every row (their plans are the ones documented).
+
 Witness chains and staircases
 -----------------------------
 Angles come from a chain of *witness* arcs ``a_1, ..., a_k``, one per action, each an open arc
@@ -99,6 +110,7 @@ from numpy.typing import NDArray
 
 from ..angles import TWO_PI
 from ..errors import PlanningError
+from ..geometry.curved import CurvedPart
 from ..geometry.transfer import TransferFunction
 from ..model.actions import Action
 from ..model.problem import Problem
@@ -119,7 +131,9 @@ __all__ = [
     "arc_front",
     "chain_option",
     "few_states",
+    "one_period_arcs",
     "pareto_front",
+    "period_rows",
     "small_options",
     "staircase",
     "widest_arc",
@@ -243,6 +257,42 @@ class ArcFront:
         return self.width_list[n] if n >= 0 else 0.0
 
 
+def period_rows(f: TransferFunction, tol: float) -> list[int] | None:
+    """The basins of one period of ``f``: those whose stable orientation is in ``[-tol, P - tol)``.
+
+    Every arc of ``f`` is a copy, shifted by a multiple of the period ``P``, of an arc that
+    starts at one of these basins, so a front of these rows alone holds every width and
+    span, and of copies always the same one (the window starts at ``-tol`` so that a state
+    at 0 computed as ``2 pi`` less a rounding stays the first). ``None`` when ``f`` has no
+    shorter period than ``2 pi`` (every row).
+
+    Examples
+    --------
+    >>> from bayesgrasp.geometry.polygon import ConvexPolygon
+    >>> from bayesgrasp.geometry.transfer import squeeze_function
+    >>> s = squeeze_function(ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
+    >>> np.degrees(s.stable).round(6).tolist(), period_rows(s, 1e-9)
+    ([0.0, 90.0, 180.0, 270.0], [0, 1])
+    """
+    k = f.n_states
+    copies = round(TWO_PI / f.period)
+    if copies <= 1 or k % copies:
+        return None
+    period = f.period
+    rows = [i for i, s in enumerate(f.values[0]) if (s + tol) % TWO_PI < period]
+    return rows if len(rows) == k // copies else None
+
+
+def one_period_arcs(problem: Problem) -> bool:
+    """Whether the planners take the arcs of one period only (:func:`period_rows`).
+
+    For curved parts (and parts with a shape tolerance), whose transfer functions are
+    computed anew at each flattening: ties between copies of a plan are then broken the
+    same way at every chordal tolerance.
+    """
+    return isinstance(problem.part, CurvedPart)
+
+
 def period_cap(problem: Problem) -> float:
     """The angle no plan orients beyond: the largest period of the action types, or less.
 
@@ -257,7 +307,12 @@ def period_cap(problem: Problem) -> float:
 
 
 def arc_front(
-    f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK, prune: bool | None = None
+    f: TransferFunction,
+    max_span: float,
+    *,
+    chunk: int = ARC_CHUNK,
+    prune: bool | None = None,
+    rows: Sequence[int] | None = None,
 ) -> ArcFront:
     """The front of the arcs of ``f`` whose image spans less than ``max_span``.
 
@@ -275,6 +330,8 @@ def arc_front(
         Enumerate only the arcs that can be on the front (:func:`_pruned_candidates`; the
         default above :data:`PRUNE_STATES` states) or every arc (O(K^2)). The front is the
         same, bit for bit.
+    rows : sequence of int, optional
+        Only arcs that start at these basins (increasing; :func:`period_rows`); default all.
 
     Returns
     -------
@@ -290,8 +347,8 @@ def arc_front(
     ([0.0, 90.0, 180.0, 270.0], [126.869898, 180.0, 306.869898, 360.0])
     """
     if f.n_states <= SMALL and prune is None:
-        return _arc_front_python(f, max_span)
-    geo = _ArcGeometry(f, max_span)
+        return _arc_front_python(f, max_span, rows)
+    geo = _ArcGeometry(f, max_span, rows)
     cand = None
     if prune if prune is not None else f.n_states > PRUNE_STATES:
         cand = _pruned_candidates(geo)
@@ -299,13 +356,12 @@ def arc_front(
         lo, width, first, span = geo.arcs(*cand)
         keep = pareto_front(span, width)
         return ArcFront.from_arrays(f.kind, lo[keep], width[keep], first[keep], span[keep])
-    k = geo.k
-    i_all = np.arange(k)
-    n_off = int(np.max(geo.last - i_all)) + 1
-    rows = max(1, chunk // n_off)
+    i_all = geo.rows
+    n_off = int(np.max(geo.last[i_all] - i_all)) + 1
+    step = max(1, chunk // n_off)
     parts: list[tuple[FloatArray, ...]] = []
-    for start in range(0, k, rows):
-        i = i_all[start : start + rows]
+    for start in range(0, len(i_all), step):
+        i = i_all[start : start + step]
         j = i[:, None] + np.arange(n_off)[None, :]  # (R, J) candidate last basins
         ok = j <= geo.last[i, None]
         lo, width, first, span = geo.arcs(np.broadcast_to(i[:, None], j.shape)[ok], j[ok])
@@ -316,21 +372,30 @@ def arc_front(
     return ArcFront.from_arrays(f.kind, lo[keep], width[keep], first[keep], span[keep])
 
 
-def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
+def _arc_front_python(
+    f: TransferFunction, max_span: float, rows: Sequence[int] | None = None
+) -> ArcFront:
     """:func:`arc_front` in plain Python floats for a few states (:func:`_front_lists`)."""
     stable, lo, hi = f.values  # no arrays made for a few states
-    lists = _front_lists(stable, lo, hi, max_span)
+    lists = _front_lists(stable, lo, hi, max_span, rows)
     return ArcFront(f.kind, *lists)
 
 
 def _front_lists(
-    stable: Sequence[float], lo: Sequence[float], hi: Sequence[float], max_span: float
+    stable: Sequence[float],
+    lo: Sequence[float],
+    hi: Sequence[float],
+    max_span: float,
+    rows: Sequence[int] | None = None,
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Span, width, first stable orientation and start of the front's arcs, step for step.
 
     The whole front of a :class:`SpanFront` (every arc enumerated at once).
     """
-    front = SpanFront(stable, lo, hi, max_span, max_span)
+    if rows is None:
+        front = SpanFront(stable, lo, hi, max_span, max_span)
+    else:
+        front = SpanFront(stable, lo, hi, max_span, max_span, rows=rows)
     front.cover(math.inf)
     firsts, los = [], []
     for i in front.rows:
@@ -373,6 +438,8 @@ class SpanFront:
       ask for at most (``cap - 2 max(tol, accuracy)``, see
       :func:`bayesgrasp.planning.exact.plan_exact`), so the arcs of a squeeze that span a
       half-turn (K of about K^2 / 2) are seldom made.
+    - ``rows`` (increasing) limits the arcs to those starting at these basins (one period of
+      a periodic function, :func:`period_rows`); default every basin.
     """
 
     __slots__ = (
@@ -381,6 +448,7 @@ class SpanFront:
         "_first",
         "_hi2",
         "_pos",
+        "_rows",
         "_s2",
         "covered",
         "lo",
@@ -398,8 +466,10 @@ class SpanFront:
         hi: Sequence[float],
         max_span: float,
         first: float,
+        rows: Sequence[int] | None = None,
     ) -> None:
         k = len(stable)
+        starts = range(k) if rows is None else rows
         add_turn = TWO_PI.__add__  # TWO_PI + x is x + TWO_PI, bit for bit
         s2 = [*stable, *map(add_turn, stable)]
         hi2 = [*hi, *map(add_turn, hi)]
@@ -412,7 +482,7 @@ class SpanFront:
         cand: list[tuple[float, float, int]] = []
         add = cand.append
         left = bisect.bisect_left
-        for i in range(k):
+        for i in starts:
             si, li = stable[i], lo[i]
             w = hi[i] - li
             if w > widest:
@@ -423,7 +493,7 @@ class SpanFront:
         cand.sort(key=_span_of)
         self.stable, self.lo, self.max_span = stable, lo, max_span
         self._s2, self._hi2, self._first = s2, hi2, first
-        self._cand, self._pos = cand, 0
+        self._cand, self._pos, self._rows = cand, 0, starts
         self._complete = math.inf if first >= max_span else first - SPAN_SLACK
         self.spans, self.widths, self.rows = [0.0], [widest], [top]
         self.covered = -math.inf
@@ -463,7 +533,7 @@ class SpanFront:
         cand = self._cand[self._pos :]
         add = cand.append
         first, max_span = self._first, self.max_span
-        for i in range(k):
+        for i in self._rows:
             si, li = stable[i], lo[i]
             start = left(s2, si + first, i + 1, i + k)
             for j in range(start, left(s2, si + max_span, i + 1, i + k)):
@@ -496,16 +566,20 @@ class _ArcGeometry:
 
     ``j`` indexes the basins repeated once round the circle (``j >= K`` is basin ``j - K``
     2 pi on); ``last[i]`` is the last basin an arc from ``i`` may reach (its image spans
-    less than ``max_span``, and at least basin ``i`` itself).
+    less than ``max_span``, and at least basin ``i`` itself). Only arcs from the basins
+    ``rows`` (increasing) are enumerated.
     """
 
     f: TransferFunction
     k: int
+    rows: NDArray[np.intp]
     s2: FloatArray
     hi2: FloatArray
     last: NDArray[np.intp]
 
-    def __init__(self, f: TransferFunction, max_span: float) -> None:
+    def __init__(
+        self, f: TransferFunction, max_span: float, rows: Sequence[int] | None = None
+    ) -> None:
         k = f.n_states
         s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
         hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
@@ -513,8 +587,10 @@ class _ArcGeometry:
         last = np.clip(
             np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1
         )
-        for name, value in (("f", f), ("k", k), ("s2", s2), ("hi2", hi2), ("last", last)):
+        starts = i_all if rows is None else np.asarray(rows, dtype=np.intp)
+        for name, value in (("f", f), ("k", k), ("rows", starts), ("s2", s2), ("hi2", hi2)):
             object.__setattr__(self, name, value)
+        object.__setattr__(self, "last", last)
 
     def arcs(self, ii: NDArray[np.intp], jj: NDArray[np.intp]) -> tuple[FloatArray, ...]:
         """``lo``, ``width``, ``s_first`` and ``span`` of the arcs ``(ii, jj)``."""
@@ -523,11 +599,12 @@ class _ArcGeometry:
 
     def spans_between(self, a: float, b: float) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
         """Every arc whose image spans between ``a`` and ``b`` (a little more, never less)."""
-        s, k = self.f.stable, self.k
-        i_all = np.arange(k)
+        i_all = self.rows
+        s = self.f.stable[i_all]
         j0 = np.maximum(np.searchsorted(self.s2, s + (a - _EXCESS_SLACK), side="left"), i_all)
         j1 = np.minimum(
-            np.searchsorted(self.s2, s + (b + _EXCESS_SLACK), side="right") - 1, self.last
+            np.searchsorted(self.s2, s + (b + _EXCESS_SLACK), side="right") - 1,
+            self.last[i_all],
         )
         return _ranges(i_all, j0, j1)
 
@@ -563,14 +640,15 @@ def _pruned_candidates(geo: _ArcGeometry) -> tuple[NDArray[np.intp], NDArray[np.
     random parts).
     """
     k, f = geo.k, geo.f
-    left = f.stable - f.basin_lo  # (K,) l_i
+    i_all = geo.rows
+    last = geo.last[i_all]
+    left = (f.stable - f.basin_lo)[i_all]  # (R,) l_i of the rows
     right = f.basin_hi - f.stable  # (K,) r_j
     r_order = np.argsort(-right, kind="stable")
     r_desc = right[r_order]
     neg = -r_desc  # increasing
-    i_all = np.arange(k)
     max_span = float(np.max(geo.s2[geo.last] - f.stable))
-    total = int(np.sum(geo.last - i_all + 1))
+    total = int(np.sum(last - i_all + 1))
     budget = 8 * k
     while True:
         if 16 * budget >= total:  # nearly as many as all arcs
@@ -588,7 +666,7 @@ def _pruned_candidates(geo: _ArcGeometry) -> tuple[NDArray[np.intp], NDArray[np.
         jj = r_order[np.arange(len(ii)) - starts]
         jj = np.where(jj >= ii, jj, jj + k)
         ok = jj <= geo.last[ii]
-        few_i, few_j = _ranges(i_all, i_all, np.minimum(i_all + 1, geo.last))
+        few_i, few_j = _ranges(i_all, i_all, np.minimum(i_all + 1, last))
         ii, jj = np.concatenate([ii[ok], few_i]), np.concatenate([jj[ok], few_j])
         done: list[tuple[float, float]] = []  # span intervals enumerated in full
         limit = 16 * budget
@@ -890,11 +968,15 @@ class ArcPlanner:
     period : float
         No plan orients beyond this: the largest period of the action types, or ``2 pi / g``
         for a goal counting ``g`` symmetric orientations as one, whichever is less.
+    one_period : bool
+        The fronts hold the arcs of one period only (:func:`period_rows`): of copies of a
+        plan shifted by a period, the same one at every flattening of a curved part.
     """
 
     problem: Problem
     tol: float
     max_span: float
+    one_period: bool = False
     fronts: dict[str, ArcFront] = field(default_factory=dict)
     # Staircase of an action type followed by the actions of staircase ``next_id`` (-1:
     # none), with its own id: a suffix of a plan is found in O(1) from the next one.
@@ -920,12 +1002,14 @@ class ArcPlanner:
         """The planner of a problem: its angle tolerance, fronts up to the largest period."""
         tol = problem.states.angle_tol
         periods = [problem.transfers[t].period for t in problem.action_kinds]
-        return cls(problem, tol, max(periods) + tol)
+        return cls(problem, tol, max(periods) + tol, one_period_arcs(problem))
 
     def front(self, kind: str) -> ArcFront:
         """The arc front of one action type."""
         if kind not in self.fronts:
-            self.fronts[kind] = arc_front(self.problem.transfers[kind], self.max_span)
+            f = self.problem.transfers[kind]
+            rows = period_rows(f, self.tol) if self.one_period else None
+            self.fronts[kind] = arc_front(f, self.max_span, rows=rows)
         return self.fronts[kind]
 
     def extend(self, level: list[Counts]) -> tuple[list[tuple[Counts, str, float]], list[Counts]]:
