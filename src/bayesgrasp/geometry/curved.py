@@ -109,6 +109,13 @@ FLAT = math.radians(5.0)
 # Angles closer than this are the same crossing of two support functions (ties of the march).
 _TIE = 1e-12
 
+# Outline sizes whose areas and moments (squares and cubes of coordinates) are computed as
+# they come; others are computed at unit size and scaled back.
+_SAFE_SIZE = (1e-90, 1e90)
+
+# Largest coordinate of a part's points (as for polygons), its arcs sampled.
+_MAX_REACH = 1e150
+
 
 # --------------------------------------------------------------------------------------
 # Outlines of segments and arcs
@@ -213,6 +220,12 @@ class CurvedRing:
         p = self.points
         origin = p[0]
         rel = p - origin
+        size = float(np.max(np.abs(rel)))
+        if not _SAFE_SIZE[0] <= size <= _SAFE_SIZE[1] and size > 0.0:
+            # Moments are cubes of coordinates: at unit size they neither overflow nor
+            # underflow (outlines may reach 1e150 across, or be 1e-150 small).
+            unit = CurvedRing(rel / size, self.bulges).area_centroid()
+            return unit[0] * size * size, np.asarray(unit[1] * size + origin, dtype=np.float64)
         q = np.roll(rel, -1, axis=0)
         cross = rel[:, 0] * q[:, 1] - q[:, 0] * rel[:, 1]
         area = 0.5 * float(cross.sum())
@@ -1217,20 +1230,32 @@ def curved_part(
     if a0 < 0:
         ring = ring.reversed()
         a0, c0 = -a0, c0
-    area, moment = a0, a0 * c0
+    # The holes' areas as fractions of the outline's: their moments relative to it, so
+    # that the products stay within range for outlines up to 1e150 across.
+    scale = a0 if a0 > 0 and not _SAFE_SIZE[0] ** 2 <= a0 <= _SAFE_SIZE[1] ** 2 else 1.0
+    area, moment = a0 / scale, a0 / scale * c0
     oriented = []
     for h in holes:
         a, c = h.area_centroid()
-        area -= abs(a)
-        moment = moment - abs(a) * c
+        area -= abs(a) / scale
+        moment = moment - abs(a) / scale * c
         oriented.append(h if a > 0 else h.reversed())
     if not area > 0:
+        area *= scale
         raise PartError(f"`outline` must enclose a non-zero area; got area {area:.6g}")
     com = moment / area
     hull = curved_hull(ring, tol)
     step = 1e-3 * hull.size if display_tol is None else display_tol
+    outline, around = ring.flattened(step), hull.boundary(step)
+    reach = max(float(np.max(np.abs(outline))), float(np.max(np.abs(around))))
+    if reach > _MAX_REACH:  # an arc reaching (or sampled) past the limit its points keep
+        raise PartError(
+            f"`outline` reaches {reach:.17g} in absolute value along its arcs; the limit is "
+            f"{_MAX_REACH:g} (rescale the part's units)"
+        )
+    sampled = ConvexPolygon.from_points(around, hull.tol)
     base = Part.from_outline(
-        ring.flattened(step),
+        outline,
         [h.flattened(step) for h in oriented],
         name=name,
         center_of_mass=com,
@@ -1239,7 +1264,7 @@ def curved_part(
     )
     part = CurvedPart(
         base.name,
-        hull.polygon(step),
+        sampled,
         base.outline,
         base.center_of_mass,
         base.units,
