@@ -23,8 +23,9 @@ from bayesgrasp.geometry.transfer import transfer_from_extrema
 from bayesgrasp.model.actions import PUSH_GRASP, SQUEEZE
 from bayesgrasp.model.prior import HistogramPrior, Prior, UniformPrior, von_mises
 from bayesgrasp.model.problem import CostModel, Goal, Problem
-from bayesgrasp.planning import PlanReport, bfs, execute_plan, plan_bfs, plan_exact
+from bayesgrasp.planning import PlanReport, bfs, execute_plan, hyperstates, plan_bfs, plan_exact
 from bayesgrasp.planning.bfs import BfsResult, search_bfs
+from bayesgrasp.planning.hyperstates import HyperstateSearch, make_roots
 from bayesgrasp.planning.result import PlanStep
 from bayesgrasp.shapes import load, names
 
@@ -484,7 +485,7 @@ def test_children_blocks_change_no_result(
     cases = block_cases(rng)
     whole = [fingerprint(search_bfs(pb, **kw)) for pb, kw in cases]  # type: ignore[arg-type]
     assert any(len(pb.classes("squeeze").mid) * pb.n_states > block for pb, _ in cases)
-    monkeypatch.setattr(bfs, "_BLOCK", block)
+    monkeypatch.setattr(hyperstates, "_BLOCK", block)
     for (pb, kw), want in zip(cases, whole, strict=True):
         assert fingerprint(search_bfs(pb, **kw)) == want  # type: ignore[arg-type]
 
@@ -494,11 +495,11 @@ def test_padding_class_is_the_first_most_certain(
     rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch, block: int
 ) -> None:
     """Padding with push-grasps (not the squeeze): the first class of the highest success."""
-    monkeypatch.setattr(bfs, "_BLOCK", block)
+    monkeypatch.setattr(hyperstates, "_BLOCK", block)
     checked = 0
     for part in random_parts(rng, 10):
         pb = Problem.build(part, actions=("push-grasp",))
-        s = bfs._Search(pb, bfs._make_roots(pb, None, None))
+        s = HyperstateSearch(pb, make_roots(pb, None, None))
         for dist in (s.dist[s.add_root(0)], rng.dirichlet(np.ones(s.k))):
             probs = np.concatenate([s.goal_prob(ch) for _, ch in s.blocks(dist, 0)])
             assert bfs._pad_class(s, 0, dist) == int(np.argmax(probs))

@@ -33,6 +33,17 @@ no more. The front of a transfer function (:func:`arc_front`: at most one arc fo
 sorted by span, widths increasing) is computed once; the widest arc under a span limit is
 then a binary search (:meth:`ArcFront.widest`).
 
+Ties between copies
+-------------------
+A transfer function of period ``P`` has ``2 pi / P`` copies of every arc, shifted by ``P``:
+the same width and span, hence plans of the same probability and cost whose success arcs
+(and final orientations) differ by ``P``. Computed widths of the copies differ in the last
+bits, so the front's rule (of equal arcs the first) would follow the rounding. For a part
+whose diameter function is computed anew at each shape (a curved outline, flattened at a
+chordal tolerance) the planner takes the arcs of one period only (:func:`period_rows`: the
+basins whose stable orientation lies in ``[-tol, P - tol)``), so the same copy wins at
+every tolerance. Polygons keep every row (their plans are the ones documented).
+
 Witness chains and staircases
 -----------------------------
 Angles come from a chain of *witness* arcs ``a_1, ..., a_k``, one per action, each an open arc
@@ -90,36 +101,61 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
-import operator
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..angles import TWO_PI
 from ..errors import PlanningError
 from ..geometry.transfer import TransferFunction
-from ..model.actions import Action
 from ..model.problem import Problem
 from ..sizes import SMALL
-from .result import PlanOption, new_option, plan_actions, short_turns
+from .chains import (
+    Counts,
+    Plans,
+    Scored,
+    chain_option,
+    one_period_arcs,
+    period_cap,
+    small_options,
+    widest_reachable,
+)
+from .fronts import (
+    ARC_CHUNK,
+    PRUNE_STATES,
+    SPAN_SLACK,
+    Arc,
+    ArcFront,
+    SpanFront,
+    arc_front_arrays,
+    pareto_front,
+    period_rows,
+)
+from .result import PlanOption
+from .staircases import ROUNDING, Staircase, staircase_python
 
 __all__ = [
     "ARC_CHUNK",
     "PRUNE_STATES",
+    "ROUNDING",
+    "SPAN_SLACK",
     "STAIR_CELLS",
     "Arc",
     "ArcFront",
     "ArcPlanner",
     "Counts",
     "Plans",
+    "Scored",
     "SpanFront",
     "Staircase",
     "arc_front",
     "chain_option",
     "few_states",
+    "one_period_arcs",
     "pareto_front",
+    "period_cap",
+    "period_rows",
     "small_options",
     "staircase",
     "widest_arc",
@@ -127,137 +163,23 @@ __all__ = [
 ]
 
 FloatArray = NDArray[np.float64]
-Counts = tuple[int, ...]
-"""How many actions of each type, in ``problem.action_kinds`` order."""
-Scored = tuple[float, float, tuple[str, ...], float]
-"""``(p, cost, action types, success-arc length)`` of a plan, as the exact planner finds it."""
-Plans = list[Scored]
 
-ARC_CHUNK = 1 << 20
-"""Arcs :func:`arc_front` enumerates at once (bounds memory for parts with many states)."""
+STAIR_CELLS = 2_000_000
+"""Most staircase entries one witness chain may build; longer chains bisect on the margin."""
 
-# The lengths admit a margin above ``accuracy`` by ``span < L - 2 accuracy``, the staircases
-# compute it as ``(L - span) / 2``: these may differ by rounding, and the witness chain must
-# exist whenever the lengths allow it.
-ROUNDING = 1e-13
-
-
-@dataclass(frozen=True, slots=True)
-class Arc:
-    """An open arc ``(lo, hi)`` of one action's frame and its image ``[s_first, s_last]``.
-
-    ``s_first .. s_last`` are the stable orientations of the basins the arc covers.
-
-    Examples
-    --------
-    >>> a = Arc("squeeze", 0.0, 2.0, 0.5, 1.5)
-    >>> a.width, a.span
-    (2.0, 1.0)
-    """
-
-    kind: str
-    lo: float
-    hi: float
-    s_first: float
-    s_last: float
-
-    @property
-    def width(self) -> float:
-        """Length of the arc."""
-        return self.hi - self.lo
-
-    @property
-    def span(self) -> float:
-        """Length of its image."""
-        return self.s_last - self.s_first
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class ArcFront:
-    """The arcs of one transfer function that no other arc beats.
-
-    Sorted by ``span`` (of the image) increasing, with ``width`` strictly increasing: an
-    arc is dropped when another is at least as wide and spans no more. Arc ``n`` is the
-    open arc ``(lo[n], lo[n] + width[n])`` with image ``[s_first[n], s_first[n] + span[n]]``.
-    The values are held as lists (the scalar binary searches of the planners, and the
-    plain-Python paths of few states); the arrays ``lo``, ``width``, ``s_first`` and ``span``
-    are made from them on first use (numpy's paths). Build it with :func:`arc_front`.
-    """
-
-    kind: str
-    span_list: list[float]
-    width_list: list[float]
-    s_first_list: list[float]
-    lo_list: list[float]
-    _arrays: dict[str, FloatArray] = field(default_factory=dict, repr=False)
-
-    @classmethod
-    def from_arrays(
-        cls, kind: str, lo: FloatArray, width: FloatArray, s_first: FloatArray, span: FloatArray
-    ) -> ArcFront:
-        """The front of these arrays (kept, and repeated as lists)."""
-        out = cls(kind, span.tolist(), width.tolist(), s_first.tolist(), lo.tolist())
-        out._arrays.update(lo=lo, width=width, s_first=s_first, span=span)
-        return out
-
-    def _array(self, name: str, values: list[float]) -> FloatArray:
-        if name not in self._arrays:
-            self._arrays[name] = np.array(values, dtype=np.float64)
-        return self._arrays[name]
-
-    @property
-    def lo(self) -> FloatArray:
-        """Start of each arc."""
-        return self._array("lo", self.lo_list)
-
-    @property
-    def width(self) -> FloatArray:
-        """Length of each arc (increasing)."""
-        return self._array("width", self.width_list)
-
-    @property
-    def s_first(self) -> FloatArray:
-        """First stable orientation of each arc's image."""
-        return self._array("s_first", self.s_first_list)
-
-    @property
-    def span(self) -> FloatArray:
-        """Length of each arc's image (increasing)."""
-        return self._array("span", self.span_list)
-
-    def __len__(self) -> int:
-        return len(self.width_list)
-
-    def arc(self, n: int) -> Arc:
-        """Arc ``n`` as plain floats."""
-        lo, s = self.lo_list[n], self.s_first_list[n]
-        return Arc(self.kind, lo, lo + self.width_list[n], s, s + self.span_list[n])
-
-    def widest(self, max_span: float) -> float:
-        """Width of the widest arc whose image spans less than ``max_span`` (0 if none does).
-
-        Every front holds a single basin (span 0), so only ``max_span <= 0`` gives 0: the
-        arc after this action is too narrow to take even one point with the margin asked for.
-        """
-        n = bisect.bisect_left(self.span_list, max_span) - 1
-        return self.width_list[n] if n >= 0 else 0.0
-
-
-def period_cap(problem: Problem) -> float:
-    """The angle no plan orients beyond: the largest period of the action types, or less.
-
-    ``2 pi / g`` when that is smaller (``g`` the goal's group order).
-    """
-    period = 0.0
-    for t in problem.action_kinds:
-        if problem.transfers[t].period > period:
-            period = problem.transfers[t].period
-    cap = TWO_PI / problem.goal_group
-    return period if period < cap else cap
+FUSED = True
+"""Run the plain-list paths of parts of few states (:meth:`ArcPlanner.plan_options` and the
+fused one-action planner of :func:`bayesgrasp.planning.exact.plan_exact`); the tests turn it
+off to compare them with the general paths."""
 
 
 def arc_front(
-    f: TransferFunction, max_span: float, *, chunk: int = ARC_CHUNK, prune: bool | None = None
+    f: TransferFunction,
+    max_span: float,
+    *,
+    chunk: int = ARC_CHUNK,
+    prune: bool | None = None,
+    rows: Sequence[int] | None = None,
 ) -> ArcFront:
     """The front of the arcs of ``f`` whose image spans less than ``max_span``.
 
@@ -272,9 +194,12 @@ def arc_front(
     chunk : int
         Candidate arcs enumerated at once (the front does not depend on it).
     prune : bool, optional
-        Enumerate only the arcs that can be on the front (:func:`_pruned_candidates`; the
-        default above :data:`PRUNE_STATES` states) or every arc (O(K^2)). The front is the
-        same, bit for bit.
+        Enumerate only the arcs that can be on the front
+        (:func:`~bayesgrasp.planning.fronts.pruned_candidates`; the default above
+        :data:`PRUNE_STATES` states) or every arc (O(K^2)). The front is the same, bit for
+        bit.
+    rows : sequence of int, optional
+        Only arcs that start at these basins (increasing; :func:`period_rows`); default all.
 
     Returns
     -------
@@ -283,6 +208,7 @@ def arc_front(
     Examples
     --------
     >>> from bayesgrasp.geometry.polygon import ConvexPolygon
+    >>> from bayesgrasp.angles import TWO_PI
     >>> from bayesgrasp.geometry.transfer import squeeze_function
     >>> s = squeeze_function(ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
     >>> front = arc_front(s, TWO_PI)
@@ -290,369 +216,40 @@ def arc_front(
     ([0.0, 90.0, 180.0, 270.0], [126.869898, 180.0, 306.869898, 360.0])
     """
     if f.n_states <= SMALL and prune is None:
-        return _arc_front_python(f, max_span)
-    geo = _ArcGeometry(f, max_span)
-    cand = None
-    if prune if prune is not None else f.n_states > PRUNE_STATES:
-        cand = _pruned_candidates(geo)
-    if cand is not None:
-        lo, width, first, span = geo.arcs(*cand)
-        keep = pareto_front(span, width)
-        return ArcFront.from_arrays(f.kind, lo[keep], width[keep], first[keep], span[keep])
-    k = geo.k
-    i_all = np.arange(k)
-    n_off = int(np.max(geo.last - i_all)) + 1
-    rows = max(1, chunk // n_off)
-    parts: list[tuple[FloatArray, ...]] = []
-    for start in range(0, k, rows):
-        i = i_all[start : start + rows]
-        j = i[:, None] + np.arange(n_off)[None, :]  # (R, J) candidate last basins
-        ok = j <= geo.last[i, None]
-        lo, width, first, span = geo.arcs(np.broadcast_to(i[:, None], j.shape)[ok], j[ok])
-        keep = pareto_front(span, width)
-        parts.append((lo[keep], width[keep], first[keep], span[keep]))
-    lo, width, first, span = (np.concatenate(x) for x in zip(*parts, strict=True))
-    keep = pareto_front(span, width)
-    return ArcFront.from_arrays(f.kind, lo[keep], width[keep], first[keep], span[keep])
+        return _arc_front_python(f, max_span, rows)
+    return arc_front_arrays(f, max_span, chunk=chunk, prune=prune, rows=rows)
 
 
-def _arc_front_python(f: TransferFunction, max_span: float) -> ArcFront:
+def _arc_front_python(
+    f: TransferFunction, max_span: float, rows: Sequence[int] | None = None
+) -> ArcFront:
     """:func:`arc_front` in plain Python floats for a few states (:func:`_front_lists`)."""
     stable, lo, hi = f.values  # no arrays made for a few states
-    lists = _front_lists(stable, lo, hi, max_span)
+    lists = _front_lists(stable, lo, hi, max_span, rows)
     return ArcFront(f.kind, *lists)
 
 
 def _front_lists(
-    stable: Sequence[float], lo: Sequence[float], hi: Sequence[float], max_span: float
+    stable: Sequence[float],
+    lo: Sequence[float],
+    hi: Sequence[float],
+    max_span: float,
+    rows: Sequence[int] | None = None,
 ) -> tuple[list[float], list[float], list[float], list[float]]:
     """Span, width, first stable orientation and start of the front's arcs, step for step.
 
     The whole front of a :class:`SpanFront` (every arc enumerated at once).
     """
-    front = SpanFront(stable, lo, hi, max_span, max_span)
+    if rows is None:
+        front = SpanFront(stable, lo, hi, max_span, max_span)
+    else:
+        front = SpanFront(stable, lo, hi, max_span, max_span, rows=rows)
     front.cover(math.inf)
     firsts, los = [], []
     for i in front.rows:
         firsts.append(stable[i])
         los.append(lo[i])
     return front.spans, front.widths, firsts, los
-
-
-_span_of = operator.itemgetter(0)
-
-# Slack of the span bounds of SpanFront (and of the fused planner's staircases): far above
-# the rounding of sums and differences of angles below 4 pi (a few ulps, about 1e-15).
-SPAN_SLACK = 1e-12
-
-
-class SpanFront:
-    """The front of :func:`arc_front` in plain Python floats, built in order of span on demand.
-
-    ``spans``, ``widths`` and ``rows`` (the first basin of each arc) are the front's arcs
-    whose image spans less than the largest bound passed to :meth:`cover` so far, bit for
-    bit those of the whole front: the same candidates, the same float operations and the
-    same Pareto rule (:func:`pareto_front`: a stable sort by span, widths strictly
-    increasing, of equal spans the last kept; so of an equal span and width the arc of the
-    first basin). In this order:
-
-    - the single basins (span 0, the first of any ``(i, j)``) first: the first widest;
-    - the arcs of two or more basins by a stable sort on the span alone, ties in the order
-      ``(i, j)``. Of the arcs of one span the front keeps the widest, and of those the
-      first, the least ``i`` (one row has one arc of each span and width): the same arc as
-      the order ``(span, width, i)`` keeps, which the second batch below uses. A prefix
-      of either order gives the front's arcs of spans below the first span not taken
-      (later arcs span more, so they can neither join the front below it nor replace an
-      arc there): :meth:`cover` takes the arcs one by one, only as far as asked.
-    - The arcs are enumerated in two batches: first those of each row ``i`` whose last
-      stable orientation lies below ``s_i + first`` (``first`` at most ``max_span`` and
-      ``2 pi``), then, only if a bound above ``first - SPAN_SLACK`` is asked, the rest
-      (sorted in with the arcs not taken yet). An arc of the second batch spans at least
-      ``first`` less a rounding, so the first batch holds every arc that spans less than
-      ``first - SPAN_SLACK``. The planner of one action type passes the spans its widths
-      ask for at most (``cap - 2 max(tol, accuracy)``, see
-      :func:`bayesgrasp.planning.exact.plan_exact`), so the arcs of a squeeze that span a
-      half-turn (K of about K^2 / 2) are seldom made.
-    """
-
-    __slots__ = (
-        "_cand",
-        "_complete",
-        "_first",
-        "_hi2",
-        "_pos",
-        "_s2",
-        "covered",
-        "lo",
-        "max_span",
-        "rows",
-        "spans",
-        "stable",
-        "widths",
-    )
-
-    def __init__(
-        self,
-        stable: Sequence[float],
-        lo: Sequence[float],
-        hi: Sequence[float],
-        max_span: float,
-        first: float,
-    ) -> None:
-        k = len(stable)
-        add_turn = TWO_PI.__add__  # TWO_PI + x is x + TWO_PI, bit for bit
-        s2 = [*stable, *map(add_turn, stable)]
-        hi2 = [*hi, *map(add_turn, hi)]
-        if first > max_span:
-            first = max_span
-        if first > TWO_PI:  # then s2[i + k] >= s_i + first: the arcs below end before i + k
-            first = TWO_PI
-        widest = -math.inf
-        top = 0
-        cand: list[tuple[float, float, int]] = []
-        add = cand.append
-        left = bisect.bisect_left
-        for i in range(k):
-            si, li = stable[i], lo[i]
-            w = hi[i] - li
-            if w > widest:
-                widest, top = w, i
-            # Arcs (i, j), i < j < i + K: the image spans less than `first` (of max_span).
-            for j in range(i + 1, left(s2, si + first)):
-                add((s2[j] - si, hi2[j] - li, i))
-        cand.sort(key=_span_of)
-        self.stable, self.lo, self.max_span = stable, lo, max_span
-        self._s2, self._hi2, self._first = s2, hi2, first
-        self._cand, self._pos = cand, 0
-        self._complete = math.inf if first >= max_span else first - SPAN_SLACK
-        self.spans, self.widths, self.rows = [0.0], [widest], [top]
-        self.covered = -math.inf
-
-    def cover(self, bound: float) -> None:
-        """Take every arc whose image spans less than ``bound`` (at once: O(arcs taken))."""
-        if bound <= self.covered:
-            return
-        if bound > self._complete:
-            self._second_batch()
-        cand, pos = self._cand, self._pos
-        end = bisect.bisect_left(cand, (bound,), pos)  # the arcs of span < bound
-        if end > pos:
-            spans, widths, rows = self.spans, self.widths, self.rows
-            best = widths[-1]
-            for arc in cand[pos:end]:
-                if arc[1] > best:
-                    x, best, i = arc
-                    if spans[-1] == x:  # of equal spans only the widest stays
-                        widths[-1], rows[-1] = best, i
-                    else:
-                        spans.append(x)
-                        widths.append(best)
-                        rows.append(i)
-            self._pos = end
-        self.covered = bound
-
-    def _second_batch(self) -> None:
-        """The arcs of spans from ``first`` to ``max_span``, sorted in with those not taken.
-
-        By ``(span, width, i)``: arcs of one span from both batches are then in an order
-        that keeps the same arc of each span (the class notes).
-        """
-        stable, lo, s2, hi2 = self.stable, self.lo, self._s2, self._hi2
-        k = len(stable)
-        left = bisect.bisect_left
-        cand = self._cand[self._pos :]
-        add = cand.append
-        first, max_span = self._first, self.max_span
-        for i in range(k):
-            si, li = stable[i], lo[i]
-            start = left(s2, si + first, i + 1, i + k)
-            for j in range(start, left(s2, si + max_span, i + 1, i + k)):
-                add((s2[j] - si, hi2[j] - li, i))
-        cand.sort()
-        self._cand, self._pos, self._complete = cand, 0, math.inf
-
-
-PRUNE_STATES = 256
-"""Above this many states :func:`arc_front` enumerates only the arcs that can be on the front."""
-
-# An arc's width less its span is computed as left(i) + right(j) for the pruning; the two
-# differ from ``width - span`` by rounding (a few ulps of 4 pi), far below this.
-_EXCESS_SLACK = 1e-12
-STAIR_CELLS = 2_000_000
-"""Most staircase entries one witness chain may build; longer chains bisect on the margin."""
-
-# Steps of the front filled by enumeration in one round; more, and the threshold is lowered.
-_MAX_STEPS = 16
-
-FUSED = True
-"""Run the plain-list paths of parts of few states (:meth:`ArcPlanner.plan_options` and the
-fused one-action planner of :func:`bayesgrasp.planning.exact.plan_exact`); the tests turn it
-off to compare them with the general paths."""
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class _ArcGeometry:
-    """The arcs of one transfer function: arc ``(i, j)`` covers basins ``i..j`` (j < i + K).
-
-    ``j`` indexes the basins repeated once round the circle (``j >= K`` is basin ``j - K``
-    2 pi on); ``last[i]`` is the last basin an arc from ``i`` may reach (its image spans
-    less than ``max_span``, and at least basin ``i`` itself).
-    """
-
-    f: TransferFunction
-    k: int
-    s2: FloatArray
-    hi2: FloatArray
-    last: NDArray[np.intp]
-
-    def __init__(self, f: TransferFunction, max_span: float) -> None:
-        k = f.n_states
-        s2 = np.concatenate([f.stable, f.stable + TWO_PI])  # (2K,)
-        hi2 = np.concatenate([f.basin_hi, f.basin_hi + TWO_PI])
-        i_all = np.arange(k)
-        last = np.clip(
-            np.searchsorted(s2, f.stable + max_span, side="left") - 1, i_all, i_all + k - 1
-        )
-        for name, value in (("f", f), ("k", k), ("s2", s2), ("hi2", hi2), ("last", last)):
-            object.__setattr__(self, name, value)
-
-    def arcs(self, ii: NDArray[np.intp], jj: NDArray[np.intp]) -> tuple[FloatArray, ...]:
-        """``lo``, ``width``, ``s_first`` and ``span`` of the arcs ``(ii, jj)``."""
-        lo = self.f.basin_lo[ii]
-        return lo, self.hi2[jj] - lo, self.f.stable[ii], self.s2[jj] - self.f.stable[ii]
-
-    def spans_between(self, a: float, b: float) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-        """Every arc whose image spans between ``a`` and ``b`` (a little more, never less)."""
-        s, k = self.f.stable, self.k
-        i_all = np.arange(k)
-        j0 = np.maximum(np.searchsorted(self.s2, s + (a - _EXCESS_SLACK), side="left"), i_all)
-        j1 = np.minimum(
-            np.searchsorted(self.s2, s + (b + _EXCESS_SLACK), side="right") - 1, self.last
-        )
-        return _ranges(i_all, j0, j1)
-
-
-def _ranges(
-    i: NDArray[np.intp], j0: NDArray[np.intp], j1: NDArray[np.intp]
-) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """The pairs ``(i[r], j)`` for ``j0[r] <= j <= j1[r]``, by ``r`` then ``j``."""
-    count = np.maximum(j1 - j0 + 1, 0)
-    total = int(count.sum())
-    ii = np.repeat(i, count)
-    starts = np.repeat(np.cumsum(count) - count, count)
-    jj = np.repeat(j0, count) + (np.arange(total) - starts)
-    return ii, jj
-
-
-def _pruned_candidates(geo: _ArcGeometry) -> tuple[NDArray[np.intp], NDArray[np.intp]] | None:
-    """The arcs that can be on the front (or tie with it), in the order ``(i, j)``.
-
-    An arc's width is its span plus its *excess* ``l_i + r_j``: the half of basin ``i``
-    before its stable orientation and the half of basin ``j`` after. The front is a
-    staircase of points ``(span_n, width_n)``; an arc of span in ``[span_n, span_{n+1})``
-    and excess below ``T`` is strictly narrower than point ``n`` when
-    ``width_n >= span_{n+1} + T``. So: take the arcs of excess at least ``T`` (a few per
-    state, the threshold found by bisection on the counts) and the arcs of one or two
-    basins, compute their front, and enumerate every arc whose span falls in a step where
-    that inequality fails (also past the last point); repeat until no step fails. Each
-    round only adds arcs, so the front found is that of all arcs, and every arc tied with
-    a front point has an excess above ``T`` and is among the candidates. When the steps to
-    fill grow too many the threshold is lowered; ``None`` when the candidates would be
-    nearly all arcs (a regular polygon: every excess is equal), which are then enumerated
-    in chunks. Memory O(C), time O((K + C) log K) for C candidates (a few per state on
-    random parts).
-    """
-    k, f = geo.k, geo.f
-    left = f.stable - f.basin_lo  # (K,) l_i
-    right = f.basin_hi - f.stable  # (K,) r_j
-    r_order = np.argsort(-right, kind="stable")
-    r_desc = right[r_order]
-    neg = -r_desc  # increasing
-    i_all = np.arange(k)
-    max_span = float(np.max(geo.s2[geo.last] - f.stable))
-    total = int(np.sum(geo.last - i_all + 1))
-    budget = 8 * k
-    while True:
-        if 16 * budget >= total:  # nearly as many as all arcs
-            return None
-        # Threshold T with about `budget` pairs of excess >= T - slack.
-        lo_t, hi_t = float(left.min() + right.min()), float(left.max() + right.max())
-        for _ in range(60):
-            mid = 0.5 * (lo_t + hi_t)
-            n = int(np.searchsorted(neg, left - (mid - _EXCESS_SLACK), side="right").sum())
-            lo_t, hi_t = (mid, hi_t) if n > budget else (lo_t, mid)
-        t = hi_t
-        count = np.searchsorted(neg, left - (t - _EXCESS_SLACK), side="right")
-        ii = np.repeat(i_all, count)
-        starts = np.repeat(np.cumsum(count) - count, count)
-        jj = r_order[np.arange(len(ii)) - starts]
-        jj = np.where(jj >= ii, jj, jj + k)
-        ok = jj <= geo.last[ii]
-        few_i, few_j = _ranges(i_all, i_all, np.minimum(i_all + 1, geo.last))
-        ii, jj = np.concatenate([ii[ok], few_i]), np.concatenate([jj[ok], few_j])
-        done: list[tuple[float, float]] = []  # span intervals enumerated in full
-        limit = 16 * budget
-        while True:
-            key = np.sort(ii * (2 * k) + jj)  # by (i, j), without repeats
-            key = key[np.append(True, key[1:] != key[:-1])]
-            ii, jj = key // (2 * k), key % (2 * k)
-            if len(ii) > limit:
-                break
-            _, width, _, span = geo.arcs(ii, jj)
-            keep = pareto_front(span, width)
-            fs, fw = span[keep], width[keep]
-            nxt = np.append(fs[1:], max_span)
-            bad = np.flatnonzero(fw < nxt + t)
-            todo = [
-                (float(fs[n]), float(nxt[n]))
-                for n in bad
-                if not any(a <= fs[n] and nxt[n] <= b for a, b in done)
-            ]
-            if not todo:
-                return ii, jj
-            steps = _merge(todo)
-            if len(steps) > _MAX_STEPS:  # the threshold is too high: lower it
-                break
-            new_i, new_j = [ii], [jj]
-            for a, b in steps:
-                more_i, more_j = geo.spans_between(a, b)
-                new_i.append(more_i)
-                new_j.append(more_j)
-                done.append((a, b))
-            ii, jj = np.concatenate(new_i), np.concatenate(new_j)
-            if len(ii) > limit:
-                break
-        budget *= 4
-
-
-def _merge(intervals: list[tuple[float, float]]) -> list[tuple[float, float]]:
-    """Touching or overlapping intervals joined (sorted by start)."""
-    out: list[tuple[float, float]] = []
-    for a, b in sorted(intervals):
-        if out and a <= out[-1][1]:
-            out[-1] = (out[-1][0], max(out[-1][1], b))
-        else:
-            out.append((a, b))
-    return out
-
-
-def pareto_front(cost: FloatArray, value: FloatArray) -> NDArray[np.intp]:
-    """Indices of the Pareto front (least ``cost``, most ``value``), by cost increasing.
-
-    On the front ``value`` strictly increases; of equal pairs the first index is kept.
-
-    Examples
-    --------
-    >>> pareto_front(np.array([1.0, 0.0, 1.0, 2.0, 2.0]), np.array([3.0, 1.0, 3.0, 2.0, 5.0]))
-    array([1, 0, 4])
-    """
-    order = np.argsort(cost, kind="stable")
-    v = value[order]
-    best_before = np.maximum.accumulate(np.concatenate([[-np.inf], v[:-1]]))
-    kept = order[v > best_before]  # value increases; cost non-decreasing
-    # Of entries with equal cost only the last (the most value) is on the front.
-    c = cost[kept]
-    return np.asarray(kept[np.append(c[1:] != c[:-1], True)], dtype=np.intp)
 
 
 def widest_arc(f: TransferFunction, limit: float, tol: float) -> Arc:
@@ -692,91 +289,6 @@ def widest_arc(f: TransferFunction, limit: float, tol: float) -> Arc:
     return front.arc(bisect.bisect_left(widths, widths[-1] - tol))
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Staircase:
-    """``tau(x)`` of one action: the best least margin of it and the actions after it.
-
-    Entry ``r`` is arc ``index[r]`` of ``front``, with ``rest[r]`` the least margin of the
-    later actions after that arc. Entries are sorted by ``rest`` decreasing, with widths
-    strictly increasing: the Pareto front of (width, rest). With ``c = width - 2 rest``
-    (non-decreasing), ``tau(x)`` is attained at the first entry with ``c >= x`` (value
-    ``rest``) or at the one before it (value ``(width - x) / 2``). Build it with
-    :func:`staircase`.
-    """
-
-    front: ArcFront
-    index: NDArray[np.intp]
-    rest: FloatArray
-    width: FloatArray
-    c: FloatArray
-    c_list: list[float]
-    tol: float
-    accuracy: float
-    rest_list: list[float] = field(default_factory=list)
-    width_list: list[float] = field(default_factory=list)
-
-    def __post_init__(self) -> None:
-        if len(self.rest_list) != len(self.c_list):
-            object.__setattr__(self, "rest_list", self.rest.tolist())
-            object.__setattr__(self, "width_list", self.width.tolist())
-
-    def tau_list(self, xs: list[float]) -> list[float]:
-        """:meth:`tau` in plain Python floats (the same operations, for a few spans)."""
-        return _tau(self.c_list, self.rest_list, self.width_list, self.tol, self.accuracy, xs)
-
-    def tau(self, x: FloatArray) -> FloatArray:
-        """Best least margin for images of spans ``x`` (``-inf`` where none fits)."""
-        n = len(self.rest)
-        r = np.searchsorted(self.c, x, side="left")  # (M,) first entry with c >= x
-        at = np.where(r < n, self.rest[np.minimum(r, n - 1)], -np.inf)
-        before = np.where(r > 0, 0.5 * (self.width[np.maximum(r - 1, 0)] - x), -np.inf)
-        value = np.maximum(at, before)
-        ok = (value > self.tol) & (value >= self.accuracy - ROUNDING)
-        return np.asarray(np.where(ok, value, -np.inf), dtype=np.float64)
-
-    def pick(self, x: float) -> Arc:
-        """The arc that attains ``tau(x)`` for one span ``x``."""
-        r = _pick(self.c_list, self.rest_list, self.width_list, x)
-        return self.front.arc(int(self.index[r]))
-
-
-def _tau(
-    c: list[float],
-    rest: list[float],
-    width: list[float],
-    tol: float,
-    accuracy: float,
-    xs: list[float],
-) -> list[float]:
-    """:meth:`Staircase.tau` of the staircase ``(c, rest, width)`` on plain Python floats.
-
-    With ``r`` the first entry with ``c >= x``: the larger of ``rest[r]`` (``-inf`` past
-    the last) and ``(width[r - 1] - x) / 2`` (``-inf`` before the first), then ``-inf``
-    unless above ``tol`` and at least ``accuracy`` (less the rounding slack).
-    """
-    inf = math.inf
-    n = len(c)
-    floor = accuracy - ROUNDING
-    left = bisect.bisect_left
-    out: list[float] = []
-    add = out.append
-    for x in xs:
-        r = left(c, x)
-        at = rest[r] if r < n else -inf
-        before = 0.5 * (width[r - 1] - x) if r > 0 else -inf
-        value = at if at >= before else before
-        add(value if value > tol and value >= floor else -inf)
-    return out
-
-
-def _pick(c: list[float], rest: list[float], width: list[float], x: float) -> int:
-    """The entry of the staircase ``(c, rest, width)`` that attains ``tau(x)``."""
-    r = bisect.bisect_left(c, x)
-    at = rest[r] if r < len(c) else -math.inf
-    before = 0.5 * (width[r - 1] - x) if r > 0 else -math.inf
-    return r if at >= before else r - 1
-
-
 def staircase(
     front: ArcFront, after: Staircase | None, tol: float, accuracy: float = 0.0
 ) -> Staircase:
@@ -792,6 +304,7 @@ def staircase(
     at most half the widest arc less a basin, (180 - 126.87) / 2 deg, to the second.
 
     >>> from bayesgrasp.geometry.polygon import ConvexPolygon
+    >>> from bayesgrasp.angles import TWO_PI
     >>> from bayesgrasp.geometry.transfer import squeeze_function
     >>> s = squeeze_function(ConvexPolygon.from_points([(0, 0), (2, 0), (2, 1), (0, 1)]))
     >>> front = arc_front(s, TWO_PI)
@@ -800,7 +313,7 @@ def staircase(
     [63.434949, 18.434949, -inf]
     """
     if len(front) <= SMALL:
-        return _staircase_python(front, after, tol, accuracy)
+        return staircase_python(front, after, tol, accuracy)
     if after is None:  # the last action collapses one basin: only single basins count
         index = np.flatnonzero(front.span <= 0.0)
         rest = np.full(len(index), np.inf)
@@ -813,64 +326,6 @@ def staircase(
     width = front.width[index]
     c = width - 2.0 * rest
     return Staircase(front, index, rest, width, c, c.tolist(), tol, accuracy)
-
-
-def _staircase_python(
-    front: ArcFront, after: Staircase | None, tol: float, accuracy: float
-) -> Staircase:
-    """:func:`staircase` in plain Python floats for a small front (:func:`_stair_lists`)."""
-    values = None if after is None else after.tau_list(front.span_list)
-    idx, rest, width, c = _stair_lists(front.span_list, front.width_list, values, tol)
-    return Staircase(
-        front,
-        np.array(idx, dtype=np.intp),
-        np.array(rest, dtype=np.float64),
-        np.array(width, dtype=np.float64),
-        np.array(c, dtype=np.float64),
-        c,
-        tol,
-        accuracy,
-        rest,
-        width,
-    )
-
-
-def _stair_lists(
-    spans: list[float], widths: list[float], values: list[float] | None, tol: float
-) -> tuple[list[int], list[float], list[float], list[float]]:
-    """Front index, rest, width and ``c`` of a staircase's entries, step for step.
-
-    ``values`` is the next action's ``tau`` at each arc of the front (``None``: this is the
-    last action, and only single basins count). The entries are what :func:`staircase`
-    keeps, ``pareto_front(-rest, width)`` of the arcs with ``rest > tol``: since the front's
-    widths increase with the index, that is every arc whose rest exceeds the rest of each
-    wider arc, found by one scan from the widest down, and already in the front's order
-    (rest decreasing, widths increasing). For the last action every single basin has rest
-    ``inf``: the widest of them (the front's spans increase from 0, so they come first).
-    """
-    if values is None:
-        n = bisect.bisect_right(spans, 0.0)  # the arcs of span <= 0: single basins
-        if n == 0:
-            return [], [], [], []
-        return [n - 1], [math.inf], [widths[n - 1]], [widths[n - 1] - 2.0 * math.inf]
-    idx: list[int] = []
-    rest: list[float] = []
-    best = -math.inf
-    for n in range(len(values) - 1, -1, -1):
-        v = values[n]
-        if v > tol and v > best:
-            best = v
-            idx.append(n)
-            rest.append(v)
-    idx.reverse()
-    rest.reverse()
-    width: list[float] = []
-    c: list[float] = []
-    for n, r in zip(idx, rest, strict=True):
-        w = widths[n]
-        width.append(w)
-        c.append(w - 2.0 * r)
-    return idx, rest, width, c
 
 
 @dataclass(slots=True)
@@ -890,11 +345,15 @@ class ArcPlanner:
     period : float
         No plan orients beyond this: the largest period of the action types, or ``2 pi / g``
         for a goal counting ``g`` symmetric orientations as one, whichever is less.
+    one_period : bool
+        The fronts hold the arcs of one period only (:func:`period_rows`): of copies of a
+        plan shifted by a period, the same one at every flattening of a curved part.
     """
 
     problem: Problem
     tol: float
     max_span: float
+    one_period: bool = False
     fronts: dict[str, ArcFront] = field(default_factory=dict)
     # Staircase of an action type followed by the actions of staircase ``next_id`` (-1:
     # none), with its own id: a suffix of a plan is found in O(1) from the next one.
@@ -920,12 +379,14 @@ class ArcPlanner:
         """The planner of a problem: its angle tolerance, fronts up to the largest period."""
         tol = problem.states.angle_tol
         periods = [problem.transfers[t].period for t in problem.action_kinds]
-        return cls(problem, tol, max(periods) + tol)
+        return cls(problem, tol, max(periods) + tol, one_period_arcs(problem))
 
     def front(self, kind: str) -> ArcFront:
         """The arc front of one action type."""
         if kind not in self.fronts:
-            self.fronts[kind] = arc_front(self.problem.transfers[kind], self.max_span)
+            f = self.problem.transfers[kind]
+            rows = period_rows(f, self.tol) if self.one_period else None
+            self.fronts[kind] = arc_front(f, self.max_span, rows=rows)
         return self.fronts[kind]
 
     def extend(self, level: list[Counts]) -> tuple[list[tuple[Counts, str, float]], list[Counts]]:
@@ -1177,152 +638,3 @@ def few_states(transfers: Iterable[TransferFunction]) -> bool:
         if f.n_states > SMALL:
             return False
     return True
-
-
-def widest_reachable(
-    fronts: list[ArcFront], tol: float, margin: float, cap: float, max_actions: int
-) -> float:
-    """The widest arc any plan collapses, up to ``cap`` (at most ``max_actions`` actions).
-
-    ``fronts`` are those of the action types; each image must fit the next arc with
-    ``margin`` to spare on each side. The widest arc of ``k + 1`` actions is ``G(W_k)``,
-    with ``G(L)`` the widest arc of any action type whose image fits an arc ``L`` wide (the
-    best counts of each length keep the widest arc, and ``G`` is non-decreasing). So the
-    widths ``W_k`` are monotone from the first step on: once ``W_{k+1} <= W_k`` no longer
-    plan collapses more. Without accuracy they grow to the period (Goldberg 1993); with it
-    they may stop short.
-    """
-    width = max(f.widest(tol) for f in fronts)
-    for _ in range(max_actions - 1):
-        if width >= cap:
-            break
-        wider = max(f.widest(width - 2.0 * margin) for f in fronts)
-        if wider <= width + tol:
-            break
-        width = wider
-    return width
-
-
-def small_options(
-    problem: Problem, fronts: dict[str, ArcFront], tol: float, plans: Plans
-) -> list[PlanOption]:
-    """:meth:`ArcPlanner.plan_options` on the fronts' lists: no :class:`Staircase` nor :class:`Arc`.
-
-    The staircase of each suffix of action types (keyed, as in :meth:`ArcPlanner.staircases`,
-    by its first action and the staircase after it), and its ``tau`` at every arc of the
-    front of the action before it, are computed once for all the plans (a plan of ``k``
-    actions needs the ``tau`` that makes the staircase of ``k`` actions); the witnesses are
-    front indices. Every float operation is the one of :meth:`ArcPlanner.witnesses`,
-    :meth:`Staircase.pick` and :func:`chain_option`, so the options are the same, bit for bit
-    (the planner checks that no chain would need more than :data:`STAIR_CELLS` entries).
-    """
-    accuracy = problem.accuracy
-    prior, group = problem.prior, problem.goal_group
-    cap = period_cap(problem)
-    actions: dict[str, Action] = {}
-    for a in problem.actions:  # (a loop: a comprehension costs more on few actions)
-        actions[a.name] = a
-    inf = math.inf
-    # (kind, id of the staircase after it, or -1) -> (id, front index, rest, width, c)
-    stairs: dict[tuple[str, int], tuple[int, list[int], list[float], list[float], list[float]]]
-    stairs = {}
-    taus: dict[tuple[str, int], list[float]] = {}  # (kind, staircase id) -> tau at its front
-
-    out = []
-    for p, cost, kinds, length in plans:
-        k = len(kinds)
-        chain_stairs = []  # the staircases of kinds[k-1:], kinds[k-2:], ..., kinds[1:]
-        after = None
-        for m in range(k - 1, 0, -1):
-            t = kinds[m]
-            key = (t, -1 if after is None else after[0])
-            st = stairs.get(key)
-            if st is None:
-                g = fronts[t]
-                later: list[float] | None = None
-                if after is not None:
-                    later = _tau_at(taus, t, g, after, tol, accuracy)
-                st = (len(stairs), *_stair_lists(g.span_list, g.width_list, later, tol))
-                stairs[key] = st
-            chain_stairs.append(st)
-            after = st
-        f = fronts[kinds[0]]
-        spans = f.span_list
-        at = bisect.bisect_left(f.width_list, length - tol)  # the arcs at..end are wide enough
-        if after is None:  # one action: a single basin
-            tolerance = None
-            while spans[at] > 0.0:
-                at += 1
-        else:
-            values = _tau_at(taus, kinds[0], f, after, tol, accuracy)
-            best = -inf
-            for n in range(at, len(values)):
-                if values[n] > best:
-                    best = values[n]
-            if not math.isfinite(best):  # pragma: no cover - the lengths guarantee a chain
-                raise PlanningError("internal error: no witness chain for a plan the lengths allow")
-            while values[at] < best - tol:
-                at += 1
-            tolerance = best
-        # chain_option, witness by witness: the first placed by the prior, each later one
-        # picked by its staircase for the span of the one before (Arc.span: s_last - s),
-        # the turn centring that image in it.
-        lo = f.lo_list[at]
-        _, start = prior.max_arc_mass(length if length < cap else cap, group, prefer=lo)
-        angles = [start - lo]
-        arc = (lo + f.width_list[at]) - lo  # Arc.width
-        for m in range(1, k):
-            s = f.s_first_list[at]
-            s_last = s + f.span_list[at]
-            _, idx, rest, width, c = chain_stairs[k - 1 - m]
-            at = idx[_pick(c, rest, width, s_last - s)]
-            f = fronts[kinds[m]]
-            lo = f.lo_list[at]
-            angles.append(0.5 * (s + s_last) - 0.5 * (lo + (lo + f.width_list[at])))
-        steps, turned = short_turns(list(map(actions.__getitem__, kinds)), angles)
-        final = math.fmod(f.s_first_list[at] + turned + TWO_PI, TWO_PI)
-        out.append(new_option(tuple(steps), final, p, cost, tolerance, (start, start + arc)))
-    return out
-
-
-def _tau_at(
-    taus: dict[tuple[str, int], list[float]],
-    kind: str,
-    front: ArcFront,
-    stair: tuple[int, list[int], list[float], list[float], list[float]],
-    tol: float,
-    accuracy: float,
-) -> list[float]:
-    """``tau`` of ``stair`` at every arc of ``front`` (of action ``kind``), memoised."""
-    key = (kind, stair[0])
-    values = taus.get(key)
-    if values is None:
-        _, _, rest, width, c = stair
-        values = taus[key] = _tau(c, rest, width, tol, accuracy, front.span_list)
-    return values
-
-
-def chain_option(
-    problem: Problem,
-    chain: list[Arc],
-    tolerance: float | None,
-    placed: float,
-    p: float,
-    cost: float,
-    arc: float,
-) -> PlanOption:
-    """The plan option of a chain of witness arcs: gripper angles and final orientation.
-
-    The first action's world angle puts ``chain[0]`` where the prior's mass on an arc of
-    length ``placed`` is largest; each later turn centres the image of the previous witness
-    in the next one. The success arc is reported ``arc`` long from the placement;
-    ``tolerance``, ``p`` and ``cost`` are reported as given.
-    """
-    _, start = problem.prior.max_arc_mass(placed, problem.goal_group, prefer=chain[0].lo)
-    angles = [start - chain[0].lo]
-    for prev, w in itertools.pairwise(chain):
-        # Centre the image [s_first, s_last] of the previous arc inside this witness.
-        angles.append(0.5 * (prev.s_first + prev.s_last) - 0.5 * (w.lo + w.hi))
-    steps, turned = short_turns(plan_actions(problem, [a.kind for a in chain]), angles)
-    final = math.fmod(chain[-1].s_first + turned + TWO_PI, TWO_PI)
-    return PlanOption(tuple(steps), final, p, cost, tolerance, (start, start + arc))

@@ -228,7 +228,12 @@ def _plan_one_small(problem: Problem, max_actions: int | None, report: Report) -
     low = tol if tol >= floor else floor  # T: every finite tau is at least this
     stable, lo, hi = f.values
     # ArcPlanner.max_span; the widths ask for spans below cap - margin2 <= cap - 2 T only.
-    front = arcs.SpanFront(stable, lo, hi, f.period + tol, cap - 2.0 * low + 2.0 * SPAN_SLACK)
+    first = cap - 2.0 * low + 2.0 * SPAN_SLACK
+    if arcs.one_period_arcs(problem):  # ties between copies broken alike at every flattening
+        one = arcs.period_rows(f, tol)
+        front = arcs.SpanFront(stable, lo, hi, f.period + tol, first, rows=one)
+    else:
+        front = arcs.SpanFront(stable, lo, hi, f.period + tol, first)
     spans, widths, rows = front.spans, front.widths, front.rows
     cover = front.cover
     left = bisect.bisect_left
