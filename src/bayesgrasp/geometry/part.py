@@ -241,10 +241,21 @@ class Part:
             raise PartError(f"`outline` must enclose a non-zero area; got area {net:.6g}")
         hull = ConvexPolygon.from_points(oriented[0], tol)
         if center_of_mass is None:
-            weighted = areas[0] * centroids[0] - sum(
-                (a * c for a, c in zip(areas[1:], centroids[1:], strict=True)), np.zeros(2)
-            )
-            com = _center_of_mass(hull, weighted / net)
+            # The centroid of the outline less its holes: sum(+-A_i c_i) / sum(+-A_i).
+            with np.errstate(over="ignore", invalid="ignore"):
+                weighted = areas[0] * centroids[0] - sum(
+                    (a * c for a, c in zip(areas[1:], centroids[1:], strict=True)), np.zeros(2)
+                )
+            point = weighted / net
+            if not np.all(np.isfinite(weighted)) or areas[0] < 1e-200:
+                # Near the largest coordinates an area times a coordinate overflows, near the
+                # smallest it underflows: weigh by area fractions instead (the same point,
+                # rounded differently).
+                point = (areas[0] / net) * centroids[0] - sum(
+                    ((a / net) * c for a, c in zip(areas[1:], centroids[1:], strict=True)),
+                    np.zeros(2),
+                )
+            com = _center_of_mass(hull, point)
         else:
             com = _center_of_mass(hull, center_of_mass)
         for arr in (*oriented, com):
