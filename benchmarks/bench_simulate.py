@@ -243,15 +243,19 @@ def study_parts() -> list[tuple[str, object, float]]:
     return out
 
 
-def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
-    """Final stable orientation of single actions: candidate settings against the reference."""
+def accuracy(n_squeeze: int, n_push: int, seed: int = 1, cands: dict | None = None) -> None:  # type: ignore[type-arg]
+    """Final stable orientation of single actions: candidate settings against the reference.
+
+    ``cands``: name -> SimParams (default: the defaults and the former engine's settings);
+    the disagreements of every candidate but ``former`` are listed.
+    """
     from bayesgrasp.angles import circle_distance
     from bayesgrasp.sim.params import SimParams
     from bayesgrasp.sim.result import boundary_distance
     from bayesgrasp.sim.rollout import BatchSqueezer
 
     ref = reference_params()
-    cands = {"default": SimParams(), "former": legacy_params()}
+    cands = cands or {"default": SimParams(), "former": legacy_params()}
     print(
         f"Accuracy study: {n_squeeze} squeezes and {n_push} push-grasps a part from random "
         f"yaws (seed {seed}); reference: 0.5 ms steps, jaws at 5 mm/s ({load_note()})"
@@ -288,13 +292,13 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
                 totals[key][1] += n
                 totals[key][2] += float(o.sim_time.sum())
                 cells.append(f"{key} {int(same.sum())}/{n}")
-                if key == "default":
+                if key != "former":
                     for i in np.flatnonzero(~same):
                         b = math.degrees(float(boundary_distance(tf.boundaries, th[i : i + 1])[0]))
                         worse.append(
-                            f"  {name} {kind} from {math.degrees(th[i]):.2f} deg "
+                            f"  [{key}] {name} {kind} from {math.degrees(th[i]):.2f} deg "
                             f"({b:.2f} deg from a basin boundary): reference "
-                            f"{math.degrees(r.end[i]):.2f} deg (class {cr[i]}), default "
+                            f"{math.degrees(r.end[i]):.2f} deg (class {cr[i]}), {key} "
                             f"{math.degrees(o.end[i]):.2f} deg (class {co[i]})"
                         )
             print("  " + "; ".join(cells), flush=True)
@@ -304,7 +308,7 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
             f"({sim / n:.3f} s simulated an action)"
         )
     print(f"reference: {t_ref:.0f} s of wall time")
-    print("disagreements of the default settings (class -1: jammed, -2: did not settle):")
+    print("disagreements (class -1: jammed, -2: did not settle):")
     print("\n".join(worse) or "  none")
 
 

@@ -1,6 +1,6 @@
 """Many squeezes per call: MuJoCo's C rollout threads, stopped when the part has settled.
 
-:class:`~bayesgrasp.sim.engine.Squeezer` steps one action at a time from Python. A plan is
+:class:`~bayesgrasp.sim.squeezer.Squeezer` steps one action at a time from Python. A plan is
 open-loop: once the starting yaw of an action is known, its whole control sequence (jaw
 targets closing at ``jaw_speed`` after their waits) is known in advance. So
 :class:`BatchSqueezer` runs the same action for a whole batch of trials through
@@ -31,7 +31,7 @@ not by the threads, so the results do not depend on ``nthread``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,8 +39,8 @@ from numpy.typing import NDArray
 from ..angles import TWO_PI
 from ..errors import SimulationError
 from ..geometry.polygon import Part
-from .engine import Squeezer, require_mujoco
 from .params import SimParams
+from .squeezer import Squeezer, jammed, require_mujoco, retry_params
 
 __all__ = ["BatchOutcome", "BatchSqueezer"]
 
@@ -204,15 +204,13 @@ class BatchSqueezer:
         else:
             ld = np.broadcast_to(np.asarray(lead), (b,))
         out = self._act(th, off, push, ld)
-        if stable is None or not (0 < sp.retry_speed < sp.jaw_speed):
+        slow = retry_params(sp)
+        if stable is None or slow is None:
             return out
-        st = np.asarray(stable, dtype=np.float64)
-        err = np.abs(np.remainder(out.end[:, None] - st[None, :] + np.pi, TWO_PI) - np.pi)
-        bad = np.flatnonzero((err.min(axis=1) > sp.jam_tol) | ~out.settled)
+        bad = np.flatnonzero(jammed(out.end, out.settled, stable, sp.jam_tol))
         if not bad.size:
             return out
         if self._slow is None:
-            slow = replace(sp, jaw_speed=sp.retry_speed)
             self._slow = BatchSqueezer(self.sq_part, self.sq.scale, slow, self.nthread)
         again = self._slow._act(th[bad], off[bad], push, ld[bad])
         fields = [np.array(getattr(out, f)) for f in ("end", "settled", "sim_time", "width")]
@@ -270,11 +268,11 @@ class BatchSqueezer:
             )
             ok = slow & full & still & (tt[None, :] > earliest[active, None])  # (A, C)
             # Run lengths of consecutive calm steps, carried over from the previous chunk.
-            run = np.empty(ok.shape, dtype=np.int64)
-            prev = calm[active]
-            for c in range(chunk):
-                prev = np.where(ok[:, c], prev + 1, 0)
-                run[:, c] = prev
+            # run[c] = steps since the last calm-breaking step (or carried + c + 1 if none).
+            steps = np.arange(1, chunk + 1)
+            last_break = np.maximum.accumulate(np.where(ok, 0, steps), axis=1)  # (A, C)
+            carried = np.where(last_break == 0, calm[active, None], 0)
+            run = carried + steps - last_break
             hit = run >= need
             done_here: BoolArray = np.asarray(hit.any(axis=1), dtype=bool)
             first = np.argmax(hit, axis=1)
