@@ -314,6 +314,9 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1, cands: dict | None = No
 
 def compare(trials: int, push_trials: int) -> None:
     """Trials per second per core: the batched engine beside the former one, in one run."""
+    import mujoco
+    import mujoco.rollout  # noqa: F401 - imported once here, not inside either engine's time
+
     from bayesgrasp.shapes import names
     from bayesgrasp.sim import simulate_mujoco
 
@@ -464,13 +467,13 @@ def _figure(
 def main() -> None:
     quick = "--quick" in sys.argv
     if "--validation" in sys.argv:
-        validation(100 if quick else 1000, 40 if quick else 200, 60 if quick else 300)
+        validation(100 if quick else 1000, 40 if quick else 1000, 60 if quick else 1000)
         return
     if "--accuracy" in sys.argv:
         accuracy(10 if quick else 40, 5 if quick else 20)
         return
     if "--compare" in sys.argv:
-        compare(10 if quick else 40, 4 if quick else 16)
+        compare(10 if quick else 200, 4 if quick else 16)
         return
     if "--study" in sys.argv:
         study(60 if quick else 300, 30 if quick else 150)

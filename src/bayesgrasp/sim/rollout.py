@@ -120,16 +120,12 @@ class BatchSqueezer:
         self._kp = float(self.sq.body.kp)
         self._runner = mjr.Rollout(nthread=self.nthread) if self.nthread > 1 else None
         self.sq_part = part
-        self._slow: BatchSqueezer | None = None  # the same scene, jaws at retry_speed
 
     def close(self) -> None:
         """Stop the rollout threads (also done when the object is collected)."""
         if self._runner is not None:
             self._runner.close()
             self._runner = None
-        if self._slow is not None:
-            self._slow.close()
-            self._slow = None
 
     def __enter__(self) -> BatchSqueezer:
         return self
@@ -138,10 +134,10 @@ class BatchSqueezer:
         self.close()
 
     def _initial(
-        self, theta: float, offset: float, push: bool, lead: int
+        self, theta: float, offset: float, push: bool, lead: int, sp: SimParams
     ) -> tuple[FloatArray, tuple[float, float], tuple[float, float], float, float]:
         """Initial state, jaw starts, jaw waits (-x, +x), earliest settle time, travel time."""
-        sq, sp, d = self.sq, self.params, self.sq.data
+        sq, d = self.sq, self.sq.data
         lo, hi = sq._place(theta, offset)
         half = 0.5 * (hi - lo) + abs(offset) + sp.clearance
         size = sq.body.size
@@ -210,9 +206,7 @@ class BatchSqueezer:
         bad = np.flatnonzero(jammed(out.end, out.settled, stable, sp.jam_tol))
         if not bad.size:
             return out
-        if self._slow is None:
-            self._slow = BatchSqueezer(self.sq_part, self.sq.scale, slow, self.nthread)
-        again = self._slow._act(th[bad], off[bad], push, ld[bad])
+        again = self._act(th[bad], off[bad], push, ld[bad], slow)  # the same model
         fields = [np.array(getattr(out, f)) for f in ("end", "settled", "sim_time", "width")]
         for arr, f in zip(fields, ("end", "settled", "sim_time", "width"), strict=True):
             arr[bad] = getattr(again, f)
@@ -220,12 +214,21 @@ class BatchSqueezer:
         return BatchOutcome(th, fields[0], fields[1], fields[2], fields[3])
 
     def _act(
-        self, th: FloatArray, off: FloatArray, push: bool, ld: NDArray[np.int_]
+        self,
+        th: FloatArray,
+        off: FloatArray,
+        push: bool,
+        ld: NDArray[np.int_],
+        sp: SimParams | None = None,
     ) -> BatchOutcome:
-        """:meth:`act` once, at ``params.jaw_speed``."""
-        sp = self.params
+        """:meth:`act` once, at ``sp.jaw_speed`` (default :attr:`params`).
+
+        Only the jaws' targets depend on ``sp`` (its jaw speed and waits): the scene is the
+        one built from :attr:`params`.
+        """
+        sp = sp or self.params
         b = th.size
-        init = [self._initial(float(th[i]), float(off[i]), push, int(ld[i])) for i in range(b)]
+        init = [self._initial(float(th[i]), float(off[i]), push, int(ld[i]), sp) for i in range(b)]
         state = np.array([x[0] for x in init])  # (B, nstate)
         starts = np.array([x[1] for x in init])  # (B, 2)
         waits = np.array([x[2] for x in init])  # (B, 2)

@@ -178,8 +178,6 @@ class Squeezer:
         self.rng = np.random.default_rng(0)
         # The jaws touch capsules of this radius at the hull's vertices (scene_xml).
         self._rc = min(self.params.edge_radius, 0.25 * self.body.thickness)
-        self._part = part
-        self._slow: Squeezer | None = None  # the same scene, jaws at retry_speed
 
     def _rest_height(self) -> float:
         """Height of the part's body frame when it rests on the table (one short settle)."""
@@ -261,14 +259,20 @@ class Squeezer:
             return out
         if not jammed([out.end], [out.settled], stable, self.params.jam_tol)[0]:
             return out
-        if self._slow is None:
-            self._slow = Squeezer(self._part, self.scale, slow)
-        again = self._slow._once(theta, offset, push, lead)
+        again = self._once(theta, offset, push, lead, slow)  # the same model, slower jaws
         return replace(again, sim_time=out.sim_time + again.sim_time)
 
-    def _once(self, theta: float, offset: float, push: bool, lead: int | None) -> ActionOutcome:
-        """:meth:`act` once, at ``params.jaw_speed``."""
-        mj, m, d, sp = self._mj, self.model, self.data, self.params
+    def _once(
+        self,
+        theta: float,
+        offset: float,
+        push: bool,
+        lead: int | None,
+        sp: SimParams | None = None,
+    ) -> ActionOutcome:
+        """:meth:`act` once, at ``sp.jaw_speed`` (default :attr:`params`; the scene's)."""
+        mj, m, d = self._mj, self.model, self.data
+        sp = sp or self.params
         lo, hi = self._place(theta, offset)
         half = 0.5 * (hi - lo) + abs(offset) + sp.clearance
         push_len = (sp.push_distance or 2.0 * self._size) if push else 0.0
