@@ -13,8 +13,9 @@ predicted against MuJoCo success for the catalogue instead, ``--agreement`` the 
 table of single squeezes against the model, ``--compare`` the trials per second per core of
 the batched engine (rollout, the settled stop, the default settings) beside the former
 engine (one trial at a time from Python, 1 ms steps, jaws at 1 cm/s, 0.1 s settle) on every
-catalogue part's Bayes plans, squeezes and push-grasps apart, and ``--accuracy`` the study
-that chose the settings: single actions from random yaws under the default settings (and
+catalogue part's Bayes plans, squeezes (200 trials, ``simulate``'s default) and push-grasps
+(16) apart, ``--validation`` the guide's validation study (1,000 trials every row), and
+``--accuracy`` the study that chose the settings: single actions from random yaws under the default settings (and
 the former ones) against a reference of fine steps and slow jaws, with every disagreement.
 """
 
