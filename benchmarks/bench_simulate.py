@@ -15,8 +15,9 @@ the batched engine (rollout, the settled stop, the default settings) beside the 
 engine (one trial at a time from Python, 1 ms steps, jaws at 1 cm/s, 0.1 s settle) on every
 catalogue part's Bayes plans, squeezes (200 trials, ``simulate``'s default) and push-grasps
 (16) apart, ``--validation`` the guide's validation study (1,000 trials every row), and
-``--accuracy`` the study that chose the settings: single actions from random yaws under the default settings (and
-the former ones) against a reference of fine steps and slow jaws, with every disagreement.
+``--accuracy`` the study that chose the settings: single actions from random yaws under the
+default settings (and the former ones) against a reference of fine steps and slow jaws,
+with every disagreement.
 """
 
 from __future__ import annotations
