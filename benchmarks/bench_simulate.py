@@ -13,9 +13,11 @@ predicted against MuJoCo success for the catalogue instead, ``--agreement`` the 
 table of single squeezes against the model, ``--compare`` the trials per second per core of
 the batched engine (rollout, the settled stop, the default settings) beside the former
 engine (one trial at a time from Python, 1 ms steps, jaws at 1 cm/s, 0.1 s settle) on every
-catalogue part's Bayes plans, squeezes and push-grasps apart, and ``--accuracy`` the study
-that chose the settings: single actions from random yaws under the default settings (and
-the former ones) against a reference of fine steps and slow jaws, with every disagreement.
+catalogue part's Bayes plans, squeezes (200 trials, ``simulate``'s default) and push-grasps
+(16) apart, ``--validation`` the guide's validation study (1,000 trials every row), and
+``--accuracy`` the study that chose the settings: single actions from random yaws under the
+default settings (and the former ones) against a reference of fine steps and slow jaws,
+with every disagreement.
 """
 
 from __future__ import annotations
@@ -243,15 +245,19 @@ def study_parts() -> list[tuple[str, object, float]]:
     return out
 
 
-def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
-    """Final stable orientation of single actions: candidate settings against the reference."""
+def accuracy(n_squeeze: int, n_push: int, seed: int = 1, cands: dict | None = None) -> None:  # type: ignore[type-arg]
+    """Final stable orientation of single actions: candidate settings against the reference.
+
+    ``cands``: name -> SimParams (default: the defaults and the former engine's settings);
+    the disagreements of every candidate but ``former`` are listed.
+    """
     from bayesgrasp.angles import circle_distance
     from bayesgrasp.sim.params import SimParams
     from bayesgrasp.sim.result import boundary_distance
     from bayesgrasp.sim.rollout import BatchSqueezer
 
     ref = reference_params()
-    cands = {"default": SimParams(), "former": legacy_params()}
+    cands = cands or {"default": SimParams(), "former": legacy_params()}
     print(
         f"Accuracy study: {n_squeeze} squeezes and {n_push} push-grasps a part from random "
         f"yaws (seed {seed}); reference: 0.5 ms steps, jaws at 5 mm/s ({load_note()})"
@@ -288,13 +294,13 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
                 totals[key][1] += n
                 totals[key][2] += float(o.sim_time.sum())
                 cells.append(f"{key} {int(same.sum())}/{n}")
-                if key == "default":
+                if key != "former":
                     for i in np.flatnonzero(~same):
                         b = math.degrees(float(boundary_distance(tf.boundaries, th[i : i + 1])[0]))
                         worse.append(
-                            f"  {name} {kind} from {math.degrees(th[i]):.2f} deg "
+                            f"  [{key}] {name} {kind} from {math.degrees(th[i]):.2f} deg "
                             f"({b:.2f} deg from a basin boundary): reference "
-                            f"{math.degrees(r.end[i]):.2f} deg (class {cr[i]}), default "
+                            f"{math.degrees(r.end[i]):.2f} deg (class {cr[i]}), {key} "
                             f"{math.degrees(o.end[i]):.2f} deg (class {co[i]})"
                         )
             print("  " + "; ".join(cells), flush=True)
@@ -304,12 +310,15 @@ def accuracy(n_squeeze: int, n_push: int, seed: int = 1) -> None:
             f"({sim / n:.3f} s simulated an action)"
         )
     print(f"reference: {t_ref:.0f} s of wall time")
-    print("disagreements of the default settings (class -1: jammed, -2: did not settle):")
+    print("disagreements (class -1: jammed, -2: did not settle):")
     print("\n".join(worse) or "  none")
 
 
 def compare(trials: int, push_trials: int) -> None:
     """Trials per second per core: the batched engine beside the former one, in one run."""
+    import mujoco
+    import mujoco.rollout  # noqa: F401 - imported once here, not inside either engine's time
+
     from bayesgrasp.shapes import names
     from bayesgrasp.sim import simulate_mujoco
 
@@ -460,13 +469,13 @@ def _figure(
 def main() -> None:
     quick = "--quick" in sys.argv
     if "--validation" in sys.argv:
-        validation(100 if quick else 1000, 40 if quick else 200, 60 if quick else 300)
+        validation(100 if quick else 1000, 40 if quick else 1000, 60 if quick else 1000)
         return
     if "--accuracy" in sys.argv:
         accuracy(10 if quick else 40, 5 if quick else 20)
         return
     if "--compare" in sys.argv:
-        compare(10 if quick else 40, 4 if quick else 16)
+        compare(10 if quick else 200, 4 if quick else 16)
         return
     if "--study" in sys.argv:
         study(60 if quick else 300, 30 if quick else 150)

@@ -308,8 +308,8 @@ def test_mujoco_policy_takes_the_jaw_lag(monkeypatch: pytest.MonkeyPatch) -> Non
     real = engine.Squeezer.act
 
     def recorded(self: object, theta: float, offset: float = 0.0, push: bool = False,
-                 lead: int | None = None) -> object:  # fmt: skip
-        res = real(self, theta, offset, push, lead)  # type: ignore[arg-type]
+                 lead: int | None = None, stable: object = None) -> object:  # fmt: skip
+        res = real(self, theta, offset, push, lead, stable)  # type: ignore[arg-type]
         acts.append((theta, push, lead, res.end))
         return res
 

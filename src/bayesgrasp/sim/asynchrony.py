@@ -36,10 +36,10 @@ from ..errors import SimulationError
 from ..geometry.polygon import Part
 from ..geometry.push import push_grasp_function
 from ..geometry.transfer import squeeze_function
-from .engine import Squeezer
 from .noise import as_generator
 from .params import SimParams
 from .result import DEFAULT_BOUNDARY_MARGIN, boundary_distance
+from .squeezer import Squeezer
 from .stats import wilson_interval
 
 __all__ = ["AsynchronyResult", "measure_asynchrony"]

@@ -36,13 +36,12 @@ import multiprocessing
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from ..angles import TWO_PI, circle_distance
-from ..errors import MissingExtraError, SimulationError
+from ..errors import SimulationError
 from ..geometry.polygon import Part
 from ..model.actions import get_action
 from ..model.problem import Problem
@@ -59,240 +58,30 @@ from .result import (
     check_trials,
     summarize,
 )
-from .scene import prism, scene_xml, units_scale
+from .rollout import BatchSqueezer
+from .scene import units_scale
+from .squeezer import SIZE_RANGE, ActionOutcome, Squeezer, require_mujoco
 
-__all__ = ["ActionOutcome", "Squeezer", "require_mujoco", "simulate_mujoco"]
+__all__ = ["SIZE_RANGE", "ActionOutcome", "Squeezer", "require_mujoco", "simulate_mujoco"]
 
 logger = logging.getLogger(__name__)
 
 FloatArray = NDArray[np.float64]
-
-#: Part sizes (metres across, twice the hull's largest distance from its centroid) the
-#: defaults were checked on: random 10-gons agreed with the squeeze model in 30/30 single
-#: squeezes from 1.2 cm to 35 cm across; at 0.5 and 0.7 cm none agreed, at 94 cm 24/30.
-SIZE_RANGE = (0.01, 0.5)
-
-
-def require_mujoco() -> Any:
-    """Import MuJoCo, or raise :class:`MissingExtraError` naming the ``sim`` extra.
-
-    Examples
-    --------
-    >>> require_mujoco().__version__
-    '4.0.0'
-    """
-    try:
-        import mujoco
-    except ImportError:
-        raise MissingExtraError("mujoco", "sim") from None
-    return mujoco
-
-
-@dataclass(frozen=True, slots=True)
-class ActionOutcome:
-    """What one simulated action did.
-
-    Attributes
-    ----------
-    start : float
-        Yaw (radians) when the jaws began to close, in the gripper frame.
-    end : float
-        Yaw where the part stopped, in ``[0, 2 pi)``.
-    settled : bool
-        Whether the jaws came to rest in time (``SimParams.max_time``).
-    sim_time : float
-        Simulated seconds.
-    width : float
-        The jaw separation when the action ended, less the vertex capsules' diameter
-        (:meth:`Squeezer.width`), metres: what a gripper's encoder reads.
-    """
-
-    start: float
-    end: float
-    settled: bool
-    sim_time: float
-    width: float = math.nan
-
-
-class Squeezer:
-    """One MuJoCo model and data of the part between the jaws; runs actions in turn.
-
-    Parameters
-    ----------
-    part : Part
-    scale : float
-        Metres per unit of the part's coordinates.
-    params : SimParams, optional
-
-    Examples
-    --------
-    >>> from bayesgrasp.geometry.polygon import Part
-    >>> from bayesgrasp.geometry.transfer import squeeze_function
-    >>> tri = Part.from_points([(0, 0), (0.04, 0), (0.01, 0.03)])
-    >>> out = Squeezer(tri, 1.0).act(np.radians(30.0))
-    >>> predicted = squeeze_function(tri.hull)(np.radians(30.0))
-    >>> out.settled, round(float(np.degrees(out.end)), 1), round(float(np.degrees(predicted)), 1)
-    (True, 18.4, 18.4)
-    """
-
-    def __init__(self, part: Part, scale: float, params: SimParams | None = None) -> None:
-        mj = require_mujoco()
-        self._mj = mj
-        self.params = params or SimParams()
-        self.scale = scale
-        self.model = mj.MjModel.from_xml_string(scene_xml(part, scale, self.params))
-        self.data = mj.MjData(self.model)
-        self.body = prism(part, scale, self.params)
-        self._rel = self.body.vertices  # (N, 2) body-frame hull
-        self._size = self.body.size
-        self.force = self.body.force  # each jaw's force limit (N)
-        m = self.model
-        self._part_q = int(m.jnt_qposadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, "part")])
-        self._part_v = int(m.jnt_dofadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, "part")])
-        self._jaw_q = [
-            int(m.jnt_qposadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, n)])
-            for n in ("jaw_neg", "jaw_pos")
-        ]
-        self._jaw_v = [
-            int(m.jnt_dofadr[mj.mj_name2id(m, mj.mjtObj.mjOBJ_JOINT, n)])
-            for n in ("jaw_neg", "jaw_pos")
-        ]
-        self._act = [mj.mj_name2id(m, mj.mjtObj.mjOBJ_ACTUATOR, n) for n in ("jaw_neg", "jaw_pos")]
-        self._z = self._rest_height()
-        #: Draws the leading jaw of a squeeze when ``params.jaw_lag > 0`` and ``lead_jaw``
-        #: is ``random`` and :meth:`act` is given no ``lead``; replace it to reseed.
-        self.rng = np.random.default_rng(0)
-        # The jaws touch capsules of this radius at the hull's vertices (scene_xml).
-        self._rc = min(self.params.edge_radius, 0.25 * self.body.thickness)
-
-    def _rest_height(self) -> float:
-        """Height of the part's body frame when it rests on the table (one short settle)."""
-        mj, d = self._mj, self.data
-        mj.mj_resetData(self.model, d)
-        for q, a, x in zip(self._jaw_q, self._act, (-1.0, 1.0), strict=True):
-            d.qpos[q] = x * (self._size + 0.05)
-            d.ctrl[a] = d.qpos[q]
-        mj.mj_forward(self.model, d)
-        mj.mj_step(self.model, d, max(1, round(0.2 / self.params.timestep)))
-        return float(d.qpos[self._part_q + 2])
-
-    def yaw(self) -> float:
-        """The part's yaw (radians, ``[0, 2 pi)``) from the free joint's quaternion."""
-        w, x, y, z = self.data.qpos[self._part_q + 3 : self._part_q + 7]
-        return float(np.mod(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)), TWO_PI))
-
-    def width(self) -> float:
-        """The jaw separation less the capsules' diameter (metres): the part's width read.
-
-        The slide joints' positions are the x of the jaws' inner faces; the capsules at the
-        hull's vertices add ``2 * edge_radius`` to every width (:mod:`bayesgrasp.sim.scene`).
-        """
-        d = self.data
-        sep = float(d.qpos[self._jaw_q[1]] - d.qpos[self._jaw_q[0]])
-        return sep - 2.0 * self._rc
-
-    def _place(self, theta: float, offset: float) -> tuple[float, float]:
-        """Put the part at yaw ``theta``, x-extent centred at ``offset``; return its extent."""
-        c, s = math.cos(theta), math.sin(theta)
-        xs = c * self._rel[:, 0] - s * self._rel[:, 1]  # (N,) x of the rotated hull
-        lo, hi = float(xs.min()), float(xs.max())
-        mid = 0.5 * (lo + hi)
-        d = self.data
-        q = self._part_q
-        d.qpos[q : q + 3] = (offset - mid, 0.0, self._z)
-        d.qpos[q + 3 : q + 7] = (math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2))
-        d.qvel[self._part_v : self._part_v + 6] = 0.0
-        return lo - mid + offset, hi - mid + offset
-
-    def act(
-        self, theta: float, offset: float = 0.0, push: bool = False, lead: int | None = None
-    ) -> ActionOutcome:
-        """One squeeze (or push-grasp when ``push``) from yaw ``theta`` in the gripper frame.
-
-        Parameters
-        ----------
-        theta : float
-            The part's orientation in the gripper frame when the jaws start to close.
-        offset : float
-            Shift (metres) along x of the part's x-extent from the gripper's centre.
-        push : bool
-            Close the -x jaw first (an action that ``pushes_first``, the push-grasp).
-        lead : int, optional
-            For a squeeze with ``params.jaw_lag > 0``: ``-1`` or ``+1``, the side (-x or
-            +x) of the jaw that starts ``jaw_lag`` seconds early. Default from
-            ``params.lead_jaw`` (``random``: drawn from :attr:`rng`).
-
-        Returns
-        -------
-        ActionOutcome
-        """
-        mj, m, d, sp = self._mj, self.model, self.data, self.params
-        lo, hi = self._place(theta, offset)
-        half = 0.5 * (hi - lo) + abs(offset) + sp.clearance
-        push_len = (sp.push_distance or 2.0 * self._size) if push else 0.0
-        # A push-grasp's +x jaw starts beyond where the pushed part can reach while it
-        # turns (its x-extent never exceeds twice its size).
-        far = -half + 2.0 * sp.clearance + push_len + 2.0 * self._size
-        start = (-half, max(half, far)) if push else (-half, half)
-        for q, v, a, x in zip(self._jaw_q, self._jaw_v, self._act, start, strict=True):
-            d.qpos[q] = x
-            d.qvel[v] = 0.0
-            d.ctrl[a] = x
-        d.time = 0.0
-        mj.mj_forward(m, d)
-        n = sp.check_every
-        dt = n * sp.timestep
-        need = max(1, math.ceil(sp.settle_time / dt))
-        vn, vp = self._jaw_v
-        an, ap = self._act
-        # The +x jaw of a push-grasp waits until the -x jaw has pushed push_len past contact;
-        # no settling test before the (last) jaw can have reached the part.
-        wait = (push_len + sp.clearance) / sp.jaw_speed if push else 0.0
-        wait_neg = 0.0
-        if not push and sp.jaw_lag > 0:  # contact asynchrony: the lagging jaw starts late
-            if lead is None:
-                lead = {"-x": -1, "+x": 1}.get(sp.lead_jaw) or int(self.rng.choice((-1, 1)))
-            if lead not in (-1, 1):
-                raise SimulationError(f"`lead` must be -1 or +1 (the leading jaw); got {lead!r}")
-            wait, wait_neg = (sp.jaw_lag, 0.0) if lead < 0 else (0.0, sp.jaw_lag)
-        earliest = max(wait, wait_neg) + sp.clearance / sp.jaw_speed
-        # Time for the last jaw to cross the whole opening, plus max_time to settle.
-        travel_time = max(wait, wait_neg) + (start[1] - start[0]) / sp.jaw_speed
-        steps_max = math.ceil((travel_time + sp.max_time) / dt)
-        force = 0.999 * self.force
-        calm = 0
-        t = 0.0
-        for _ in range(steps_max):
-            t += dt
-            d.ctrl[an] = start[0] + sp.jaw_speed * max(0.0, t - wait_neg)
-            d.ctrl[ap] = start[1] - sp.jaw_speed * max(0.0, t - wait)
-            mj.mj_step(m, d, n)
-            slow = max(abs(d.qvel[vn]), abs(d.qvel[vp])) < sp.settle_speed
-            # Blocked jaws are slow while their force still ramps up (kp * jaw_speed per
-            # second): the squeeze is over only when both push with their full force.
-            full = min(abs(d.actuator_force[an]), abs(d.actuator_force[ap])) >= force
-            pv = self._part_v
-            still = (
-                math.hypot(d.qvel[pv], d.qvel[pv + 1]) < sp.part_speed
-                and abs(d.qvel[pv + 5]) < sp.part_spin
-            )
-            if t > earliest and slow and full and still:
-                calm += 1
-                if calm >= need:
-                    return ActionOutcome(theta, self.yaw(), True, t, self.width())
-            else:
-                calm = 0
-        return ActionOutcome(theta, self.yaw(), False, t, self.width())
-
 
 # --- parallel trials ---------------------------------------------------------------------
 
 _WORKER: Squeezer | None = None
 
 
-def _init_worker(part: Part, scale: float, params: SimParams) -> None:
-    global _WORKER
+_STABLE: FloatArray | None = None
+
+
+def _init_worker(
+    part: Part, scale: float, params: SimParams, stable: FloatArray | None = None
+) -> None:
+    global _WORKER, _STABLE
     _WORKER = Squeezer(part, scale, params)
+    _STABLE = stable
 
 
 @dataclass(frozen=True, slots=True)
@@ -313,17 +102,22 @@ def _run_trial(trial: _Trial) -> list[ActionOutcome]:
     leads = trial.leads or (None,) * len(trial.angles)
     steps = zip(trial.angles, trial.offsets, trial.pushes, leads, strict=True)
     for angle, off, push, lead in steps:
-        res = sq.act(float(np.mod(yaw - angle, TWO_PI)), off, push, lead)
+        res = sq.act(float(np.mod(yaw - angle, TWO_PI)), off, push, lead, _STABLE)
         out.append(res)
         yaw = res.end
     return out
 
 
 def _map_trials(
-    part: Part, scale: float, params: SimParams, trials: Sequence[_Trial], workers: int
+    part: Part,
+    scale: float,
+    params: SimParams,
+    trials: Sequence[_Trial],
+    workers: int,
+    stable: FloatArray | None = None,
 ) -> Iterator[list[ActionOutcome]]:
     if workers <= 1:
-        _init_worker(part, scale, params)
+        _init_worker(part, scale, params, stable)
         for t in trials:
             yield _run_trial(t)
         return
@@ -332,7 +126,9 @@ def _map_trials(
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     chunk = max(1, min(8, len(trials) // (4 * workers)))
-    with ctx.Pool(workers, initializer=_init_worker, initargs=(part, scale, params)) as pool:
+    with ctx.Pool(
+        workers, initializer=_init_worker, initargs=(part, scale, params, stable)
+    ) as pool:
         yield from pool.imap(_run_trial, trials, chunksize=chunk)
 
 
@@ -354,8 +150,6 @@ def _rollout_trials(
     ``stable``: the part's stable orientations; jammed actions are retried with slow jaws
     (:meth:`~bayesgrasp.sim.rollout.BatchSqueezer.act`).
     """
-    from .rollout import BatchSqueezer
-
     n, k = len(trials), len(trials[0].angles)
     starts, ends = np.zeros((n, k)), np.zeros((n, k))
     settled = np.zeros((n, k), dtype=bool)
@@ -421,7 +215,9 @@ def simulate_mujoco(
         ``rollout`` (default): every action of a batch of trials in one call of
         :func:`mujoco.rollout.rollout`, stopped when each has settled
         (:class:`~bayesgrasp.sim.rollout.BatchSqueezer`); ``stepped``: one trial at a time
-        from Python (:class:`Squeezer`). Both run the same scene and settled test.
+        from Python (:class:`Squeezer`). Both run the same scene and settled test, and both
+        run a jammed action again with the jaws at ``params.retry_speed``
+        (:func:`~bayesgrasp.sim.squeezer.retry_params`).
 
     Returns
     -------
@@ -484,7 +280,7 @@ def simulate_mujoco(
     t0 = time.perf_counter()
     if method == "stepped":
         outcomes: list[list[ActionOutcome]] = []
-        for res in _map_trials(problem.part, sc, params, tasks, workers):
+        for res in _map_trials(problem.part, sc, params, tasks, workers, problem.states.stable):
             outcomes.append(res)
             if progress is not None:
                 progress(len(outcomes), trials)

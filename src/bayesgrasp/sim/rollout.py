@@ -1,6 +1,6 @@
 """Many squeezes per call: MuJoCo's C rollout threads, stopped when the part has settled.
 
-:class:`~bayesgrasp.sim.engine.Squeezer` steps one action at a time from Python. A plan is
+:class:`~bayesgrasp.sim.squeezer.Squeezer` steps one action at a time from Python. A plan is
 open-loop: once the starting yaw of an action is known, its whole control sequence (jaw
 targets closing at ``jaw_speed`` after their waits) is known in advance. So
 :class:`BatchSqueezer` runs the same action for a whole batch of trials through
@@ -31,7 +31,7 @@ not by the threads, so the results do not depend on ``nthread``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,8 +39,8 @@ from numpy.typing import NDArray
 from ..angles import TWO_PI
 from ..errors import SimulationError
 from ..geometry.polygon import Part
-from .engine import Squeezer, require_mujoco
 from .params import SimParams
+from .squeezer import Squeezer, jammed, require_mujoco, retry_params
 
 __all__ = ["BatchOutcome", "BatchSqueezer"]
 
@@ -120,16 +120,12 @@ class BatchSqueezer:
         self._kp = float(self.sq.body.kp)
         self._runner = mjr.Rollout(nthread=self.nthread) if self.nthread > 1 else None
         self.sq_part = part
-        self._slow: BatchSqueezer | None = None  # the same scene, jaws at retry_speed
 
     def close(self) -> None:
         """Stop the rollout threads (also done when the object is collected)."""
         if self._runner is not None:
             self._runner.close()
             self._runner = None
-        if self._slow is not None:
-            self._slow.close()
-            self._slow = None
 
     def __enter__(self) -> BatchSqueezer:
         return self
@@ -138,10 +134,10 @@ class BatchSqueezer:
         self.close()
 
     def _initial(
-        self, theta: float, offset: float, push: bool, lead: int
+        self, theta: float, offset: float, push: bool, lead: int, sp: SimParams
     ) -> tuple[FloatArray, tuple[float, float], tuple[float, float], float, float]:
         """Initial state, jaw starts, jaw waits (-x, +x), earliest settle time, travel time."""
-        sq, sp, d = self.sq, self.params, self.sq.data
+        sq, d = self.sq, self.sq.data
         lo, hi = sq._place(theta, offset)
         half = 0.5 * (hi - lo) + abs(offset) + sp.clearance
         size = sq.body.size
@@ -204,17 +200,13 @@ class BatchSqueezer:
         else:
             ld = np.broadcast_to(np.asarray(lead), (b,))
         out = self._act(th, off, push, ld)
-        if stable is None or not (0 < sp.retry_speed < sp.jaw_speed):
+        slow = retry_params(sp)
+        if stable is None or slow is None:
             return out
-        st = np.asarray(stable, dtype=np.float64)
-        err = np.abs(np.remainder(out.end[:, None] - st[None, :] + np.pi, TWO_PI) - np.pi)
-        bad = np.flatnonzero((err.min(axis=1) > sp.jam_tol) | ~out.settled)
+        bad = np.flatnonzero(jammed(out.end, out.settled, stable, sp.jam_tol))
         if not bad.size:
             return out
-        if self._slow is None:
-            slow = replace(sp, jaw_speed=sp.retry_speed)
-            self._slow = BatchSqueezer(self.sq_part, self.sq.scale, slow, self.nthread)
-        again = self._slow._act(th[bad], off[bad], push, ld[bad])
+        again = self._act(th[bad], off[bad], push, ld[bad], slow)  # the same model
         fields = [np.array(getattr(out, f)) for f in ("end", "settled", "sim_time", "width")]
         for arr, f in zip(fields, ("end", "settled", "sim_time", "width"), strict=True):
             arr[bad] = getattr(again, f)
@@ -222,12 +214,21 @@ class BatchSqueezer:
         return BatchOutcome(th, fields[0], fields[1], fields[2], fields[3])
 
     def _act(
-        self, th: FloatArray, off: FloatArray, push: bool, ld: NDArray[np.int_]
+        self,
+        th: FloatArray,
+        off: FloatArray,
+        push: bool,
+        ld: NDArray[np.int_],
+        sp: SimParams | None = None,
     ) -> BatchOutcome:
-        """:meth:`act` once, at ``params.jaw_speed``."""
-        sp = self.params
+        """:meth:`act` once, at ``sp.jaw_speed`` (default :attr:`params`).
+
+        Only the jaws' targets depend on ``sp`` (its jaw speed and waits): the scene is the
+        one built from :attr:`params`.
+        """
+        sp = sp or self.params
         b = th.size
-        init = [self._initial(float(th[i]), float(off[i]), push, int(ld[i])) for i in range(b)]
+        init = [self._initial(float(th[i]), float(off[i]), push, int(ld[i]), sp) for i in range(b)]
         state = np.array([x[0] for x in init])  # (B, nstate)
         starts = np.array([x[1] for x in init])  # (B, 2)
         waits = np.array([x[2] for x in init])  # (B, 2)
@@ -270,11 +271,11 @@ class BatchSqueezer:
             )
             ok = slow & full & still & (tt[None, :] > earliest[active, None])  # (A, C)
             # Run lengths of consecutive calm steps, carried over from the previous chunk.
-            run = np.empty(ok.shape, dtype=np.int64)
-            prev = calm[active]
-            for c in range(chunk):
-                prev = np.where(ok[:, c], prev + 1, 0)
-                run[:, c] = prev
+            # run[c] = steps since the last calm-breaking step (or carried + c + 1 if none).
+            steps = np.arange(1, chunk + 1)
+            last_break = np.maximum.accumulate(np.where(ok, 0, steps), axis=1)  # (A, C)
+            carried = np.where(last_break == 0, calm[active, None], 0)
+            run = carried + steps - last_break
             hit = run >= need
             done_here: BoolArray = np.asarray(hit.any(axis=1), dtype=bool)
             first = np.argmax(hit, axis=1)
