@@ -16,7 +16,9 @@ the layers below it, never from a layer above:
 4. ``strategy``: ``planning.strategy`` (one strategy type over every planner, and its exact
    evaluation);
 5. ``output``: ``io``, ``report`` (with ``report.curved``), ``figures``, ``sim``, ``paper``;
-6. ``surface``: ``cli``, ``web``, ``sweep``, and the package's own ``__init__`` (the facade).
+6. ``run``: ``runs`` (what a request asks of the library: the part, problem and planner
+   options, the noise-aware run, the provenance; shared by the surfaces);
+7. ``surface``: ``cli``, ``web``, ``sweep``, and the package's own ``__init__`` (the facade).
 
 Measured on every ``.py`` file under ``src/bayesgrasp`` with :mod:`ast`; nothing is imported:
 
@@ -65,6 +67,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("planning", ("planning", "solid.policy")),
     ("strategy", ("planning.strategy",)),
     ("output", ("io", "report", "figures", "sim", "paper")),
+    ("run", ("runs",)),
     ("surface", ("cli", "web", "sweep", "")),
 )
 

@@ -93,9 +93,10 @@ def test_help_loads_no_command_module() -> None:
         )
         return list(json.loads(proc.stdout.replace("'", '"')))
 
-    assert loaded("--help") == ["bayesgrasp.cli._typer"]  # the app itself
+    # the app itself and its command list
+    assert loaded("--help") == ["bayesgrasp.cli._typer", "bayesgrasp.cli.commands"]
     assert loaded("plan", "--help") == [
-        f"bayesgrasp.cli.{m}" for m in ("_typer", "common", "options", "plan", "specs")
+        f"bayesgrasp.cli.{m}" for m in ("_typer", "commands", "common", "options", "plan", "specs")
     ]
 
 

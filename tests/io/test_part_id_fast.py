@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from bayesgrasp.geometry.polygon import Part
-from bayesgrasp.io import plans
+from bayesgrasp.io import part_identity
 from bayesgrasp.io.plans import part_id
 from bayesgrasp.shapes import load, names
 
@@ -23,14 +23,14 @@ from bayesgrasp.shapes import load, names
 def _both(part: Part) -> tuple[str, str]:
     fast = part_id(part)
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(plans, "_small_id_bytes", lambda *_: None)
+        mp.setattr(part_identity, "_small_id_bytes", lambda *_: None)
         general = part_id(part)
     return fast, general
 
 
 def test_the_small_path_is_taken() -> None:
     part = load("key")
-    assert plans._small_id_bytes(part, plans._grid(part.hull)) is not None
+    assert part_identity._small_id_bytes(part, part_identity._grid(part.hull)) is not None
 
 
 @pytest.mark.parametrize("name", names())
@@ -72,7 +72,7 @@ def test_exact_halves_round_to_even(pts: list[tuple[int, int]], com: tuple[int, 
     except ValueError:  # degenerate, or the centre of mass outside the hull
         return
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(plans, "_grid", lambda hull: 0.5)
+        mp.setattr(part_identity, "_grid", lambda hull: 0.5)
         fast, general = _both(part)
     assert fast == general
 
@@ -80,7 +80,7 @@ def test_exact_halves_round_to_even(pts: list[tuple[int, int]], com: tuple[int, 
 def test_a_large_hull_takes_numpy() -> None:
     t = 2 * math.pi * np.arange(200) / 200
     part = Part.from_points(np.column_stack([np.cos(t), 2 * np.sin(t)]))
-    assert len(part.hull.vertices) > plans.SMALL
+    assert len(part.hull.vertices) > part_identity.SMALL
     assert part_id(part).startswith("sha256:")
 
 
@@ -89,11 +89,11 @@ def test_values_near_the_int64_limit() -> None:
     square = Part.from_points([(0.0, 0.0), (3.0, 0.0), (3.0, 3.0), (0.0, 3.0)])
     step = 2.0**-62  # (x - cx) / step = +-1.5 * 2^62: in [2^62, 2^63), numpy's cast exact
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(plans, "_grid", lambda hull: step)
-        assert plans._small_id_bytes(square, step) is not None
+        mp.setattr(part_identity, "_grid", lambda hull: step)
+        assert part_identity._small_id_bytes(square, step) is not None
         fast, general = _both(square)
     assert fast == general
     wide = Part.from_points([(0.0, 0.0), (4.0, 0.0), (4.0, 3.0), (0.0, 3.0)])
-    assert plans._small_id_bytes(wide, step) is None  # 2^63: beyond int64
-    assert plans._small_id_bytes(wide, 1e-320) is None  # an infinity
-    assert plans._small_id_bytes(wide, math.nan) is None
+    assert part_identity._small_id_bytes(wide, step) is None  # 2^63: beyond int64
+    assert part_identity._small_id_bytes(wide, 1e-320) is None  # an infinity
+    assert part_identity._small_id_bytes(wide, math.nan) is None

@@ -291,7 +291,7 @@ def test_cli_guaranteed_json(capsys: pytest.CaptureFixture[str]) -> None:
 def test_cli_guaranteed_table(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(capsys, "plan", "rectangle", "--guaranteed")
     assert code == 0 and err == ""
-    assert "guaranteed plan: 2 action(s) S(+0.00) S(-45.00)" in out
+    assert "guaranteed plan: 2 action(s), first 0.00 deg, alphas (deg) [-45.00]" in out
     assert "modulo 180 deg" in out
 
 

@@ -11,7 +11,7 @@ from typer.core import TyperGroup
 
 from ..errors import BayesGraspError, NoPlanError
 from ..shapes import names as catalogue_names
-from . import COMMANDS
+from .commands import COMMANDS
 
 __all__ = ["app", "run"]
 

@@ -20,22 +20,46 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import typer
 
-from .specs import guaranteed_plan
+from ..runs.specs import PLAN_NAMES, guaranteed_plan, simulate_inputs
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
     from ..model.problem import Problem
     from ..planning.result import PlanOption
-    from .specs import ProblemSpec
+    from ..runs.specs import ProblemSpec
+
+__all__ = [
+    "IMAGE_FORMATS",
+    "PLAN_NAMES",
+    "accuracy_value",
+    "bound_value",
+    "check_figure_path",
+    "check_outputs",
+    "chosen_plan",
+    "cost_value",
+    "emit_json",
+    "flatten_value",
+    "input_files",
+    "list_files",
+    "no_plan",
+    "print_note",
+    "save_figure",
+    "simulate_inputs",
+    "with_progress",
+    "write_failed",
+]
 
 IMAGE_FORMATS = ("png", "svg", "pdf")
-PLAN_NAMES = {"bayes": "Bayes", "most-certain": "most certain", "guaranteed": "guaranteed"}
-"""The plans ``--plan`` names, and how titles call them."""
 
 
 def emit_json(doc: dict[str, Any]) -> None:
     """Print a JSON document (no NaN or infinity: those become null upstream)."""
     typer.echo(json.dumps(doc, indent=2, allow_nan=False))
+
+
+def print_note(text: str) -> None:
+    """Tell the user something about how their input was read: one line on stderr."""
+    typer.echo(f"bayesgrasp: note: {text}", err=True)
 
 
 def with_progress(description: str, total: int, work: Callable[[Any], Any]) -> Any:
@@ -261,7 +285,7 @@ def _plan_file(
     import dataclasses
 
     from ..io.plans import part_id, read_plan, same_part
-    from .specs import GoalKind
+    from ..runs.specs import GoalKind
 
     src = read_plan(path)
     if same_part(src.part, part) is False and not force:
@@ -278,28 +302,3 @@ def _plan_file(
     plan = src.option
     missing = tuple(k for k in plan.kinds if k not in spec.actions)
     return spec.build(part, missing, prior), plan, path.name
-
-
-def simulate_inputs(
-    engine: str,
-    plan: str,
-    seed: int,
-    trials: int,
-    noise_deg: float,
-    noise_kind: str,
-    offset_mm: float = 0.0,
-    units: str | None = None,
-    workers: int | None = None,
-) -> dict[str, Any]:
-    """How a simulation was run, for its document's provenance (defaults left out)."""
-    return {
-        "engine": engine,
-        "plan": plan,
-        "seed": seed,
-        "trials": trials,
-        "noise_deg": noise_deg,
-        "noise_kind": noise_kind,
-        "offset_mm": offset_mm or None,
-        "units": units,
-        "workers": workers,
-    }

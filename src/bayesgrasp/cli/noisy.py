@@ -7,35 +7,43 @@ surfaces the noise-aware plan: the table or ``--json``, ``--only best``, ``--gua
 (:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`), ``--plot`` (the distributions
 under the noise), ``--export`` (the robot file, with the noise model in its header) and
 several parts or ``--batch`` (:func:`~bayesgrasp.cli.batch.run_batch`, one document a line),
-all through :mod:`.strategies` (:func:`strategy_run`); :class:`NoisyRun` is the same run
-for the plot command, the web service and sweeps.
+all through :mod:`.strategies` (:func:`strategy_run`). :class:`NoisyRun` is the run of
+:mod:`bayesgrasp.runs.noisy` (the plot command, the web service and sweeps make the same),
+with the command line's parsing and files.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
 from ..io.plans import noisy_plan_document
+from ..runs import noisy as runs
+from ..runs.noisy import Planned
+from .strategies import StrategyRun, noisy_text
 
 noisy_document = noisy_plan_document  # the document is written by io.plans
 
 if TYPE_CHECKING:
     from ..model.noise import NoiseModel, TurnNoise
-    from ..model.payoff import Payoff
     from ..model.problem import Problem
-    from ..planning.guaranteed import GuaranteedPlan
     from ..planning.noisy import NoisyPlanResult
-    from ..planning.strategy import StrategyResult
+    from ..runs.specs import ProblemSpec
     from .outputs import PartOutputs
-    from .specs import ProblemSpec
-    from .strategies import StrategyRun
 
-#: A noise-aware plan and its guaranteed plan (or the reason there is none, or not asked).
-Planned = tuple["NoisyPlanResult", "GuaranteedPlan | str | None"]
+__all__ = [
+    "NoisyRun",
+    "Planned",
+    "asked",
+    "noise_model",
+    "noisy_document",
+    "noisy_text",
+    "strategy_run",
+    "turn_noise",
+]
 
 
 def asked(turn: str | None, contact: float | None, payoff: Path | None) -> bool:
@@ -71,8 +79,6 @@ def strategy_run(
     """
     if asked(turn, contact, payoff):
         return NoisyRun.of(spec, turn, contact, payoff, best_only, guaranteed).strategy_run(spec)
-    from .strategies import StrategyRun
-
     return StrategyRun(spec, best_only, guaranteed)
 
 
@@ -84,14 +90,12 @@ def noise_model(turn: str | None, contact: float | None) -> NoiseModel:
 
 
 @dataclass(frozen=True, slots=True)
-class NoisyRun:
-    """The noise options of a ``plan`` run, parsed once for all its parts."""
+class NoisyRun(runs.NoisyRun):
+    """The noise options of a ``plan`` run, parsed once for all its parts.
 
-    noise: NoiseModel
-    payoff: Payoff | None
-    max_actions: int | None
-    best_only: bool
-    guaranteed: bool
+    :class:`bayesgrasp.runs.noisy.NoisyRun` (planning, documents), made from the command
+    line's options (:meth:`of`) and writing its files (:meth:`write_outputs`).
+    """
 
     @classmethod
     def of(
@@ -125,52 +129,9 @@ class NoisyRun:
 
     def strategy_run(self, spec: ProblemSpec) -> StrategyRun:
         """The run of these options (:class:`~.strategies.StrategyRun`, the noise-aware planner)."""
-        from .strategies import StrategyRun
-
         return StrategyRun(
             spec, self.best_only, self.guaranteed, self.noise, self.payoff, noisy=True
         )
-
-    def solve(self, pb: Problem) -> StrategyResult:
-        """The noise-aware plans of a problem, and its guaranteed plan under the noise."""
-        from ..planning.strategy import solve
-
-        return solve(
-            pb,
-            noise=self.noise,
-            payoff=self.payoff,
-            max_actions=self.max_actions,
-            best_only=self.best_only,
-            guaranteed=self.guaranteed,
-        )
-
-    def plan(self, pb: Problem) -> Planned:
-        """:meth:`solve` as the pair (noise-aware plans, guaranteed plan or why none)."""
-        from ..planning.noisy import NoisyPlanResult
-
-        res = self.solve(pb)
-        assert isinstance(res.source, NoisyPlanResult)
-        found = res.guaranteed if res.guaranteed_missing is None else res.guaranteed_missing
-        return res.source, found
-
-    def document(
-        self, done: Planned | StrategyResult, inputs: dict[str, Any] | None = None
-    ) -> dict[str, Any]:
-        """The plan document (``plan --json``) of a planned part."""
-        from ..io.plans import strategy_document
-
-        if isinstance(done, tuple):
-            res, found = done
-            sure, missing = (None, found) if isinstance(found, str) else (found, None)
-            return noisy_document(res, guaranteed=sure, guaranteed_missing=missing, inputs=inputs)
-        return strategy_document(done, inputs=inputs)
-
-    def robot_metadata(self, res: NoisyPlanResult) -> dict[str, Any]:
-        """What a robot file of the plan says about the noise it was planned for."""
-        meta: dict[str, Any] = {"noise": self.noise.to_json()}
-        if res.payoff is not None:
-            meta["payoff"] = res.payoff.tolist()
-        return meta
 
     def write_outputs(
         self, outputs: PartOutputs, index: int, pb: Problem, res: NoisyPlanResult
@@ -183,26 +144,3 @@ class NoisyRun:
             write_robot(path, pb, res.bayes_plan.option, self.robot_metadata(res))
 
         outputs.write(pb.part.name, index, lambda: noisy_plan_figure(res), robot)
-
-
-def noisy_text(res: NoisyPlanResult) -> str:
-    """The plan table, then the payoff and noise-free probability of each plan."""
-    from .. import report
-
-    lines = [report.plan_table(res.plan_result())]
-    lines.append(
-        f"noise: {res.noise.describe()}; P(success) and E[cost] are exact under it"
-        + ("" if res.payoff is None else "; E[cost] is per unit payoff")
-    )
-    lines.append("no noise: the same steps' E[payoff] with exact actions")
-    lines.append(f"{'k':>3} {'E[payoff]':>10} {'no noise':>10}  source")
-    for o in res.options:
-        lines.append(
-            f"{o.option.n_actions:>3} {o.expected_payoff:10.4f} "
-            f"{o.noise_free_probability:10.4f}  {o.source}"
-        )
-    lines.append(
-        f"{res.candidates} plans evaluated; no single turn of a refined plan gains more than "
-        f"{res.refinement_bound:.2g} in E[payoff]"
-    )
-    return "\n".join(lines)

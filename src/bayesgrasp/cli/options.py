@@ -19,7 +19,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 
-from .common import accuracy_value, bound_value, cost_value, flatten_value
+from .common import accuracy_value, bound_value, cost_value, flatten_value, print_note
 from .specs import GoalKind, Method, PartFormat, PartSpec, ProblemSpec, SenseSpec, problem_spec
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -331,7 +331,9 @@ def part_options(func: F, optional: bool = False) -> F:
 
     ``optional``: PART may be left out (``PartSpec.part`` is then ``None``).
     """
-    return _replace(func, "part", _part_params(optional), lambda values: PartSpec(**values))
+    return _replace(
+        func, "part", _part_params(optional), lambda values: PartSpec(**values, note=print_note)
+    )
 
 
 def problem_options(push_grasp_alias: bool = False) -> Callable[[F], F]:

@@ -152,7 +152,7 @@ def simulate_policy_command(
     scale = units_scale(units) if units is not None else None
     params = None  # --jaw-lag: checked for every candidate before any work
     if jaw_lag:
-        from .simulate import lagged_params
+        from .engines import lagged_params
 
         checked = [lagged_params(jaw_lag, p, units) for p in parts]  # one SimParams for all
         params = checked[0]

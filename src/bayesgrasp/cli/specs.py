@@ -1,271 +1,33 @@
-"""What the shared options become: the part to read, the problem to build, the planner."""
+"""What the shared options become: the part to read, the problem to build, the planner.
+
+The values live in :mod:`bayesgrasp.runs.specs` (the web service and sweeps make the same
+ones); they are importable from here as the commands use them.
+"""
 
 from __future__ import annotations
 
-import enum
-import functools
-import math
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from ..runs.specs import (
+    Engine,
+    GoalKind,
+    Method,
+    PartFormat,
+    PartSpec,
+    ProblemSpec,
+    SenseSpec,
+    guaranteed_plan,
+    problem_spec,
+    run_inputs,
+)
 
-if TYPE_CHECKING:
-    from ..geometry.polygon import Part
-    from ..model.prior import Prior
-    from ..model.problem import Problem
-    from ..planning.guaranteed import GuaranteedPlan
-    from ..planning.result import PlanReport
-
-
-class PartFormat(enum.StrEnum):
-    """Part file formats (default: from the file's extension)."""
-
-    json = "json"
-    csv = "csv"
-    wkt = "wkt"
-    geojson = "geojson"
-    svg = "svg"
-    dxf = "dxf"
-    stl = "stl"
-    obj = "obj"
-    ply = "ply"
-    threemf = "3mf"
-    glb = "glb"
-
-
-class Method(enum.StrEnum):
-    """Planner to use."""
-
-    exact = "exact"
-    bfs = "bfs"
-
-
-class Engine(enum.StrEnum):
-    """How a plan is executed (simulate, sweep)."""
-
-    kinematic = "kinematic"
-    mujoco = "mujoco"
-
-
-class GoalKind(enum.StrEnum):
-    """What counts as success."""
-
-    single = "single"
-    symmetry = "symmetry"
-
-
-@dataclass(frozen=True, slots=True)
-class PartSpec:
-    """PART and the part-file options (see :func:`bayesgrasp.io.resolve_part`)."""
-
-    part: str
-    fmt: PartFormat | None = None
-    element: str | None = None
-    layer: str | None = None
-    flatten_tol: float | None = None
-    com: str | None = None
-    shape_tol: float = 0.0
-
-    def load(self) -> Part:
-        """Read the part: ``--shape-tol`` applied, then ``--com X,Y`` when given.
-
-        See :func:`~bayesgrasp.geometry.curved.with_shape_tol`.
-        """
-        import dataclasses
-
-        from ..errors import PartError
-        from ..geometry.curved import with_shape_tol
-        from ..geometry.polygon import Part
-        from ..io import resolve_part
-        from ..solid.mesh import is_mesh
-
-        fmt = self.fmt.value if self.fmt else None
-        if is_mesh(self.part, fmt):  # a solid: one resting pose's footprint (cli/meshes.py)
-            from .meshes import load_mesh_part
-
-            return load_mesh_part(self)
-        part = resolve_part(
-            self.part, fmt, element=self.element, layer=self.layer, tolerance=self.flatten_tol
-        )
-        kind = fmt or self.part.rpartition(".")[2].lower()
-        if kind in ("csv", "json") and part.outline is part.hull.vertices:  # a point cloud
-            import typer
-
-            typer.echo(
-                f"bayesgrasp: note: the points of {self.part} cross themselves in file order, "
-                "so they are a point cloud: the part is their convex hull"
-                + ("" if self.com else " (centre of mass its centroid; --com X,Y to set it)"),
-                err=True,
-            )
-        part = with_shape_tol(part, self.shape_tol)
-        if self.com is None:
-            return part
-        try:
-            xy = [float(v) for v in self.com.split(",")]
-        except ValueError:
-            xy = []
-        if len(xy) != 2 or not all(math.isfinite(v) for v in xy):
-            raise PartError(f"`--com` must be X,Y (two finite numbers); got {self.com!r}")
-        try:  # validated as Part.from_points does: strictly inside the hull
-            com = Part.from_points(part.hull.vertices, center_of_mass=xy).center_of_mass
-        except PartError as exc:
-            raise PartError(f"`--com` {self.com}: {exc}") from None
-        return dataclasses.replace(part, center_of_mass=com)
-
-
-@dataclass(frozen=True, slots=True)
-class ProblemSpec:
-    """The problem and planner options of a command, parsed."""
-
-    prior: str = "uniform"
-    costs: Mapping[str, float] | None = None
-    first: Mapping[str, float] | None = None
-    verify: float = 1.0
-    retry: float = 0.0
-    goal: GoalKind = GoalKind.single
-    actions: tuple[str, ...] = ("squeeze",)
-    accuracy_deg: float = 0.0
-    method: Method = Method.exact
-    max_actions: int | None = None
-    given: frozenset[str] = frozenset()
-    """The options of ``prior`` and ``goal`` the user gave (a plan file's own apply otherwise)."""
-
-    def build(
-        self, part: Part, more_actions: tuple[str, ...] = (), prior: Prior | None = None
-    ) -> Problem:
-        """The problem for ``part`` (with ``more_actions`` added to the action kinds).
-
-        ``prior`` replaces the ``--prior`` text (a plan file's prior).
-        """
-        from ..model.problem import Problem
-
-        return Problem.build(part, **self.problem_inputs(more_actions, prior))
-
-    def problem_inputs(
-        self, more_actions: tuple[str, ...] = (), prior: Prior | None = None
-    ) -> dict[str, Any]:
-        """The keywords of ``Problem.build`` but the part (immutable: a batch makes them once).
-
-        A prior, cost or goal equal to build's default is build's shared one
-        (:func:`~bayesgrasp.model.problem.shared_defaults`).
-        """
-        from ..model.cost import CostModel
-        from ..model.goal import Goal
-        from ..model.prior import parse_prior
-        from ..model.problem import shared_defaults
-
-        cost = CostModel(self.costs or {}, self.verify, self.first or {}, self.retry)
-        return shared_defaults(
-            {
-                "prior": parse_prior(self.prior) if prior is None else prior,
-                "cost": cost,
-                "goal": Goal(self.goal.value),
-                "actions": tuple(dict.fromkeys((*self.actions, *more_actions))),
-                "accuracy": math.radians(self.accuracy_deg),
-            }
-        )
-
-    def plan(self, problem: Problem, best_only: bool = False) -> PlanReport:
-        """The best plan of every length, by the chosen planner.
-
-        ``best_only``: only the Bayes and the most certain plans.
-        """
-        return self.planner(best_only)(problem)
-
-    def planner(self, best_only: bool = False) -> Callable[[Problem], PlanReport]:
-        """:meth:`plan` as a function of the problem (a batch looks the planner up once)."""
-        from ..planning import plan_bfs, plan_exact
-
-        if self.method is Method.bfs:
-            max_actions = self.max_actions
-
-            def bfs(problem: Problem) -> PlanReport:
-                found = plan_bfs(problem, max_actions=max_actions)
-                return found.best_only() if best_only else found
-
-            return bfs
-        report: Literal["all", "best"] = "best" if best_only else "all"
-        return functools.partial(plan_exact, max_actions=self.max_actions, report=report)
-
-
-def problem_spec(names: list[str], values: Mapping[str, Any]) -> ProblemSpec:
-    """The :class:`ProblemSpec` of the problem options' values, keyed as the parameters.
-
-    ``names``: the action kinds with a cost option each (``cost_0`` is ``--NAME-cost`` of
-    ``names[0]``, ``first_0`` its ``--first-NAME-cost``); ``None`` is an option not given.
-    The command line (:func:`bayesgrasp.cli.options.problem_options`) and the batch's own
-    parser (:mod:`bayesgrasp.cli.batch`) both make their spec here.
-    """
-    from ..model.actions import PUSH_GRASP, SQUEEZE
-
-    actions = [a.strip() for a in values["actions"].split(",") if a.strip()]
-    if values.get("push_grasp"):  # exactly --actions squeeze,push-grasp (order breaks ties)
-        actions = [SQUEEZE.name, PUSH_GRASP.name, *actions]
-    first = {n: values[f"first_{i}"] for i, n in enumerate(names)}
-    given = frozenset(k for k in ("prior", "goal") if values[k] is not None)
-    return ProblemSpec(
-        prior="uniform" if values["prior"] is None else values["prior"],
-        costs={n: values[f"cost_{i}"] for i, n in enumerate(names)},
-        first={n: c for n, c in first.items() if c is not None},
-        verify=values["verify_cost"],
-        retry=values["retry_cost"],
-        goal=values["goal"] or GoalKind.single,
-        actions=tuple(dict.fromkeys(actions)),
-        accuracy_deg=values["accuracy"],
-        method=values["method"],
-        max_actions=values["max_squeezes"],
-        given=given,
-    )
-
-
-@dataclass(frozen=True, slots=True)
-class SenseSpec:
-    """``--sense`` and the options of a sensing policy (plan, simulate and plot --sense)."""
-
-    sense: str
-    """The sensor (``width[:SIGMA,RES]``)."""
-    also: tuple[str, ...] = ()
-    """The other candidate parts (``--also``; ``plan`` adds its further PARTs)."""
-    part_prior: str | None = None
-    max_actions: int = 3
-    max_memory_mb: float = 2048.0
-    """The policy search's memory bound (``--max-memory``)."""
-    time_limit_s: float = 60.0
-    """The policy search's time bound (``--time-limit``)."""
-
-    def parts(self, part: PartSpec) -> list[Part]:
-        """PART, then each candidate part, read with the same part-file options.
-
-        Candidates in other units than PART are converted to PART's
-        (:func:`~bayesgrasp.units.convert`): the gripper reads every width in one unit.
-        """
-        import dataclasses
-
-        from ..units import convert
-
-        first = part.load()
-        more = [dataclasses.replace(part, part=p).load() for p in self.also]
-        if first.units is None:
-            return [first, *more]
-        return [first, *(convert(p, first.units) if p.units else p for p in more)]
-
-
-def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:
-    """The guaranteed plan of a problem, or the reason none exists (a string)."""
-    from ..planning import guaranteed
-
-    found = guaranteed.plan_guaranteed(problem)
-    return found if found.status == "ok" else str(found.reason or "no guaranteed plan")
-
-
-def run_inputs(part: PartSpec | None, spec: ProblemSpec) -> dict[str, Any]:
-    """What a command adds to a document's provenance: the longest plan, the part-file options.
-
-    Options not given are ``None`` (left out of the document); the web service, which
-    reads no part files, gives ``part=None``.
-    """
-    out: dict[str, Any] = {"max_actions": spec.max_actions}
-    if part is not None:
-        out |= {"format": part.fmt.value if part.fmt else None, "element": part.element}
-        out |= {"layer": part.layer, "flatten_tolerance": part.flatten_tol, "com": part.com}
-    return out
+__all__ = [
+    "Engine",
+    "GoalKind",
+    "Method",
+    "PartFormat",
+    "PartSpec",
+    "ProblemSpec",
+    "SenseSpec",
+    "guaranteed_plan",
+    "problem_spec",
+    "run_inputs",
+]

@@ -25,11 +25,12 @@ if TYPE_CHECKING:
     from ..model.payoff import Payoff
     from ..model.problem import Problem
     from ..model.sensing import WidthSensor
+    from ..planning.noisy import NoisyPlanResult
     from ..planning.strategy import StrategyResult
     from .outputs import PartOutputs
     from .specs import ProblemSpec, SenseSpec
 
-__all__ = ["StrategyRun", "check_stroke", "document", "text", "write_outputs"]
+__all__ = ["StrategyRun", "check_stroke", "document", "noisy_text", "text", "write_outputs"]
 
 
 @dataclass(frozen=True)
@@ -136,8 +137,6 @@ def text(result: StrategyResult, max_actions: int | None = None, fold_below: flo
     if isinstance(src, Policy):
         return _policy_text(src, result.problem.part.units, fold_below)
     if isinstance(src, NoisyPlanResult):
-        from .noisy import noisy_text
-
         lines = [noisy_text(src)]
     else:
         lines = [report.plan_table(src, max_actions)]
@@ -147,6 +146,29 @@ def text(result: StrategyResult, max_actions: int | None = None, fold_below: flo
             lines.append(f"(guaranteed under {src.noise.describe()})")
     if result.guaranteed_missing is not None:
         lines.append(f"Guaranteed plan: none ({result.guaranteed_missing})")
+    return "\n".join(lines)
+
+
+def noisy_text(res: NoisyPlanResult) -> str:
+    """The plan table, then the payoff and noise-free probability of each plan."""
+    from .. import report
+
+    lines = [report.plan_table(res.plan_result())]
+    lines.append(
+        f"noise: {res.noise.describe()}; P(success) and E[cost] are exact under it"
+        + ("" if res.payoff is None else "; E[cost] is per unit payoff")
+    )
+    lines.append("no noise: the same steps' E[payoff] with exact actions")
+    lines.append(f"{'k':>3} {'E[payoff]':>10} {'no noise':>10}  source")
+    for o in res.options:
+        lines.append(
+            f"{o.option.n_actions:>3} {o.expected_payoff:10.4f} "
+            f"{o.noise_free_probability:10.4f}  {o.source}"
+        )
+    lines.append(
+        f"{res.candidates} plans evaluated; no single turn of a refined plan gains more than "
+        f"{res.refinement_bound:.2g} in E[payoff]"
+    )
     return "\n".join(lines)
 
 

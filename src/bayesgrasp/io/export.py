@@ -86,6 +86,7 @@ import numpy as np
 from ..errors import ExportError  # defined in errors.py; importable from here as before
 from ..model.problem import Problem, nearest_state
 from ..planning.result import PlanOption
+from .gripper import GripperAngles, wrap_angle
 from .plans import json_float, part_document
 
 if TYPE_CHECKING:  # the policy machinery (and scipy) only when a policy is written
@@ -123,24 +124,6 @@ CSV_COLUMNS = (
 )
 
 
-class GripperAngles:
-    """The degrees of a step's radians (a base of :class:`RobotStep` and machine states)."""
-
-    __slots__ = ()
-    turn_rad: float
-    gripper_rad: float
-
-    @property
-    def turn_deg(self) -> float:
-        """:attr:`turn_rad` in degrees."""
-        return math.degrees(self.turn_rad)
-
-    @property
-    def gripper_deg(self) -> float:
-        """:attr:`gripper_rad` in degrees, in ``(-180, 180]``."""
-        return math.degrees(self.gripper_rad)
-
-
 @dataclass(frozen=True, slots=True)
 class RobotStep(GripperAngles):
     """One action of a plan as a controller executes it.
@@ -171,18 +154,6 @@ class RobotStep(GripperAngles):
     width_after: float
     width_after_min: float
     width_after_max: float
-
-
-def wrap_angle(angle: float) -> float:
-    """An angle in ``(-pi, pi]`` (plans' and state machines' gripper angles).
-
-    Examples
-    --------
-    >>> wrap_angle(3 * math.pi) == math.pi, wrap_angle(-math.pi) == math.pi
-    (True, True)
-    """
-    out = math.remainder(angle, 2.0 * math.pi)
-    return math.pi if out <= -math.pi else out
 
 
 _wrap = wrap_angle

@@ -87,7 +87,7 @@ from ..model.problem import Problem, nearest_state
 from ..model.sensing import WidthSensor
 from ..planning.policy import Branch, Policy, PolicyNode, Reject
 from ..planning.result import PlanOption
-from .export import GripperAngles, wrap_angle
+from .gripper import GripperAngles, wrap_angle
 from .plans import json_float
 
 __all__ = [

@@ -33,6 +33,7 @@ from ..model.actions import ACTIONS, SQUEEZE, Action, get_action
 from ..model.prior import Prior, UniformPrior
 
 if TYPE_CHECKING:  # ``squeeze`` and ``push`` print tables without importing the planners
+    from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
     from ..planning.result import PlanOption, PlanReport
     from ..sim.kinematic import SimulationResult
@@ -40,6 +41,7 @@ if TYPE_CHECKING:  # ``squeeze`` and ``push`` print tables without importing the
 __all__ = [
     "guaranteed_text",
     "num",
+    "plan_steps_text",
     "plan_table",
     "push_json",
     "push_table",
@@ -47,6 +49,7 @@ __all__ = [
     "simulate_table",
     "squeeze_json",
     "squeeze_table",
+    "tagged",
     "transfer_json",
 ]
 
@@ -111,15 +114,19 @@ def squeeze_table(part: Part, f: TransferFunction, prior: Prior | None = None) -
 
 
 def guaranteed_text(g: GuaranteedPlan) -> str:
-    """One paragraph: the guaranteed plan's steps, period, final orientation and tolerance."""
+    """One paragraph: the guaranteed plan's steps, period, final orientation and tolerance.
+
+    The steps are written as :func:`plan_table` writes a row (:func:`plan_steps_text`): the
+    first gripper angle, then the turns (tagged by action when the table tags them).
+    """
     o = g.option
-    steps = " ".join(
-        f"{get_action(s.kind).tag}({num(math.degrees(s.alpha), '+.2f')})" for s in o.steps
-    )
+    mixed = tagged(g.problem)
+    steps = plan_steps_text(o, mixed)
+    head = "steps" if mixed else "alphas"
     tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.3f} deg"
     return (
-        f"guaranteed plan: {o.n_actions} action(s) {steps}\n"
-        f"  ({_tags(ACTIONS.values())}; the first angle in the world frame, then turns)\n"
+        f"guaranteed plan: {o.n_actions} action(s), first {num(math.degrees(o.first_angle), '.2f')}"
+        f" deg, {head} (deg) {steps}\n"
         f"  sends every orientation to {num(math.degrees(o.final_orientation), '.2f')} deg modulo "
         f"{math.degrees(g.period):.4g} deg; tolerance {tol}\n"
         f"  for the goal: P(success) {o.success_probability:.4f}, "
@@ -183,8 +190,22 @@ def _tags(actions: Iterable[Action]) -> str:
     return ", ".join(f"{a.tag} = {a.name}" for a in actions)
 
 
-def _plan_text(o: PlanOption, mixed: bool) -> str:
-    """The relative turns in degrees; with several action kinds each step is tagged."""
+def tagged(problem: Problem) -> bool:
+    """Whether a problem's plans are written with each step tagged by its action.
+
+    Plans of squeezes only are written as their turns (``[+34.59, -23.49]``); any other
+    action kind tags every step (``P S+23.49``).
+    """
+    return len(problem.action_kinds) > 1 or problem.action_kinds != (SQUEEZE.name,)
+
+
+def plan_steps_text(o: PlanOption, mixed: bool) -> str:
+    """A plan's relative turns in degrees, as :func:`plan_table` writes them.
+
+    Without ``mixed``: the turns before each further squeeze in brackets (``-`` for none);
+    with it, each step's action tag (``S`` squeeze, ``P`` push-grasp) followed by its turn,
+    the first step's angle left to the table's first column.
+    """
     if not mixed:
         alphas = ", ".join(f"{num(math.degrees(a), '+.2f')}" for a in o.alphas)
         return f"[{alphas}]" if alphas else "-"
@@ -202,9 +223,9 @@ def plan_table(report: PlanReport, max_actions: int | None = None) -> str:
     those only.
     """
     pb = report.problem
-    mixed = len(pb.action_kinds) > 1 or pb.action_kinds != (SQUEEZE.name,)
+    mixed = tagged(pb)
     action = "action" if len(pb.action_kinds) > 1 else pb.action_kinds[0]
-    texts = [_plan_text(o, mixed) for o in report.options]
+    texts = [plan_steps_text(o, mixed) for o in report.options]
     width = max(34, *(len(t) for t in texts))
     head = "steps (deg)" if mixed else "alphas (deg)"
     lines = [
@@ -307,7 +328,7 @@ def simulate_table(res: SimulationResult, title: str = "") -> str:
     o = res.option
     tol = "-" if o.tolerance is None else f"{math.degrees(o.tolerance):.2f} deg"
     lo, hi = res.ci95
-    steps = _plan_text(o, len(set(o.kinds)) > 1)
+    steps = plan_steps_text(o, len(set(o.kinds)) > 1)
     lines = [
         f"{title}{res.engine} execution, {res.trials} trials",
         f"plan: {steps} (first action at {num(math.degrees(o.first_angle), '.2f')} deg, "
