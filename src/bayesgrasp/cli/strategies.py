@@ -18,9 +18,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ..runs.strategies import check_stroke, document, robot_metadata
+
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
-    from ..io.export import Stroke
     from ..model.noise import NoiseModel
     from ..model.payoff import Payoff
     from ..model.problem import Problem
@@ -115,13 +116,6 @@ class StrategyRun:
         return self.solve(problems if self.sensing is not None else problems[0], sensor)
 
 
-def document(result: StrategyResult, inputs: dict[str, Any] | None = None) -> dict[str, Any]:
-    """The result's document (``plan --json``; :func:`~bayesgrasp.io.plans.strategy_document`)."""
-    from ..io.plans import strategy_document
-
-    return strategy_document(result, inputs=inputs)
-
-
 def text(result: StrategyResult, max_actions: int | None = None, fold_below: float = 0.0) -> str:
     """The result as ``plan`` prints it without ``--json``.
 
@@ -210,26 +204,6 @@ def _actions(n: int) -> str:
 def exit_code(result: StrategyResult) -> int:
     """1 when a guaranteed plan was asked for and none exists, else 0."""
     return 0 if result.guaranteed_missing is None else 1
-
-
-def check_stroke(result: StrategyResult, stroke: Stroke | None) -> None:
-    """Refuse a strategy with a step outside the gripper's stroke (``None``: no stroke given)."""
-    if stroke is None:
-        return
-    from ..io.export import check_stroke as check
-
-    problems = result.problem if result.kind == "plan" else list(result.problems)
-    check(problems, result.robot_strategy, stroke)
-
-
-def robot_metadata(result: StrategyResult) -> dict[str, Any] | None:
-    """What a robot file says about the model the strategy was planned for (noise, payoff)."""
-    meta: dict[str, Any] = {}
-    if result.noise is not None:
-        meta["noise"] = result.noise.to_json()
-    if result.payoff is not None:
-        meta["payoff"] = result.payoff.tolist()
-    return meta or None
 
 
 def write_outputs(

@@ -588,7 +588,7 @@ def _plan_noisy(
     With ``guaranteed``, also the plan guaranteed under the (bounded) noise, as ``plan
     --turn-noise uniform:A --guaranteed`` (status ``no-plan`` when there is none).
     """
-    from ..cli.noisy import NoisyRun
+    from ..runs.noisy import NoisyRun
 
     run = NoisyRun(_noise(options), payoff, options.max_actions, False, options.guaranteed)
     done = run.plan(pb)
@@ -634,8 +634,8 @@ def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
             from ..sim.result import with_prediction
 
             res = with_prediction(res, pb, model, u)  # MuJoCo drew the turn error
-    from ..cli.common import simulate_inputs
     from ..io.plans import provenance
+    from ..runs.specs import simulate_inputs
 
     doc = report.simulate_json(res, pb.part)  # with the provenance `bayesgrasp simulate` writes
     how = simulate_inputs(

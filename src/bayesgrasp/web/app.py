@@ -1,7 +1,7 @@
 """The FastAPI application of ``bayesgrasp serve``: the JSON API, the page, the gallery.
 
 Every API answer is the document the command line prints with ``--json``, built by the same
-library calls (:class:`~bayesgrasp.cli.specs.ProblemSpec`,
+library calls (:class:`~bayesgrasp.runs.specs.ProblemSpec`,
 :func:`bayesgrasp.io.plans.plan_document`, :mod:`bayesgrasp.report`). Every error is a JSON
 body ``{detail, error, status}`` (:class:`~bayesgrasp.web.models.ErrorBody`): bad input is a
 422 whose ``detail`` is the command line's one-line message; a body over

@@ -3,7 +3,7 @@
 Every function here is work a worker process runs (:data:`~bayesgrasp.web.service.WORK`):
 it takes the worker's :class:`~bayesgrasp.web.service.Service` (to read parts within the
 server's limits) and a request (:mod:`bayesgrasp.web.models`), and builds its answer with the
-command line's own library calls (:class:`~bayesgrasp.cli.specs.ProblemSpec`,
+command line's own library calls (:class:`~bayesgrasp.runs.specs.ProblemSpec`,
 :func:`bayesgrasp.planning.solve`, :func:`bayesgrasp.io.plans.strategy_document`,
 :func:`bayesgrasp.io.export.write_robot`, :mod:`bayesgrasp.report`).
 """
@@ -84,8 +84,8 @@ def push_document(service: Service, req: PartRequest) -> dict[str, Any]:
 
 def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
     """``bayesgrasp plan PART [options] [--guaranteed] [--max-opening W ...] --json``."""
-    from ..cli.specs import run_inputs
-    from ..cli.strategies import document
+    from ..runs.specs import run_inputs
+    from ..runs.strategies import document
 
     spec = problem_spec(req)
     result = plan_strategy(service, req, spec)
@@ -97,10 +97,10 @@ def plan_strategy(service: Service, req: PlanRequest, spec: Any) -> StrategyResu
 
     The noise-aware plans with the noise or payoff options; with ``within_stroke`` only plans
     the stroke allows; with ``max_opening`` or ``min_opening`` a Bayes plan outside the stroke
-    is refused (:func:`~bayesgrasp.cli.strategies.check_stroke`).
+    is refused (:func:`~bayesgrasp.runs.strategies.check_stroke`).
     """
-    from ..cli.strategies import check_stroke
     from ..planning.strategy import solve
+    from ..runs.strategies import check_stroke
 
     stroke = stroke_of(req)
     check_within_stroke(req, stroke, policy=False)
@@ -138,17 +138,17 @@ def policy_document_of(service: Service, req: PolicyRequest) -> dict[str, Any]:
     With the noise or payoff options, the policy under the noisy actions
     (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`), as the command line plans it.
     """
-    from ..cli.strategies import document
+    from ..runs.strategies import document
 
     return document(policy_strategy(service, req))
 
 
 def policy_strategy(service: Service, req: PolicyRequest) -> StrategyResult:
     """The Bayes policy of ``policy`` as a strategy; refused if outside the stroke given."""
-    from ..cli.strategies import check_stroke
     from ..planning.noisy_policy import plan_noisy_policy
     from ..planning.policy import Policy, plan_policy
     from ..planning.strategy import StrategyResult
+    from ..runs.strategies import check_stroke
 
     stroke = stroke_of(req)
     check_within_stroke(req, stroke, policy=True)
@@ -180,13 +180,13 @@ def export_file(service: Service, req: ExportRequest) -> tuple[str, bytes]:
 
     The Bayes plan (or with ``sense`` the policy's state machine) for a robot, written by the
     command line's own writer (:func:`bayesgrasp.io.export.write_robot`, with the noise and
-    payoff of :func:`bayesgrasp.cli.strategies.robot_metadata`); the name is
+    payoff of :func:`bayesgrasp.runs.strategies.robot_metadata`); the name is
     ``PART-plan.FORMAT`` or ``PART-policy.FORMAT``.
     """
     import tempfile
 
-    from ..cli.strategies import robot_metadata
     from ..io.export import write_robot
+    from ..runs.strategies import robot_metadata
 
     result = export_strategy(service, req)
     problems: Any = result.problem if result.kind == "plan" else list(result.problems)
@@ -277,9 +277,8 @@ def simulate_document(
         res = simulate_kinematic(
             pb, option, trials, noise, rng=req.seed, payoff=u, progress=progress
         )
-    from ..cli.common import simulate_inputs
-    from ..cli.specs import run_inputs
     from ..io.plans import provenance
+    from ..runs.specs import run_inputs, simulate_inputs
 
     doc = report.simulate_json(res, p)  # with the provenance the command line writes
     how = simulate_inputs(engine, req.plan, req.seed, trials, deg, kind, offset_mm)

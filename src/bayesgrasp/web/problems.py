@@ -1,6 +1,6 @@
 """From a request's options to the problem the command line would build.
 
-:func:`problem_spec` makes the :class:`~bayesgrasp.cli.specs.ProblemSpec` of ``plan``'s
+:func:`problem_spec` makes the :class:`~bayesgrasp.runs.specs.ProblemSpec` of ``plan``'s
 options, :func:`build_problem` the problem (with an inline histogram or sample prior),
 :func:`chosen_option` the plan ``--plan`` names, :func:`stroke_of` the gripper's stroke.
 Options the command line would refuse are refused here with its reasons (422).
@@ -45,9 +45,9 @@ def prior_string(opts: PartRequest | ProblemOptions) -> str:
 
 
 def problem_spec(opts: ProblemOptions) -> Any:
-    """The :class:`~bayesgrasp.cli.specs.ProblemSpec` the command line makes of these options."""
-    from ..cli.specs import GoalKind, Method, ProblemSpec
+    """The :class:`~bayesgrasp.runs.specs.ProblemSpec` the command line makes of these options."""
     from ..model.actions import get_action
+    from ..runs.specs import GoalKind, Method, ProblemSpec
 
     for name in (*opts.costs, *opts.first_costs):
         get_action(name)  # an unknown action: PlanningError naming the known ones
@@ -105,8 +105,7 @@ def chosen_option(
     which: str, opts: ProblemOptions, part: Part, spec: Any
 ) -> tuple[Problem, PlanOption, str]:
     """The problem and the plan ``which`` names (as ``--plan`` does)."""
-    from ..cli.common import PLAN_NAMES
-    from ..cli.specs import guaranteed_plan
+    from ..runs.specs import PLAN_NAMES, guaranteed_plan
 
     problem = build_problem(part, opts, spec)
     if which == "guaranteed":

@@ -115,7 +115,7 @@ class Service:
             raise LimitError(422, "`part` needs exactly one of vertices, catalogue or file")
         limit = self.limits.max_vertices
         if spec.catalogue is not None:
-            from ..cli.specs import PartSpec
+            from ..runs.specs import PartSpec
 
             if spec.catalogue not in names():
                 raise LimitError(

@@ -129,8 +129,8 @@ def chosen_beliefs(
     """
     import numpy as np
 
-    from ..cli.common import PLAN_NAMES
     from ..errors import NoPlanError
+    from ..runs.specs import PLAN_NAMES
     from .problems import build_problem, chosen_option, exact_method
 
     if not req.noisy:
