@@ -658,10 +658,11 @@ class _Solver:
         """Cycle cost and success mass of the leaf chosen for masses ``total`` (best ``s``).
 
         ``s`` is the success mass of the best declaration. Declares unless rejecting is
-        strictly better (as :meth:`value` decides).
+        strictly better or nothing declared can succeed (as :meth:`value` decides).
         """
         lam, v, rho = self.lam, self.verify, self.retry
-        declare = (v + rho) * total - (lam + rho) * s <= rho * total + _EPS * total
+        # A tie goes to rejecting where no declaration can succeed (s = 0, verify 0).
+        declare = ((v + rho) * total - (lam + rho) * s <= rho * total + _EPS * total) & (s > 0)
         c = np.where(declare, v * total + rho * (total - s), rho * total)
         return np.asarray(c), np.asarray(np.where(declare, s, 0.0))
 
@@ -820,7 +821,7 @@ class _Solver:
         declare = v + rho - (lam + rho) * sf
         best: float
         decision: tuple[Any, ...]
-        if declare <= rho + _EPS:
+        if declare <= rho + _EPS and sf > 0:  # declaring what cannot succeed: reject
             best, decision, c, p = declare, ("declare", int(o)), v + rho * (1 - sf), sf
         else:
             best, decision, c, p = rho, ("reject",), rho, 0.0
@@ -922,7 +923,7 @@ class PolicyBuilder:
         else:
             settled = np.ones(len(kept), dtype=bool)
         succ, state = s.success(q)
-        declare = (s.verify + s.retry) - (s.lam + s.retry) * succ <= s.retry + _EPS
+        declare = ((s.verify + s.retry) - (s.lam + s.retry) * succ <= s.retry + _EPS) & (succ > 0)
         # Leaf key of each bin: the declared state, or -1 to reject, or -2 to act on.
         leaf_key = np.where(settled, np.where(declare, state, -1), -2)
         w = mass * pm
