@@ -113,6 +113,8 @@ ROW_COLUMNS: tuple[tuple[str, type], ...] = (
     ("contact_noise", float),
     ("payoff", str),  # the payoff file
     ("bayes_payoff", float),  # the Bayes plan's expected payoff (with noise or a payoff)
+    ("pose", int),  # a mesh's rows: the resting pose (0 the most probable), as `poses` lists
+    ("pose_probability", float),  # its quasi-static probability
 )
 
 #: Most outline points a row keeps for drawing (evenly spaced beyond that).

@@ -50,6 +50,7 @@ __all__ = [
     "error_rows",
     "part_id",
     "plan_part",
+    "plan_part_rows",
     "run_chunk",
     "timeout_row",
 ]
@@ -103,9 +104,16 @@ def _outline(part: Any) -> str:
 
 
 def _plan(
-    part: Any, options: SweepOptions, prior: Prior, payoff: Payoff | None = None
+    part: Any,
+    options: SweepOptions,
+    prior: Prior,
+    payoff: Payoff | None = None,
+    element: str | None = None,
 ) -> tuple[Any, dict[str, Any], str]:
-    """Problem, plan report and plan document, as ``bayesgrasp plan --json`` makes them."""
+    """Problem, plan report and plan document, as ``bayesgrasp plan --json`` makes them.
+
+    ``element``: a mesh's pose, as ``--pose K`` records it.
+    """
     from ..io.plans import plan_document
     from ..model.cost import CostModel
     from ..model.goal import Goal
@@ -136,6 +144,8 @@ def _plan(
     )
     given: dict[str, Any] = {"max_actions": options.max_actions, "layer": options.layer}
     given["flatten_tolerance"] = options.flatten_tol  # what the CLI records
+    if element is not None:
+        given["element"] = element
     if options.noisy:
         return _plan_noisy(pb, options, payoff, given)
     if options.method == "bfs":
@@ -188,7 +198,7 @@ def _plan_noisy(
     return done[0], run.document(done, given), "no-plan" if isinstance(done[1], str) else "ok"
 
 
-def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
+def _simulate(rep: Any, options: SweepOptions, element: str | None = None) -> dict[str, Any]:
     """The ``bayesgrasp.simulate/1`` document of the Bayes plan's execution.
 
     Under noise or a payoff ``rep`` is the noise-aware result: its Bayes plan runs under the
@@ -238,6 +248,8 @@ def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
     if options.noisy:
         how |= {"contact_noise": options.contact_noise, "payoff": options.payoff}
     given = {"max_actions": options.max_actions, "layer": options.layer}
+    if element is not None:
+        given["element"] = element
     doc["provenance"] = provenance(pb, None, **how, **given, flatten_tolerance=options.flatten_tol)
     return doc
 
@@ -318,6 +330,8 @@ def plan_part(
 ) -> dict[str, Any]:
     """Read, plan and optionally simulate one part: one row, never an exception.
 
+    A mesh gives its most probable pose's row (:func:`plan_part_rows` gives them all).
+
     Parameters
     ----------
     source : PartSource or str
@@ -347,14 +361,120 @@ def plan_part(
     """
     if isinstance(source, str):
         source = PartSource(source)
-    row = empty_row(source.path, source.sha256, options)
+    return plan_part_rows(source, options, prior, payoff)[0]
+
+
+def plan_part_rows(
+    source: PartSource | str,
+    options: SweepOptions,
+    prior: Prior | None = None,
+    payoff: Payoff | None = None,
+) -> list[dict[str, Any]]:
+    """The rows of one part file: one for a planar part, one per resting pose of a mesh.
+
+    A mesh's rows are its poses' footprints, most probable first, as ``plan MESH --pose K
+    --json`` plans them (the quasi-static poses of :func:`bayesgrasp.solid.parts.study_of`):
+    ``part_id`` ends in ``#pose-K``, ``pose`` is K and ``pose_probability`` its
+    probability. A mesh that cannot be read is one error row. ``simulate="mujoco"`` is
+    refused for a mesh's rows (an error in each): the physics would squeeze the footprint
+    extruded to a prism, not the solid, which may topple or rest otherwise.
+
+    Examples
+    --------
+    >>> import tempfile, trimesh
+    >>> f = Path(tempfile.mkdtemp()) / "brick.stl"
+    >>> _ = trimesh.creation.box(extents=(1, 2, 4)).export(f)
+    >>> rows = plan_part_rows(str(f), SweepOptions())
+    >>> [(r["part_id"][-7:], r["pose"], round(r["pose_probability"], 4)) for r in rows][:3]
+    [('#pose-0', 0, 0.3344), ('#pose-1', 1, 0.3344), ('#pose-2', 2, 0.131)]
+    """
+    if isinstance(source, str):
+        source = PartSource(source)
     t0 = time.perf_counter()
     try:
-        part, digest = _read_part(source, options)
+        poses = _mesh_poses(source, options)
+    except Exception as exc:  # an unreadable mesh is one error row
+        row = empty_row(source.path, source.sha256, options)
+        row["plan_seconds"] = time.perf_counter() - t0
+        return [error_row(row, exc)]
+    if poses is None:
+        row = empty_row(source.path, source.sha256, options)
+        try:
+            part, digest = _read_part(source, options)
+        except Exception as exc:  # a bad part is a row; a bug in it too, with its class
+            row["plan_seconds"] = time.perf_counter() - t0
+            return [error_row(row, exc)]
         if digest:
             row.update(sha256=digest, part_id=part_id(source.path, digest))
+        return [_plan_row(row, part, options, prior, payoff, t0)]
+    parts, probs, digest = poses
+    rows = []
+    for k, (part, prob) in enumerate(zip(parts, probs, strict=True)):
+        t0 = time.perf_counter() if k else t0
+        row = empty_row(source.path, digest, options)
+        row.update(part_id=f"{part_id(source.path, digest)}#pose-{k}", pose=k)
+        row["pose_probability"] = prob
+        if options.simulate == "mujoco":
+            row["plan_seconds"] = time.perf_counter() - t0
+            rows.append(error_row(row, SweepError(MESH_MUJOCO)))
+            continue
+        rows.append(_plan_row(row, part, options, prior, payoff, t0, str(k)))
+    return rows
+
+
+#: Why a sweep does not simulate a mesh's poses in MuJoCo.
+MESH_MUJOCO = (
+    "simulate mujoco: a mesh's pose is planned as its footprint, and MuJoCo would squeeze "
+    "that footprint extruded to a prism, not the solid (which may topple); use kinematic"
+)
+
+
+def _mesh_poses(
+    source: PartSource, options: SweepOptions
+) -> tuple[list[Any], list[float], str] | None:
+    """A mesh's pose footprints, their probabilities and the file's hash; None: no mesh."""
+    from ..errors import PartFileError
+    from ..geometry.curved import with_shape_tol
+    from ..solid.mesh import is_mesh, read_mesh_bytes
+    from ..solid.parts import pose_part, study_of
+
+    if not is_mesh(source.path):
+        return None
+    data = source.data
+    if data is None:
+        try:
+            data = Path(source.path).read_bytes()
+        except OSError:
+            return None  # the part reader says why, in the CLI's words
+    if options.layer is not None:
+        raise PartFileError(f"{source.path}: a mesh has no layers (--layer is for DXF)")
+    if options.flatten_tol is not None:
+        raise PartFileError(f"{source.path}: a mesh has no curves to flatten (--flatten-tol)")
+    kind = Path(source.path).suffix.lstrip(".").lower()
+    solid = read_mesh_bytes(data, kind, source.path)
+    study = study_of(solid)
+    tol = options.shape_tol
+    named = [
+        pose_part(study, k, f"{solid.name}-pose-{k}", solid.units) for k in range(len(study.poses))
+    ]
+    parts = [with_shape_tol(p, tol) for p in named]
+    return parts, [float(p.probability) for p in study.poses], hashlib.sha256(data).hexdigest()
+
+
+def _plan_row(
+    row: dict[str, Any],
+    part: Any,
+    options: SweepOptions,
+    prior: Prior | None,
+    payoff: Payoff | None,
+    t0: float,
+    element: str | None = None,
+) -> dict[str, Any]:
+    """Plan (and sense, and simulate) one read part into ``row`` (``element``: its pose)."""
+    try:
         payoff = _read_payoff(options, payoff)
-        rep, doc, status = _plan(part, options, prior or parse_prior(options.prior), payoff)
+        parsed = prior or parse_prior(options.prior)
+        rep, doc, status = _plan(part, options, parsed, payoff, element)
         _fill(row, part, doc)
         row["status"] = status
     except Exception as exc:  # a bad part is a row; a bug in it too, with its class
@@ -370,7 +490,7 @@ def plan_part(
     if options.simulate is not None:
         t1 = time.perf_counter()
         try:
-            sim = _simulate(rep, options)
+            sim = _simulate(rep, options, element)
             row.update(
                 sim_engine=sim["engine"],
                 sim_trials=sim["trials"],
@@ -419,12 +539,14 @@ class ChunkResult:
     worker: str = ""
 
 
-def _call_with_timeout(work: Callable[[], dict[str, Any]], timeout: float) -> dict[str, Any] | None:
+def _call_with_timeout(
+    work: Callable[[], list[dict[str, Any]]], timeout: float
+) -> list[dict[str, Any]] | None:
     """``work()`` in a thread, or ``None`` when it is not done in ``timeout`` seconds.
 
     Python threads cannot be killed; the engine restarts the worker whose thread is stuck.
     """
-    box: list[dict[str, Any]] = []
+    box: list[list[dict[str, Any]]] = []
     t = threading.Thread(target=lambda: box.append(work()), daemon=True)
     t.start()
     t.join(timeout)
@@ -455,13 +577,13 @@ def run_chunk(
     rows: list[dict[str, Any]] = []
     for i, src in enumerate(sources):
         if timeout is None:
-            rows.append(plan_part(src, options, prior, payoff))
+            rows.extend(plan_part_rows(src, options, prior, payoff))
             continue
-        row = _call_with_timeout(lambda s=src: plan_part(s, options, prior, payoff), timeout)  # type: ignore[misc]
-        if row is None:
+        got = _call_with_timeout(lambda s=src: plan_part_rows(s, options, prior, payoff), timeout)  # type: ignore[misc]
+        if got is None:
             rows.append(timeout_row(src, options, timeout))
             return ChunkResult(rows, tuple(sources[i + 1 :]), True, worker)
-        rows.append(row)
+        rows.extend(got)
     return ChunkResult(rows, (), False, worker)
 
 
