@@ -174,3 +174,13 @@ def test_jaw_height_needs_a_mesh(tmp_path: Path, capsys) -> None:
     assert main(["plan", str(part), "--jaw-height", "1"]) == 2
     err = capsys.readouterr().err
     assert "--jaw-height needs a mesh PART" in err and err.count("\n") == 1
+
+
+def test_jaw_height_refuses_standard_input(prism: Path, capsys, monkeypatch) -> None:
+    import io
+    import sys
+
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(prism.read_bytes())))
+    assert main(["plan", "-", "--format", "stl", "--jaw-height", "40"]) == 2
+    err = capsys.readouterr().err
+    assert "not on standard input" in err and err.count("\n") == 1

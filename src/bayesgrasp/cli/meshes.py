@@ -255,6 +255,11 @@ def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
         return
     if not is_mesh_part(part):
         raise typer.BadParameter("--jaw-height needs a mesh PART", param_hint="--jaw-height")
+    if part.part == "-":  # the mesh would be read twice: the check, then the plan
+        raise typer.BadParameter(
+            "--jaw-height needs the mesh in a file, not on standard input",
+            param_hint="--jaw-height",
+        )
     from ..solid.parts import pose_index
     from ..solid.topple import toppling_report
 
