@@ -98,3 +98,12 @@ def test_a_sweep_writes_every_pose_once_and_resumes(wedge: Path, tmp_path: Path)
     assert sorted(r["pose"] for r in rows if r["pose"] is not None) == list(range(n))
     again = run_sweep([str(wedge), str(plate)], out, options, workers=1, fmt="csv", resume=True)
     assert again.written == 0 and len(read_results(out)) == n + 1
+
+
+def test_the_report_names_each_pose(wedge: Path) -> None:
+    from bayesgrasp.sweep.report import report_html
+
+    rows = plan_part_rows(str(wedge), SweepOptions(max_actions=2))
+    text = report_html(rows)
+    for r in rows:
+        assert f"(pose {r['pose']}, p = {r['pose_probability']:.3g})" in text
