@@ -241,3 +241,21 @@ def test_simulate_and_plot_take_the_pose_options(
     assert "add --sense" in capsys.readouterr().err
     assert main([command, "house", "--sense", "width", "--pose-prior", "perturbed"]) == 2
     assert "for a mesh PART" in capsys.readouterr().err
+
+
+def test_free_verification_rejects_a_pose_that_cannot_be_the_goal(wedge_file: Path) -> None:
+    """Verify cost 0: declaring a non-goal pose costs what rejecting it does (a retry); the
+    policy rejects it, and every declaration left can succeed. The cost is the tie's either
+    way: the brute-force check prices each leaf by hand (declare s: -lambda s + rho (1 - s))."""
+    from bayesgrasp.model.cost import CostModel
+
+    solid = read_mesh(wedge_file)
+    study = resting_poses(solid.vertices, solid.center_of_mass)
+    free = CostModel(verify=0.0)
+    pol = plan_pose_policy(study, "width", goal_pose=0, cost=free, max_actions=2)
+    leaves = list(_leaves(pol.root))
+    assert all(x.success_probability > 0 for x in leaves if isinstance(x, Declare))
+    assert any(isinstance(x, Reject) for x in leaves)
+    tiny = plan_pose_policy(study, "width", goal_pose=0, cost=CostModel(verify=1e-9), max_actions=2)
+    assert_allclose(pol.expected_cost, tiny.expected_cost, rtol=1e-6)
+    assert_allclose(pol.success_probability, tiny.success_probability, rtol=1e-6)

@@ -244,12 +244,77 @@ def _match(
     return [float(x) for x in out]
 
 
+def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
+    """``plan MESH [--pose K] --jaw-height H``: refuse pose K if a squeeze may topple it.
+
+    The part's planar orientation is unknown, so a squeeze at any gripper angle may meet the
+    pose at any closing direction: a pose that topples at some direction
+    (:func:`bayesgrasp.solid.topple.toppling_angles`) topples under every gripper angle.
+    """
+    if jaw_height is None:
+        return
+    if not is_mesh_part(part):
+        raise typer.BadParameter("--jaw-height needs a mesh PART", param_hint="--jaw-height")
+    if part.part == "-":  # the mesh would be read twice: the check, then the plan
+        raise typer.BadParameter(
+            "--jaw-height needs the mesh in a file, not on standard input",
+            param_hint="--jaw-height",
+        )
+    from ..solid.parts import pose_index
+    from ..solid.topple import toppling_report
+
+    study = _study(load_solid(part))
+    k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
+    found = toppling_report(study, jaw_height)[k]
+    if found.fraction > 0:
+        raise typer.BadParameter(
+            f"a squeeze with the jaws at height {jaw_height:g} topples pose {k} (the push tips "
+            f"it before it slides at {found.describe()} of its frame; the "
+            "planar orientation is unknown, so every gripper angle may meet one): plan another "
+            "--pose or lower the jaws",
+            param_hint="--jaw-height",
+        )
+    typer.echo(
+        f"bayesgrasp: note: no squeeze with the jaws at height {jaw_height:g} topples pose {k}",
+        err=True,
+    )
+
+
+def check_poses_toppling(study: PoseStudy, weights: list[float], jaw_height: float) -> None:
+    """``plan MESH --sense --jaw-height H``: refuse the policy if a squeeze may topple a pose.
+
+    Every action of the policy squeezes whichever pose the part is in, at an unknown planar
+    orientation; a pose of positive prior weight that some closing direction topples would
+    be tipped, so the policy is refused, naming those poses. Poses of weight 0 do not count.
+    """
+    from ..solid.topple import toppling_report
+
+    report = toppling_report(study, jaw_height)
+    bad = [r for r in report if r.fraction > 0 and weights[r.pose] > 0]
+    if bad:
+        which = "; ".join(f"pose {r.pose} at {r.describe()}" for r in bad)
+        every = " (every pose that may occur)" if len(bad) == sum(w > 0 for w in weights) else ""
+        raise typer.BadParameter(
+            f"a squeeze with the jaws at height {jaw_height:g} topples{every}: {which} (closing "
+            "directions in each pose's frame; the planar orientation is unknown, so every "
+            "gripper angle may meet one): give those poses weight 0 (--pose-prior FILE) or "
+            "lower the jaws",
+            param_hint="--jaw-height",
+        )
+    typer.echo(
+        f"bayesgrasp: note: no squeeze with the jaws at height {jaw_height:g} topples a pose "
+        "of positive weight",
+        err=True,
+    )
+
+
 def pose_sensing(
     part: PartSpec,
     sensing: SenseSpec,
     spec: ProblemSpec,
     goal_pose: str | None,
     pose_prior: str | None,
+    jaw_height: float | None = None,
 ) -> tuple[PoseSense, PoseProblems]:
     """The --sense options of ``plan MESH``: the poses as candidates, the goal pose's problems."""
     from ..solid.parts import pose_parts
@@ -259,6 +324,8 @@ def pose_sensing(
     n = len(study.poses)
     goal = goal_pose_index(goal_pose, n) if goal_pose is not None else 0
     weights = pose_prior_weights(pose_prior, solid, study)
+    if jaw_height is not None:
+        check_poses_toppling(study, weights, jaw_height)
     footprints = tuple(pose_parts(study, solid.units))
     undeclared = frozenset(f"pose-{k}" for k in range(n) if goal is not None and k != goal)
     values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(ProblemSpec)}

@@ -182,6 +182,19 @@ GoalPoseOpt = Annotated[
         "rejected (dropped again, --retry-cost) (default 0); any: every pose may be declared.",
     ),
 ]
+JawHeightOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--jaw-height",
+        min=0.0,
+        metavar="H",
+        help="With a mesh PART: height of the jaws' contact above the table (the mesh's "
+        "units). A pose that a squeeze at this height may topple (the first jaw's push tips it "
+        "before it slides, table friction 0.5) is refused: with --pose K that pose, with "
+        "--sense the policy, naming the poses. Default: the jaws at the table, no squeeze "
+        "topples a part.",
+    ),
+]
 PosePriorOpt = Annotated[
     str | None,
     typer.Option(

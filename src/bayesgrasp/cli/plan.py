@@ -18,6 +18,7 @@ from .options import (
     FoldOpt,
     ForceOpt,
     GoalPoseOpt,
+    JawHeightOpt,
     JsonOpt,
     MaxMemoryOpt,
     MaxOpeningOpt,
@@ -173,6 +174,7 @@ def plan(
     pose: PoseOpt = None,
     goal_pose: GoalPoseOpt = None,
     pose_prior: PosePriorOpt = None,
+    jaw_height: JawHeightOpt = None,
 ) -> None:
     """Best squeeze plan of every length, the Bayes plan and the most certain plan.
 
@@ -190,12 +192,14 @@ def plan(
     and --export then write one file a part, named by a path with {name}.
     """
     from . import noisy
-    from .meshes import is_mesh_part, mesh_options, pose_sensing
+    from .meshes import check_pose_toppling, is_mesh_part, mesh_options, pose_sensing
     from .outputs import PartOutputs
     from .strategies import check_stroke, document, exit_code, text, write_outputs
 
     candidates = bool(more_parts or also or part_prior is not None)
     part = mesh_options(part, sense, pose, goal_pose, pose_prior, candidates, batch)
+    if jaw_height is not None and (sense is None or not is_mesh_part(part)):
+        check_pose_toppling(part, jaw_height)
     stroke = None
     if max_opening is not None or min_opening is not None:
         from ..io.export import Stroke
@@ -226,7 +230,7 @@ def plan(
         more = (*(more_parts or []), *(also or []))  # more PARTs are candidates, as --also
         sensing = sense_spec(sense, more, part_prior, spec, max_memory, time_limit)
         if is_mesh_part(part):  # the candidates are the mesh's resting poses
-            sensing, spec = pose_sensing(part, sensing, spec, goal_pose, pose_prior)
+            sensing, spec = pose_sensing(part, sensing, spec, goal_pose, pose_prior, jaw_height)
         fold = fold_below if _given(ctx, "fold_below") else None  # the figure's, when given
         from .sensing import plan_policy_command, sense_noise
 

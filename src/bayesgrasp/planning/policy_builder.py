@@ -109,7 +109,7 @@ class PolicyBuilder:
         else:
             settled = np.ones(len(kept), dtype=bool)
         succ, state = s.success(q)
-        declare = (s.verify + s.retry) - (s.lam + s.retry) * succ <= s.retry + EPS
+        declare = ((s.verify + s.retry) - (s.lam + s.retry) * succ <= s.retry + EPS) & (succ > 0)
         # Leaf key of each bin: the declared state, or -1 to reject, or -2 to act on.
         leaf_key = np.where(settled, np.where(declare, state, -1), -2)
         w = mass * pm

@@ -330,10 +330,11 @@ class Solver:
         """Cycle cost and success mass of the leaf chosen for masses ``total`` (best ``s``).
 
         ``s`` is the success mass of the best declaration. Declares unless rejecting is
-        strictly better (as :meth:`value` decides).
+        strictly better or nothing declared can succeed (as :meth:`value` decides).
         """
         lam, v, rho = self.lam, self.verify, self.retry
-        declare = (v + rho) * total - (lam + rho) * s <= rho * total + EPS * total
+        # A tie goes to rejecting where no declaration can succeed (s = 0, verify 0).
+        declare = ((v + rho) * total - (lam + rho) * s <= rho * total + EPS * total) & (s > 0)
         c = np.where(declare, v * total + rho * (total - s), rho * total)
         return np.asarray(c), np.asarray(np.where(declare, s, 0.0))
 
@@ -486,7 +487,7 @@ class Solver:
         declare = v + rho - (lam + rho) * sf
         best: float
         decision: tuple[Any, ...]
-        if declare <= rho + EPS:
+        if declare <= rho + EPS and sf > 0:  # declaring what cannot succeed: reject
             best, decision, c, p = declare, ("declare", int(o)), v + rho * (1 - sf), sf
         else:
             best, decision, c, p = rho, ("reject",), rho, 0.0

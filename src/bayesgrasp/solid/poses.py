@@ -29,13 +29,18 @@ the mesh or the hull is triangulated. The solid angle of a face is the sum of it
 for the triangle's corners ``a, b, d`` taken from ``c``, summed exactly to rounding (the
 triangles of a face tile it and do not overlap, so their solid angles add).
 
-The *perturbed* estimator averages the quasi-static one over centres of mass drawn from an
-isotropic normal distribution about ``c`` (standard deviation ``sigma`` times the part's
-size, draws outside the hull discarded), the form ``trimesh.poses.compute_stable_poses``
-gives the paper's perturbed estimator with its ``sigma`` and ``n_samples``. It blurs the
-sharp boundaries of the quasi-static model: a face whose centre-of-mass projection lies near
-an edge shares its probability with its neighbour, as a part that still moves a little when
-it lands would.
+The *perturbed* estimator here is trimesh's form (``trimesh.poses.compute_stable_poses``
+with its ``sigma`` and ``n_samples``): the Monte Carlo average of the quasi-static
+probabilities over ``samples`` centres of mass drawn from the isotropic normal distribution
+:math:`N(c, s^2 I)`, :math:`s` = ``sigma`` times the part's size (its largest distance from
+the mean of its points; trimesh's ``sigma`` is the covariance :math:`s^2` in the mesh's
+units), a draw outside the hull discarded and drawn again. The tests check it against
+trimesh's own sampler. It is *not* verified to be the paper's perturbed quasi-static
+estimator: the paper describes that one as taking "a measure of dynamic stability based on
+perturbation" into account with the quasi-static estimator's :math:`O(n \log n)` time, a
+deterministic computation, where this one is a sampled average. It blurs the sharp
+boundaries of the quasi-static model: a face whose centre-of-mass projection lies near an
+edge shares its probability with its neighbour.
 
 Each stable pose has a planar frame: ``z`` points up (minus the face's outward normal), ``x``
 is the mesh axis most parallel to the table projected on it, ``y = z x x``, and the origin

@@ -4,8 +4,10 @@ Needs the ``sweep`` extra (``pip install 'bayesgrasp[sweep]'``: Dask distributed
 pyarrow); the core of bayesgrasp never imports this package. Dask is imported only when a
 sweep runs, so this package imports without it.
 
+- :mod:`~bayesgrasp.sweep.options`: :class:`SweepOptions`, the options of every part;
+- :mod:`~bayesgrasp.sweep.rows`: a row's columns, the part file a task gets, error rows;
 - :mod:`~bayesgrasp.sweep.tasks`: the work of one part on a worker (a row, never an
-  exception) and :class:`SweepOptions`;
+  exception; a mesh, a row per resting pose);
 - :mod:`~bayesgrasp.sweep.engine`: :func:`run_sweep`, the Dask driver;
 - :mod:`~bayesgrasp.sweep.results`: Parquet and CSV results, appended in batches, resumable;
 - :mod:`~bayesgrasp.sweep.report`: an HTML report of a results file.

@@ -411,7 +411,8 @@ def run_sweep(
     as_completed: Any = distributed.as_completed
 
     buffer: list[dict[str, Any]] = []
-    seen: set[str] = set()
+    seen: set[str] = set()  # the paths done
+    seen_rows: set[str] = set()
     last_flush = time.monotonic()
     started = time.perf_counter()
     tag = uuid.uuid4().hex[:8]
@@ -481,8 +482,10 @@ def run_sweep(
                     _restart(client, res.worker)
             fut.release()
             for row in rows:
-                if row["path"] in seen:  # a task run twice (its worker died after it ended)
+                key = row["part_id"]  # a mesh's poses share their path
+                if key in seen_rows:  # a task run twice (its worker died after it ended)
                     continue
+                seen_rows.add(key)
                 seen.add(row["path"])
                 buffer.append(row)
                 counts[row["status"]] += 1

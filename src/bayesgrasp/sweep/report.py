@@ -28,7 +28,22 @@ from typing import Any
 from ..errors import MissingExtraError
 from .results import read_metadata, read_results
 
-__all__ = ["disagreements", "report_html", "write_report"]
+__all__ = ["disagreements", "report_html", "row_label", "write_report"]
+
+
+def row_label(row: dict[str, Any]) -> str:
+    """A row's part as the report names it: its path, and a mesh's pose with its probability.
+
+    Examples
+    --------
+    >>> row_label({"path": "a.stl", "pose": 2, "pose_probability": 0.125})
+    'a.stl (pose 2, p = 0.125)'
+    >>> row_label({"path": "a.json"})
+    'a.json'
+    """
+    if row.get("pose") is None:
+        return str(row["path"])
+    return f"{row['path']} (pose {row['pose']}, p = {float(row['pose_probability']):.3g})"
 
 
 def _pyplot() -> Any:
@@ -169,7 +184,7 @@ def _parts_table(rows: Sequence[dict[str, Any]], limit: int) -> str:
         sim = r.get("sim_observed") is not None
         body.append(
             [
-                r["path"],
+                row_label(r),
                 r["status"],
                 r.get("sides") if r.get("sides") is not None else "-",
                 r.get("states") if r.get("states") is not None else "-",
@@ -309,7 +324,7 @@ def report_html(
                     ["part", "outline", "predicted", "observed", "95% interval", "jams"],
                     [
                         (
-                            r["path"],
+                            row_label(r),
                             _outline(r),
                             _num(r["sim_predicted"]),
                             _num(r["sim_observed"]),
@@ -332,7 +347,7 @@ def report_html(
             "<h2>Parts that failed</h2>",
             _table(
                 ["part", "error", "message"],
-                [(r["path"], r["error_class"], r["error_message"]) for r in failed[:limit]],
+                [(row_label(r), r["error_class"], r["error_message"]) for r in failed[:limit]],
             ),
         ]
     parts += [_SORT_JS, "</body></html>"]

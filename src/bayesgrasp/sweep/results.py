@@ -35,7 +35,8 @@ from pathlib import Path
 from typing import Any, Literal, Protocol
 
 from ..errors import MissingExtraError
-from .tasks import ROW_COLUMNS, SweepError, SweepOptions
+from .options import SweepError, SweepOptions
+from .rows import ROW_COLUMNS
 
 __all__ = [
     "FORMATS",

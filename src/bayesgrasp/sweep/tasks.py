@@ -17,449 +17,43 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
-import socket
 import tempfile
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, cast
 
 from ..errors import BayesGraspError
 from ..model.prior import Prior, parse_prior
+from .options import DEFAULT_TRIALS, ENGINES, GOALS, METHODS, SweepError, SweepOptions
+from .rows import MAX_OUTLINE_POINTS, ROW_COLUMNS, PartSource, empty_row, error_row, part_id
 
 if TYPE_CHECKING:
     from ..model.noise import NoiseModel
     from ..model.payoff import Payoff
 
 __all__ = [
+    "DEFAULT_TRIALS",
     "ENGINES",
     "GOALS",
+    "MAX_OUTLINE_POINTS",
     "METHODS",
     "ROW_COLUMNS",
     "ChunkResult",
     "PartSource",
     "SweepError",
     "SweepOptions",
+    "empty_row",
+    "error_row",
     "error_rows",
     "part_id",
     "plan_part",
+    "plan_part_rows",
     "run_chunk",
     "timeout_row",
 ]
-
-#: Planners a sweep may use (the ``plan`` command's ``--method``).
-METHODS = ("exact", "bfs")
-#: Goals (the ``plan`` command's ``--goal``).
-GOALS = ("single", "symmetry")
-#: Execution checks of each part's Bayes plan (the ``simulate`` command's ``--engine``).
-ENGINES = ("kinematic", "mujoco")
-#: Default trials of each engine (as ``bayesgrasp simulate``).
-DEFAULT_TRIALS = {"kinematic": 1_000_000, "mujoco": 200}
-
-
-class SweepError(BayesGraspError, ValueError):
-    """Bad sweep settings, or a results file that cannot be written or resumed."""
-
-
-def _number(name: str, value: float | None, *, optional: bool = False) -> None:
-    """Refuse a negative or non-finite option (``None`` allowed when ``optional``)."""
-    if value is None and optional:
-        return
-    if not isinstance(value, int | float) or not math.isfinite(value) or value < 0:
-        raise SweepError(f"`{name}` must be a finite number >= 0; got {value!r}")
-
-
-@dataclass(frozen=True, slots=True)
-class SweepOptions:
-    """The options applied to every part of a sweep (those of ``plan`` and ``simulate``).
-
-    Parameters
-    ----------
-    prior : str
-        Prior on the initial orientation, as ``--prior`` (``uniform``,
-        ``vonmises:MEAN_DEG,KAPPA``, ``histogram:FILE``, ``sample:FILE``).
-    squeeze_cost, push_grasp_cost, verify_cost, retry_cost : float
-        Costs of a squeeze, a push-grasp, the verification and a failed verification.
-    first_squeeze_cost, first_push_grasp_cost : float, optional
-        Cost of a squeeze or push-grasp that is the first action (default: as the others).
-    goal : {"single", "symmetry"}
-    actions : tuple of str
-        Action names a plan may use (``("squeeze",)`` or ``("squeeze", "push-grasp")``).
-    accuracy_deg : float
-        Gripper accuracy in degrees (``--accuracy``).
-    method : {"exact", "bfs"}
-    max_actions : int, optional
-        Longest plan to consider (``--max-actions``).
-    guaranteed : bool
-        Also plan the shortest guaranteed plan (``--guaranteed``); on by default, since a
-        row reports its length.
-    simulate : {"kinematic", "mujoco"}, optional
-        Execute each part's Bayes plan ``trials`` times with this engine.
-    trials : int, optional
-        Default: 1,000,000 kinematic, 200 mujoco (as ``bayesgrasp simulate``).
-    seed : int
-        Seed of every part's simulation (each part uses the same seed, so its row equals
-        ``bayesgrasp simulate PART --seed SEED``, whatever worker runs it and when).
-    noise_deg : float
-        Gripper angle error (standard deviation or bound), degrees.
-    noise_kind : {"normal", "uniform"}
-    offset_mm : float
-        MuJoCo: the part's centre off the gripper centre along the squeeze axis (mm).
-    layer : str, optional
-        DXF: read only this layer.
-    flatten_tol : float, optional
-        Chordal tolerance of curve flattening, in each file's units.
-    shape_tol : float
-        Manufacturing tolerance of every part, in its units (``--shape-tol``): minima of the
-        width it could lose are not states (0: none; left out of :meth:`to_json` then, so
-        the keys of sweeps run before it existed still resume).
-    sense : str, optional
-        Also plan each part's Bayes sensing policy with this jaw-width sensor (``width`` or
-        ``width:SIGMA,RES`` in each part's units, as ``plan --sense``); its cost, success
-        and actions fill the ``policy_*`` columns. ``None`` (default): no policy, and left
-        out of :meth:`to_json` like ``sense_max_actions``.
-    sense_max_actions : int
-        The policy's depth (``plan --sense ... --max-actions``).
-    turn_noise : str, optional
-        Error of every gripper turn, ``normal:SIGMA_DEG`` or ``uniform:A_DEG``
-        (``plan --turn-noise``).
-    contact_noise : float, optional
-        Probability in [0, 1] that a squeeze's jaws touch one after the other
-        (``plan --contact-noise``).
-    payoff : str, optional
-        A payoff file (``plan --payoff``), read once by the client.
-
-        With any of these three, each part's plan is the noise-aware Bayes plan
-        (:func:`~bayesgrasp.planning.noisy.plan_noisy`), its row ``plan_json`` the document
-        ``plan PATH --turn-noise ... --json`` prints. That planner seeds from the exact
-        planner, so ``method`` must be ``"exact"``. ``guaranteed`` asks for the plan that
-        succeeds under every turn error within the bound
-        (:func:`~bayesgrasp.planning.robust.plan_guaranteed_noisy`), refused under a normal
-        turn error, which has no bound; turn it off for those. ``sense`` plans the policy
-        under the noisy actions (:func:`~bayesgrasp.planning.noisy_policy.plan_noisy_policy`,
-        ``plan PATH --sense S --turn-noise ... --json``); ``simulate`` executes the
-        noise-aware Bayes plan under the noise and predicts it exactly (``simulate PATH
-        --turn-noise ... --json``; ``noise_deg`` stays 0, and MuJoCo takes no
-        ``contact_noise``: its contacts are the physics' own). Left out of :meth:`to_json`
-        when not given, so the keys of sweeps run before them still resume.
-
-    Examples
-    --------
-    >>> o = SweepOptions(actions=("squeeze", "push-grasp"), accuracy_deg=1.0)
-    >>> o.plan_args()
-    ['--json', '--actions', 'squeeze,push-grasp', '--accuracy', '1.0', '--guaranteed']
-    >>> len(o.key)
-    16
-    """
-
-    prior: str = "uniform"
-    squeeze_cost: float = 1.0
-    push_grasp_cost: float = 1.0
-    verify_cost: float = 1.0
-    first_squeeze_cost: float | None = None
-    first_push_grasp_cost: float | None = None
-    retry_cost: float = 0.0
-    goal: str = "single"
-    actions: tuple[str, ...] = ("squeeze",)
-    accuracy_deg: float = 0.0
-    method: str = "exact"
-    max_actions: int | None = None
-    guaranteed: bool = True
-    simulate: str | None = None
-    trials: int | None = None
-    seed: int = 0
-    noise_deg: float = 0.0
-    noise_kind: str = "normal"
-    offset_mm: float = 0.0
-    layer: str | None = None
-    flatten_tol: float | None = None
-    shape_tol: float = 0.0
-    sense: str | None = None
-    sense_max_actions: int = 3
-    turn_noise: str | None = None
-    contact_noise: float | None = None
-    payoff: str | None = None
-
-    def __post_init__(self) -> None:
-        for name in ("squeeze_cost", "push_grasp_cost", "verify_cost", "retry_cost"):
-            _number(name, getattr(self, name))
-        _number("first_squeeze_cost", self.first_squeeze_cost, optional=True)
-        _number("first_push_grasp_cost", self.first_push_grasp_cost, optional=True)
-        _number("accuracy_deg", self.accuracy_deg)
-        _number("noise_deg", self.noise_deg)
-        _number("offset_mm", self.offset_mm)
-        _number("flatten_tol", self.flatten_tol, optional=True)
-        _number("shape_tol", self.shape_tol)
-        if self.goal not in GOALS:
-            raise SweepError(f"`goal` must be one of {', '.join(GOALS)}; got {self.goal!r}")
-        if self.method not in METHODS:
-            raise SweepError(f"`method` must be one of {', '.join(METHODS)}; got {self.method!r}")
-        if isinstance(self.actions, str) or not self.actions:
-            raise SweepError(
-                f"`actions` must be a non-empty tuple of action names; got {self.actions!r}"
-            )
-        from ..model.actions import parse_actions
-
-        parse_actions(self.actions)  # unknown names: PlanningError naming the known ones
-        if self.simulate is not None and self.simulate not in ENGINES:
-            raise SweepError(
-                f"`simulate` must be None or one of {', '.join(ENGINES)}; got {self.simulate!r}"
-            )
-        if self.noise_kind not in ("normal", "uniform"):
-            raise SweepError(f"`noise_kind` must be 'normal' or 'uniform'; got {self.noise_kind!r}")
-        for name in ("max_actions", "trials"):
-            v = getattr(self, name)
-            if v is not None and (not isinstance(v, int) or isinstance(v, bool) or v < 1):
-                raise SweepError(f"`{name}` must be None or an integer >= 1; got {v!r}")
-        if self.offset_mm > 0 and self.simulate != "mujoco":
-            raise SweepError("`offset_mm` applies to simulate='mujoco' only")
-        v = self.sense_max_actions
-        if not isinstance(v, int) or isinstance(v, bool) or not 1 <= v <= 8:
-            raise SweepError(f"`sense_max_actions` must be an integer in [1, 8]; got {v!r}")
-        if self.sense is not None:
-            from ..model.sensing import parse_sensor
-
-            parse_sensor(self.sense)  # a malformed sensor: SensorError saying why
-        self._check_noise()
-
-    def _check_noise(self) -> None:
-        """Refuse a malformed noise, and the options the noise-aware planner does not take."""
-        if self.turn_noise is not None:
-            from ..model.noise import parse_turn_noise
-
-            parse_turn_noise(self.turn_noise)  # PlanningError naming the two forms
-        q = self.contact_noise
-        if q is not None and (
-            isinstance(q, bool) or not isinstance(q, int | float) or not 0 <= q <= 1
-        ):
-            raise SweepError(f"`contact_noise` must be a probability in [0, 1]; got {q!r}")
-        if self.payoff is not None and not isinstance(self.payoff, str):
-            raise SweepError(f"`payoff` must be the path of a payoff file; got {self.payoff!r}")
-        if not self.noisy:
-            return
-        if self.method != "exact":
-            raise SweepError(
-                "the noise-aware planner (turn_noise, contact_noise, payoff) seeds from the "
-                "exact planner; drop method='bfs'"
-            )
-        if self.guaranteed and self.turn_noise is not None:
-            from ..model.noise import parse_turn_noise
-            from ..planning.robust import UNBOUNDED_GUARANTEE
-
-            turn = parse_turn_noise(self.turn_noise)
-            if not turn.exact and turn.kind == "normal":
-                raise SweepError(f"`guaranteed`: {UNBOUNDED_GUARANTEE}")
-        if self.noise_deg or self.noise_kind != "normal":
-            raise SweepError(
-                "`noise_deg` and `noise_kind` are the turn error of a simulation of the exact "
-                "plan; the noise-aware plan is simulated under its own turn_noise"
-            )
-        if self.simulate == "mujoco" and self.contact_noise is not None:
-            raise SweepError(
-                "`contact_noise` applies to simulate='kinematic' only: in MuJoCo the jaws' "
-                "contacts are the physics' own"
-            )
-
-    @property
-    def noisy(self) -> bool:
-        """Whether the parts are planned under noise or a payoff (the noise-aware planner)."""
-        return not (self.turn_noise is None and self.contact_noise is None and self.payoff is None)
-
-    @property
-    def n_trials(self) -> int:
-        """Trials of the simulation (0 without one)."""
-        if self.simulate is None:
-            return 0
-        return self.trials or DEFAULT_TRIALS[self.simulate]
-
-    def to_json(self) -> dict[str, Any]:
-        """The options as a JSON object (recorded in the results' metadata)."""
-        out = asdict(self)
-        out["actions"] = list(self.actions)
-        if not self.shape_tol:
-            del out["shape_tol"]
-        if self.sense is None:
-            del out["sense"], out["sense_max_actions"]
-        for name in ("turn_noise", "contact_noise", "payoff"):
-            if out[name] is None:
-                del out[name]
-        return out
-
-    @classmethod
-    def from_json(cls, doc: dict[str, Any]) -> SweepOptions:
-        """Options from :meth:`to_json`."""
-        known = {k: v for k, v in doc.items() if k in cls.__dataclass_fields__}
-        if "actions" in known:
-            known["actions"] = tuple(known["actions"])
-        return cls(**known)
-
-    @property
-    def key(self) -> str:
-        """16 hex digits identifying the options (rows of other options are not resumed)."""
-        text = json.dumps(self.to_json(), sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-    def plan_args(self) -> list[str]:
-        """The ``bayesgrasp plan PART`` arguments that give the same plan document."""
-        args = ["--json"]
-        if self.prior != "uniform":
-            args += ["--prior", self.prior]
-        defaults = SweepOptions()
-        flags = (
-            ("squeeze_cost", "--squeeze-cost"),
-            ("verify_cost", "--verify-cost"),
-            ("first_squeeze_cost", "--first-squeeze-cost"),
-            ("first_push_grasp_cost", "--first-push-grasp-cost"),
-            ("retry_cost", "--retry-cost"),
-            ("push_grasp_cost", "--push-grasp-cost"),
-            ("goal", "--goal"),
-            ("method", "--method"),
-            ("max_actions", "--max-actions"),
-            ("layer", "--layer"),
-            ("flatten_tol", "--flatten-tol"),
-            ("shape_tol", "--shape-tol"),
-        )
-        for name, flag in flags:
-            v = getattr(self, name)
-            if v != getattr(defaults, name):
-                args += [flag, str(v)]
-        if self.actions != defaults.actions:
-            args += ["--actions", ",".join(self.actions)]
-        if self.accuracy_deg:
-            args += ["--accuracy", str(self.accuracy_deg)]
-        if self.guaranteed:
-            args.append("--guaranteed")
-        for name, flag in (
-            ("turn_noise", "--turn-noise"),
-            ("contact_noise", "--contact-noise"),
-            ("payoff", "--payoff"),
-        ):
-            v = getattr(self, name)
-            if v is not None:
-                args += [flag, str(v)]
-        return args
-
-
-@dataclass(frozen=True, slots=True)
-class PartSource:
-    """One part file as the client sends it: its path, and its bytes or not.
-
-    Attributes
-    ----------
-    path : str
-        The path as the sweep found it (relative paths are relative to the client's working
-        directory); the row's ``path`` and the name in error messages.
-    sha256 : str
-        Hex digest of the bytes the client hashed (``""`` when it could not read them).
-    data : bytes, optional
-        The file's bytes (for workers that do not share the client's file system); without
-        them the worker reads ``path``.
-    """
-
-    path: str
-    sha256: str = ""
-    data: bytes | None = field(default=None, repr=False)
-
-    @property
-    def size(self) -> int:
-        """Bytes sent (0 for a path)."""
-        return 0 if self.data is None else len(self.data)
-
-
-def part_id(path: str, sha256: str) -> str:
-    """The stable id of a part: its path and the first 16 hex digits of its hash.
-
-    Examples
-    --------
-    >>> part_id("parts/a.json", "0123456789abcdef0123")
-    'parts/a.json#0123456789abcdef'
-    """
-    return f"{path}#{sha256[:16]}"
-
-
-#: The columns of a row, in order, with their types (``str``, ``int``, ``float``, ``bool``);
-#: every column may be missing (``None``), as for a part that failed.
-ROW_COLUMNS: tuple[tuple[str, type], ...] = (
-    ("part_id", str),
-    ("path", str),
-    ("sha256", str),
-    ("options_key", str),
-    ("status", str),  # ok | no-plan (no guaranteed plan: `plan` exits 1) | error
-    ("error_class", str),
-    ("error_message", str),
-    ("name", str),
-    ("units", str),
-    ("sides", int),
-    ("symmetry_order", int),
-    ("states", int),
-    ("period_rad", float),
-    ("method", str),
-    ("plans", int),
-    ("bayes_actions", int),
-    ("bayes_cost", float),
-    ("bayes_probability", float),
-    ("bayes_tolerance_rad", float),
-    ("bayes_first_rad", float),
-    ("bayes_final_rad", float),
-    ("bayes_steps", str),  # JSON: [{"type": ..., "alpha_rad": ...}, ...]
-    ("most_certain_actions", int),
-    ("most_certain_probability", float),
-    ("guaranteed_actions", int),
-    ("guaranteed_missing", str),
-    ("sim_engine", str),
-    ("sim_trials", int),
-    ("sim_predicted", float),
-    ("sim_observed", float),
-    ("sim_ci_low", float),
-    ("sim_ci_high", float),
-    ("sim_p_value", float),
-    ("sim_jams", int),
-    ("sim_seconds", float),
-    ("plan_seconds", float),
-    ("policy_cost", float),  # with `sense`: the Bayes policy's expected cost
-    ("policy_success", float),
-    ("policy_actions", float),  # expected actions a cycle
-    ("policy_json", str),  # the document `bayesgrasp plan PATH --sense ... --json` prints
-    ("outline", str),  # JSON: the outline's points (for the report's drawings)
-    ("plan_json", str),  # the document `bayesgrasp plan PATH --json` prints
-    ("sim_json", str),  # the document `bayesgrasp simulate PATH --json` prints
-    ("worker", str),
-    # last, so that results files written before them still resume
-    ("turn_noise", str),  # `normal:SIGMA_DEG` / `uniform:A_DEG`, as given
-    ("contact_noise", float),
-    ("payoff", str),  # the payoff file
-    ("bayes_payoff", float),  # the Bayes plan's expected payoff (with noise or a payoff)
-)
-
-#: Most outline points a row keeps for drawing (evenly spaced beyond that).
-MAX_OUTLINE_POINTS = 2000
-
-
-def _empty_row(path: str, sha256: str, options: SweepOptions) -> dict[str, Any]:
-    row: dict[str, Any] = dict.fromkeys(name for name, _ in ROW_COLUMNS)
-    row.update(
-        part_id=part_id(path, sha256),
-        path=path,
-        sha256=sha256 or None,  # None: the bytes could not be read
-        options_key=options.key,
-        worker=f"{socket.gethostname()}:{os.getpid()}",
-        turn_noise=options.turn_noise,
-        contact_noise=options.contact_noise,
-        payoff=options.payoff,
-    )
-    return row
-
-
-def _error(row: dict[str, Any], exc: BaseException) -> dict[str, Any]:
-    """Fill the error columns: the class and the message the CLI prints, on one line."""
-    row["status"] = "error"
-    row["error_class"] = type(exc).__name__
-    text = " ".join(str(exc).split("\n")).strip() or repr(exc)
-    row["error_message"] = text
-    return row
 
 
 def _read_bytes_part(path: str, data: bytes, options: SweepOptions) -> Any:
@@ -510,9 +104,16 @@ def _outline(part: Any) -> str:
 
 
 def _plan(
-    part: Any, options: SweepOptions, prior: Prior, payoff: Payoff | None = None
+    part: Any,
+    options: SweepOptions,
+    prior: Prior,
+    payoff: Payoff | None = None,
+    element: str | None = None,
 ) -> tuple[Any, dict[str, Any], str]:
-    """Problem, plan report and plan document, as ``bayesgrasp plan --json`` makes them."""
+    """Problem, plan report and plan document, as ``bayesgrasp plan --json`` makes them.
+
+    ``element``: a mesh's pose, as ``--pose K`` records it.
+    """
     from ..io.plans import plan_document
     from ..model.cost import CostModel
     from ..model.goal import Goal
@@ -543,6 +144,8 @@ def _plan(
     )
     given: dict[str, Any] = {"max_actions": options.max_actions, "layer": options.layer}
     given["flatten_tolerance"] = options.flatten_tol  # what the CLI records
+    if element is not None:
+        given["element"] = element
     if options.noisy:
         return _plan_noisy(pb, options, payoff, given)
     if options.method == "bfs":
@@ -595,7 +198,7 @@ def _plan_noisy(
     return done[0], run.document(done, given), "no-plan" if isinstance(done[1], str) else "ok"
 
 
-def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
+def _simulate(rep: Any, options: SweepOptions, element: str | None = None) -> dict[str, Any]:
     """The ``bayesgrasp.simulate/1`` document of the Bayes plan's execution.
 
     Under noise or a payoff ``rep`` is the noise-aware result: its Bayes plan runs under the
@@ -645,6 +248,8 @@ def _simulate(rep: Any, options: SweepOptions) -> dict[str, Any]:
     if options.noisy:
         how |= {"contact_noise": options.contact_noise, "payoff": options.payoff}
     given = {"max_actions": options.max_actions, "layer": options.layer}
+    if element is not None:
+        given["element"] = element
     doc["provenance"] = provenance(pb, None, **how, **given, flatten_tolerance=options.flatten_tol)
     return doc
 
@@ -725,6 +330,8 @@ def plan_part(
 ) -> dict[str, Any]:
     """Read, plan and optionally simulate one part: one row, never an exception.
 
+    A mesh gives its most probable pose's row (:func:`plan_part_rows` gives them all).
+
     Parameters
     ----------
     source : PartSource or str
@@ -754,30 +361,136 @@ def plan_part(
     """
     if isinstance(source, str):
         source = PartSource(source)
-    row = _empty_row(source.path, source.sha256, options)
+    return plan_part_rows(source, options, prior, payoff)[0]
+
+
+def plan_part_rows(
+    source: PartSource | str,
+    options: SweepOptions,
+    prior: Prior | None = None,
+    payoff: Payoff | None = None,
+) -> list[dict[str, Any]]:
+    """The rows of one part file: one for a planar part, one per resting pose of a mesh.
+
+    A mesh's rows are its poses' footprints, most probable first, as ``plan MESH --pose K
+    --json`` plans them (the quasi-static poses of :func:`bayesgrasp.solid.parts.study_of`):
+    ``part_id`` ends in ``#pose-K``, ``pose`` is K and ``pose_probability`` its
+    probability. A mesh that cannot be read is one error row. ``simulate="mujoco"`` is
+    refused for a mesh's rows (an error in each): the physics would squeeze the footprint
+    extruded to a prism, not the solid, which may topple or rest otherwise.
+
+    Examples
+    --------
+    >>> import tempfile, trimesh
+    >>> f = Path(tempfile.mkdtemp()) / "brick.stl"
+    >>> _ = trimesh.creation.box(extents=(1, 2, 4)).export(f)
+    >>> rows = plan_part_rows(str(f), SweepOptions())
+    >>> [(r["part_id"][-7:], r["pose"], round(r["pose_probability"], 4)) for r in rows][:3]
+    [('#pose-0', 0, 0.3344), ('#pose-1', 1, 0.3344), ('#pose-2', 2, 0.131)]
+    """
+    if isinstance(source, str):
+        source = PartSource(source)
     t0 = time.perf_counter()
     try:
-        part, digest = _read_part(source, options)
+        poses = _mesh_poses(source, options)
+    except Exception as exc:  # an unreadable mesh is one error row
+        row = empty_row(source.path, source.sha256, options)
+        row["plan_seconds"] = time.perf_counter() - t0
+        return [error_row(row, exc)]
+    if poses is None:
+        row = empty_row(source.path, source.sha256, options)
+        try:
+            part, digest = _read_part(source, options)
+        except Exception as exc:  # a bad part is a row; a bug in it too, with its class
+            row["plan_seconds"] = time.perf_counter() - t0
+            return [error_row(row, exc)]
         if digest:
             row.update(sha256=digest, part_id=part_id(source.path, digest))
+        return [_plan_row(row, part, options, prior, payoff, t0)]
+    parts, probs, digest = poses
+    rows = []
+    for k, (part, prob) in enumerate(zip(parts, probs, strict=True)):
+        t0 = time.perf_counter() if k else t0
+        row = empty_row(source.path, digest, options)
+        row.update(part_id=f"{part_id(source.path, digest)}#pose-{k}", pose=k)
+        row["pose_probability"] = prob
+        if options.simulate == "mujoco":
+            row["plan_seconds"] = time.perf_counter() - t0
+            rows.append(error_row(row, SweepError(MESH_MUJOCO)))
+            continue
+        rows.append(_plan_row(row, part, options, prior, payoff, t0, str(k)))
+    return rows
+
+
+#: Why a sweep does not simulate a mesh's poses in MuJoCo.
+MESH_MUJOCO = (
+    "simulate mujoco: a mesh's pose is planned as its footprint, and MuJoCo would squeeze "
+    "that footprint extruded to a prism, not the solid (which may topple); use kinematic"
+)
+
+
+def _mesh_poses(
+    source: PartSource, options: SweepOptions
+) -> tuple[list[Any], list[float], str] | None:
+    """A mesh's pose footprints, their probabilities and the file's hash; None: no mesh."""
+    from ..errors import PartFileError
+    from ..geometry.curved import with_shape_tol
+    from ..solid.mesh import is_mesh, read_mesh_bytes
+    from ..solid.parts import pose_part, study_of
+
+    if not is_mesh(source.path):
+        return None
+    data = source.data
+    if data is None:
+        try:
+            data = Path(source.path).read_bytes()
+        except OSError:
+            return None  # the part reader says why, in the CLI's words
+    if options.layer is not None:
+        raise PartFileError(f"{source.path}: a mesh has no layers (--layer is for DXF)")
+    if options.flatten_tol is not None:
+        raise PartFileError(f"{source.path}: a mesh has no curves to flatten (--flatten-tol)")
+    kind = Path(source.path).suffix.lstrip(".").lower()
+    solid = read_mesh_bytes(data, kind, source.path)
+    study = study_of(solid)
+    tol = options.shape_tol
+    named = [
+        pose_part(study, k, f"{solid.name}-pose-{k}", solid.units) for k in range(len(study.poses))
+    ]
+    parts = [with_shape_tol(p, tol) for p in named]
+    return parts, [float(p.probability) for p in study.poses], hashlib.sha256(data).hexdigest()
+
+
+def _plan_row(
+    row: dict[str, Any],
+    part: Any,
+    options: SweepOptions,
+    prior: Prior | None,
+    payoff: Payoff | None,
+    t0: float,
+    element: str | None = None,
+) -> dict[str, Any]:
+    """Plan (and sense, and simulate) one read part into ``row`` (``element``: its pose)."""
+    try:
         payoff = _read_payoff(options, payoff)
-        rep, doc, status = _plan(part, options, prior or parse_prior(options.prior), payoff)
+        parsed = prior or parse_prior(options.prior)
+        rep, doc, status = _plan(part, options, parsed, payoff, element)
         _fill(row, part, doc)
         row["status"] = status
     except Exception as exc:  # a bad part is a row; a bug in it too, with its class
         row["plan_seconds"] = time.perf_counter() - t0
-        return _error(row, exc)
+        return error_row(row, exc)
     if options.sense is not None:
         try:
             _policy(row, rep.problem, options, payoff)
         except Exception as exc:  # the plan columns stay; the message says which step failed
-            _error(row, exc)
+            error_row(row, exc)
             row["error_message"] = f"sensing policy: {row['error_message']}"
     row["plan_seconds"] = time.perf_counter() - t0
     if options.simulate is not None:
         t1 = time.perf_counter()
         try:
-            sim = _simulate(rep, options)
+            sim = _simulate(rep, options, element)
             row.update(
                 sim_engine=sim["engine"],
                 sim_trials=sim["trials"],
@@ -791,15 +504,15 @@ def plan_part(
                 sim_json=json.dumps(sim, allow_nan=False, separators=(",", ":")),
             )
         except Exception as exc:
-            _error(row, exc)
+            error_row(row, exc)
         row["sim_seconds"] = time.perf_counter() - t1
     return row
 
 
 def timeout_row(source: PartSource, options: SweepOptions, timeout: float) -> dict[str, Any]:
     """The error row of a part whose work took longer than ``timeout`` seconds."""
-    row = _empty_row(source.path, source.sha256, options)
-    return _error(
+    row = empty_row(source.path, source.sha256, options)
+    return error_row(
         row,
         TimeoutError(f"{source.path}: the part took longer than the timeout of {timeout:g} s"),
     )
@@ -826,12 +539,14 @@ class ChunkResult:
     worker: str = ""
 
 
-def _call_with_timeout(work: Callable[[], dict[str, Any]], timeout: float) -> dict[str, Any] | None:
+def _call_with_timeout(
+    work: Callable[[], list[dict[str, Any]]], timeout: float
+) -> list[dict[str, Any]] | None:
     """``work()`` in a thread, or ``None`` when it is not done in ``timeout`` seconds.
 
     Python threads cannot be killed; the engine restarts the worker whose thread is stuck.
     """
-    box: list[dict[str, Any]] = []
+    box: list[list[dict[str, Any]]] = []
     t = threading.Thread(target=lambda: box.append(work()), daemon=True)
     t.start()
     t.join(timeout)
@@ -862,13 +577,13 @@ def run_chunk(
     rows: list[dict[str, Any]] = []
     for i, src in enumerate(sources):
         if timeout is None:
-            rows.append(plan_part(src, options, prior, payoff))
+            rows.extend(plan_part_rows(src, options, prior, payoff))
             continue
-        row = _call_with_timeout(lambda s=src: plan_part(s, options, prior, payoff), timeout)  # type: ignore[misc]
-        if row is None:
+        got = _call_with_timeout(lambda s=src: plan_part_rows(s, options, prior, payoff), timeout)  # type: ignore[misc]
+        if got is None:
             rows.append(timeout_row(src, options, timeout))
             return ChunkResult(rows, tuple(sources[i + 1 :]), True, worker)
-        rows.append(row)
+        rows.extend(got)
     return ChunkResult(rows, (), False, worker)
 
 
@@ -876,4 +591,4 @@ def error_rows(
     sources: Sequence[PartSource], options: SweepOptions, exc: BaseException
 ) -> list[dict[str, Any]]:
     """Error rows for parts whose task failed as a whole (a worker died running it)."""
-    return [_error(_empty_row(s.path, s.sha256, options), exc) for s in sources]
+    return [error_row(empty_row(s.path, s.sha256, options), exc) for s in sources]
