@@ -1,4 +1,5 @@
-"""The package's layout: no private name is imported across modules (``benchmarks/layout.py``)."""
+"""The package's layout (``benchmarks/layout.py``): no private name imported across modules, no
+import circle, no import up the layers, no module over the size limit."""
 
 from __future__ import annotations
 
@@ -29,11 +30,14 @@ def test_no_private_name_imported_across_modules() -> None:
     assert found == [], "\n".join(f"{a}:{line} imports {name} of {b}" for a, b, line, name in found)
 
 
-def test_the_lower_layers_have_no_circle() -> None:
+def test_no_circle_and_no_import_up_the_layers() -> None:
     graph = layout.import_graph(ROOT / "src")
-    low = [c for c in layout.circles(graph) if any(layout.layer_of(m) <= 2 for m in c)]
-    assert low == []
-    assert [i for i in layout.upward(graph) if layout.layer_of(i.source) <= 2] == []
+    assert layout.circles(graph) == []
+    assert [f"{i.source}:{i.line} -> {i.target}" for i in layout.upward(graph)] == []
+
+
+def test_no_module_over_the_size_limit() -> None:
+    assert layout.sizes(ROOT / "src") == [], f"modules over {layout.LIMIT} lines"
 
 
 def test_the_checker_sees_private_names(tmp_path: Path) -> None:
