@@ -35,6 +35,11 @@ Fields (angles in radians, readings in the parts' units)::
                                        declaring leaf stops and earns the payoff of the state
                                        reached, P is the expected payoff of a cycle and C
                                        the expected cost per unit payoff
+      "stopped": why, "requested_actions": n, "lower_bound": L,
+                                       only when the search reached its time or memory
+                                       bound: the policy is then the best of max_actions
+                                       actions (the deepest search that finished), and no
+                                       policy of n actions costs less than L
       "root": NODE
     }
     NODE = {"action": {"type": "squeeze" | "push-grasp", "alpha_rad": a, "margin_rad": m},
@@ -150,6 +155,10 @@ def policy_document(policy: Policy) -> dict[str, Any]:
         doc["refinement_bound"] = policy.refinement_bound
     if policy.payoff is not None:
         doc["payoff"] = list(policy.payoff)
+    if policy.stopped:
+        doc["stopped"] = policy.stopped
+        doc["requested_actions"] = policy.requested_actions
+        doc["lower_bound"] = policy.lower_bound
     doc["root"] = _policy_node(policy.root)
     return doc
 
