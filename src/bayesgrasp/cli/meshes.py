@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
+from ..errors import PartError
+from ..solid.parts import study_of
 from .specs import PartSpec, ProblemSpec, SenseSpec
 
 if TYPE_CHECKING:
@@ -81,49 +83,12 @@ def mesh_options(
     return part
 
 
-def load_mesh_part(part: PartSpec) -> Part:
-    """PART's pose footprint (``element``: the pose), ``--com X,Y,Z`` and ``--shape-tol``."""
-    from ..geometry.curved import with_shape_tol
-    from ..solid.parts import pose_index, pose_part
-
-    solid = load_solid(part)
-    study = _study(solid)
-    k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
-    return with_shape_tol(
-        pose_part(study, k, f"{solid.name}-pose-{k}", solid.units), part.shape_tol
-    )
-
-
 def load_solid(part: PartSpec) -> Solid:
     """The solid of PART (a mesh file or ``-`` with --format), ``--com X,Y,Z`` applied."""
-    from ..solid.mesh import read_mesh, read_mesh_bytes
-    from ..solid.parts import parse_com
-
-    com = parse_com(part.com)
-    if part.layer is not None or part.flatten_tol is not None:
-        raise typer.BadParameter("a mesh has no layers or curves: drop --layer, --flatten-tol")
-    if part.part == "-":
-        import sys
-
-        from ..io import MAX_BYTES
-
-        data = sys.stdin.buffer.read(MAX_BYTES + 1)
-        fmt = part.fmt.value if part.fmt else ""
-        return read_mesh_bytes(data, fmt, "<stdin>", com=com)
-    return read_mesh(part.part, part.fmt.value if part.fmt else None, com=com)
-
-
-def _study(solid: Solid, estimator: str = "quasi-static") -> PoseStudy:
-    import numpy as np
-
-    from ..solid.poses import resting_poses
-
-    return resting_poses(
-        solid.hull if solid.hull is not None else solid.vertices[np.unique(solid.faces)],
-        solid.center_of_mass,
-        estimator=estimator,  # type: ignore[arg-type]
-        rng=0,
-    )
+    try:
+        return part.load_solid()
+    except PartError as exc:
+        raise typer.BadParameter(str(exc)) from None
 
 
 @dataclass(frozen=True, slots=True)
@@ -174,7 +139,7 @@ def pose_prior_weights(text: str | None, solid: Solid, study: PoseStudy) -> list
         return [p.probability for p in study.poses]
     key = text.strip()
     if key.lower() == "perturbed":
-        other = _study(solid, "perturbed")
+        other = study_of(solid, "perturbed")
         # Faces stable only for some perturbed centres are no pose of the mesh: left out.
         return _match(other.normals, other.probabilities, study, "perturbed", strict=False)
     if key.lower().startswith("drops:"):
@@ -263,7 +228,7 @@ def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
     from ..solid.parts import pose_index
     from ..solid.topple import toppling_report
 
-    study = _study(load_solid(part))
+    study = study_of(load_solid(part))
     k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
     found = toppling_report(study, jaw_height)[k]
     if found.fraction > 0:
@@ -320,7 +285,7 @@ def pose_sensing(
     from ..solid.parts import pose_parts
 
     solid = load_solid(part)
-    study = _study(solid)
+    study = study_of(solid)
     n = len(study.poses)
     goal = goal_pose_index(goal_pose, n) if goal_pose is not None else 0
     weights = pose_prior_weights(pose_prior, solid, study)

@@ -9,7 +9,7 @@ keeps the pose, so planning a pose is planning that part.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -87,12 +87,14 @@ def pose_index(text: str | int | None, n: int, source: str = "--pose") -> int:
     return k
 
 
-def study_of(solid: Solid) -> PoseStudy:
-    """The quasi-static poses of a solid."""
+def study_of(
+    solid: Solid, estimator: Literal["quasi-static", "perturbed"] = "quasi-static"
+) -> PoseStudy:
+    """The poses of a solid by ``estimator`` (the perturbed one's samples seeded: reproducible)."""
     from .poses import resting_poses
 
     points = solid.hull if solid.hull is not None else solid.vertices[np.unique(solid.faces)]
-    return resting_poses(points, solid.center_of_mass)
+    return resting_poses(points, solid.center_of_mass, estimator=estimator, rng=0)
 
 
 def mesh_part(
