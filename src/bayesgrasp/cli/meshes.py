@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING, Any
 
 import typer
 
-from ..errors import PartError
 from ..solid.parts import study_of
 from .specs import PartSpec, ProblemSpec, SenseSpec
 
@@ -81,14 +80,6 @@ def mesh_options(
             "--part-prior and other PARTs (--pose-prior sets the poses' prior)"
         )
     return part
-
-
-def load_solid(part: PartSpec) -> Solid:
-    """The solid of PART (a mesh file or ``-`` with --format), ``--com X,Y,Z`` applied."""
-    try:
-        return part.load_solid()
-    except PartError as exc:
-        raise typer.BadParameter(str(exc)) from None
 
 
 @dataclass(frozen=True, slots=True)
@@ -228,7 +219,7 @@ def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
     from ..solid.parts import pose_index
     from ..solid.topple import toppling_report
 
-    study = study_of(load_solid(part))
+    study = study_of(part.load_solid())
     k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
     found = toppling_report(study, jaw_height)[k]
     if found.fraction > 0:
@@ -284,7 +275,7 @@ def pose_sensing(
     """The --sense options of ``plan MESH``: the poses as candidates, the goal pose's problems."""
     from ..solid.parts import pose_parts
 
-    solid = load_solid(part)
+    solid = part.load_solid()
     study = study_of(solid)
     n = len(study.poses)
     goal = goal_pose_index(goal_pose, n) if goal_pose is not None else 0
