@@ -306,14 +306,17 @@ def mesh_sensing(
     candidates: bool,
     goal_pose: str | None = None,
     pose_prior: str | None = None,
+    jaw_height: float | None = None,
 ) -> tuple[SenseSpec, ProblemSpec]:
     """``simulate`` and ``plot`` with --sense: a mesh PART's policy is over its poses.
 
-    As ``plan MESH --sense --goal-pose K --pose-prior P`` (default goal pose 0, the
-    quasi-static pose prior); any other PART is returned as it came (and the pose options
-    refused).
+    As ``plan MESH --sense --goal-pose K --pose-prior P --jaw-height H`` (default goal pose
+    0, the quasi-static pose prior, no toppling check); any other PART is returned as it
+    came (and the pose options refused).
     """
     mesh_options(part, sensing.sense, None, goal_pose, pose_prior, candidates, None)
     if not is_mesh_part(part):
+        if jaw_height is not None:
+            check_pose_toppling(part, jaw_height)  # refuses: not a mesh
         return sensing, spec
-    return pose_sensing(part, sensing, spec, goal_pose, pose_prior)
+    return pose_sensing(part, sensing, spec, goal_pose, pose_prior, jaw_height)

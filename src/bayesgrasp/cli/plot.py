@@ -19,6 +19,7 @@ from .options import (
     AlsoOpt,
     ContactNoiseOpt,
     GoalPoseOpt,
+    JawHeightOpt,
     JsonOpt,
     MaxMemoryOpt,
     PartPriorOpt,
@@ -92,6 +93,7 @@ def plot(
     time_limit: TimeLimitOpt = None,
     goal_pose: GoalPoseOpt = None,
     pose_prior: PosePriorOpt = None,
+    jaw_height: JawHeightOpt = None,
     turn_noise: TurnNoiseOpt = None,
     contact_noise: ContactNoiseOpt = None,
     payoff: PayoffOpt = None,
@@ -130,7 +132,7 @@ def plot(
         from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
 
         sensing, spec = mesh_sensing(
-            part, sensing, spec, bool(also or part_prior), goal_pose, pose_prior
+            part, sensing, spec, bool(also or part_prior), goal_pose, pose_prior, jaw_height
         )
         action = sense_noise(turn_noise, contact_noise, payoff)
         plot_policy_command(part, spec, sensing, out, formats, as_json, action)
@@ -141,6 +143,10 @@ def plot(
         raise typer.BadParameter(
             "--goal-pose and --pose-prior plan a policy over poses: add --sense"
         )
+    if jaw_height is not None:
+        from .meshes import check_pose_toppling
+
+        check_pose_toppling(part, jaw_height)
     if (max_memory, time_limit) != (None, None):
         raise typer.BadParameter(
             "--max-memory and --time-limit bound a policy search: they need --sense"

@@ -24,6 +24,7 @@ from .options import (
     AlsoOpt,
     ContactNoiseOpt,
     GoalPoseOpt,
+    JawHeightOpt,
     JsonOpt,
     MaxMemoryOpt,
     PartPriorOpt,
@@ -149,6 +150,7 @@ def simulate(
     time_limit: TimeLimitOpt = None,
     goal_pose: GoalPoseOpt = None,
     pose_prior: PosePriorOpt = None,
+    jaw_height: JawHeightOpt = None,
     sensor_error: SensorErrorOpt = False,
     jaw_lag: JawLagOpt = 0.0,
 ) -> None:
@@ -226,7 +228,7 @@ def simulate(
         from .meshes import mesh_sensing  # a mesh PART: the policy over its poses
 
         sensing, spec = mesh_sensing(
-            part, sensing, spec, bool(also or part_prior), goal_pose, pose_prior
+            part, sensing, spec, bool(also or part_prior), goal_pose, pose_prior, jaw_height
         )
         simulate_policy_command(
             part, spec, sensing, engine, trials, workers, offset, seed, units,
@@ -239,6 +241,10 @@ def simulate(
         raise typer.BadParameter(
             "--goal-pose and --pose-prior plan a policy over poses: add --sense"
         )
+    if jaw_height is not None:
+        from .meshes import check_pose_toppling
+
+        check_pose_toppling(part, jaw_height)
     if (max_memory, time_limit) != (None, None):
         raise typer.BadParameter(
             "--max-memory and --time-limit bound a policy search: they need --sense"
