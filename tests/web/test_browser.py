@@ -6,27 +6,14 @@ import json
 import math
 import os
 import re
-import socket
-import subprocess
-import sys
 import tempfile
 import time
-import urllib.request
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-CHROMIUM = Path("/usr/bin/chromium")
-ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--no-first-run",
-]
 ROOT = Path(__file__).resolve().parents[2]
 # The documentation's screenshots are retaken with BAYESGRASP_SCREENSHOTS=1; otherwise the
 # tests write them to a temporary folder (a test run leaves the repository as it was).
@@ -39,88 +26,8 @@ SCREENSHOT = _SHOTS / "web-plan.png"
 TRIANGLE_CLICKS = [(100, 300), (300, 300), (160, 120)]  # canvas pixels
 TRIANGLE = [[25.0, 25.0], [75.0, 25.0], [40.0, 70.0]]  # grid 20 px = 5 mm, y up
 
-pytestmark = [
-    pytest.mark.browser,
-    pytest.mark.skipif(
-        not CHROMIUM.exists(),
-        reason=f"{CHROMIUM} is missing (apt-get install chromium); browser tests skipped",
-    ),
-]
+pytestmark = pytest.mark.browser  # the `browser` fixture skips where Chromium is missing
 CliJson = Callable[..., tuple[int, Any]]
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
-def _serve_command(port: int, data: Path) -> list[str]:
-    from bayesgrasp.cli import COMMANDS
-
-    args = ["--host", "127.0.0.1", "--port", str(port), "--data", str(data)]
-    if "serve" in COMMANDS:
-        return [sys.executable, "-m", "bayesgrasp.cli", "serve", *args]
-    # until the command is listed: run the command module itself
-    code = "import sys; from bayesgrasp.cli.serve import app; app(sys.argv[1:])"
-    return [sys.executable, "-c", code, *args]
-
-
-@pytest.fixture(scope="module")
-def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """The URL of a ``bayesgrasp serve`` started for these tests (stopped afterwards)."""
-    port = _free_port()
-    data = tmp_path_factory.mktemp("web-data")
-    log = data / "serve.log"
-    with log.open("wb") as out:
-        proc = subprocess.Popen(
-            _serve_command(port, data), stdout=out, stderr=subprocess.STDOUT, cwd=ROOT
-        )
-    url = f"http://127.0.0.1:{port}"
-    try:
-        deadline = time.monotonic() + 30
-        while True:
-            try:
-                with urllib.request.urlopen(f"{url}/api/v1/health", timeout=1) as r:
-                    if r.status == 200:
-                        break
-            except OSError:
-                if proc.poll() is not None or time.monotonic() > deadline:
-                    raise RuntimeError(f"serve did not start: {log.read_text()}") from None
-                time.sleep(0.1)
-        yield url
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    sync_api = pytest.importorskip("playwright.sync_api")
-    with sync_api.sync_playwright() as pw:
-        b = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS, headless=True)
-        try:
-            yield b
-        finally:
-            b.close()
-
-
-@pytest.fixture
-def page(browser: Any) -> Iterator[Any]:
-    context = browser.new_context(viewport={"width": 1280, "height": 1100})
-    context.set_default_timeout(60_000)  # a loaded CI machine; the waits end on conditions
-    pg = context.new_page()
-    errors: list[str] = []
-    pg.on("pageerror", lambda exc: errors.append(str(exc)))
-    try:
-        yield pg
-    finally:
-        context.close()
-    assert not errors, errors
 
 
 def table(page: Any) -> list[dict[str, str]]:
