@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import time
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -37,16 +39,120 @@ def test_a_kinematic_job_gives_the_simulate_document(client: Any) -> None:
     assert result["provenance"]["engine"] == "kinematic"
 
 
-def test_a_failed_job_says_why(make_client: Any) -> None:
-    client = make_client(max_mujoco_trials=10)
-    r = client.post("/api/v1/simulate/jobs", json={"part": {"catalogue": "key"}, "trials": 11})
+def test_a_request_the_server_cannot_run_is_refused_when_posted(make_client: Any) -> None:
+    client = make_client(max_mujoco_trials=10, max_trials=1000)
+    jobs = client.app.state.jobs.jobs
+    cases = [
+        ({"trials": 11}, "`trials` is 11; the limit is 10"),
+        ({"engine": "kinematic", "trials": 1001}, "`trials` is 1001; the limit is 1000"),
+        ({"engine": "kinematic"}, "`trials` is 100000; the limit is 1000"),  # the default
+        ({"contact_noise": 0.1, "trials": 5}, "`contact_noise`: applies to the kinematic"),
+        (
+            {"engine": "kinematic", "trials": 5, "offset_mm": 1},
+            "`offset_mm`: applies to the mujoco",
+        ),
+    ]
+    for extra, detail in cases:
+        r = client.post("/api/v1/simulate/jobs", json={"part": {"catalogue": "key"}, **extra})
+        assert r.status_code == 422, (extra, r.text)
+        assert r.json()["detail"].startswith(detail), r.json()
+    assert not jobs  # nothing was queued
+    lim = client.get("/api/v1/limits").json()
+    assert lim["max_mujoco_trials"] == 10 and lim["max_trials"] == 1000
+    assert lim["engines"][0] == "kinematic" and set(lim["engines"]) <= {"kinematic", "mujoco"}
+
+
+def test_a_failed_job_says_why(client: Any) -> None:
+    # a plan document for another part: refused by the worker that reads the part
+    other = client.post("/api/v1/plan", json={"part": {"catalogue": "triangle"}}).json()
+    body = {"part": {"catalogue": "key"}, "engine": "kinematic", "trials": 10, "plan": other}
+    r = client.post("/api/v1/simulate/jobs", json=body)
     doc = _wait(client, r.json()["url"])
     assert doc["status"] == "failed"
-    assert doc["error"] == {
-        "status": 422,
-        "error": "limit",
-        "detail": "`trials` is 11; the limit is 10",
-    }
+    assert doc["error"]["status"] == 422 and doc["error"]["error"] == "limit"
+    assert doc["error"]["detail"].startswith(
+        "`plan`: the plan document is for part 'triangle' (sha256:"
+    ), doc["error"]
+
+
+def test_a_plan_of_the_table_runs_as_the_cli_runs_it_from_a_file(
+    client: Any, cli_json: Any, tmp_path: Path
+) -> None:
+    """Any row of ``plan``'s answer, sent back, is the plan ``simulate --plan FILE`` runs."""
+    plan = client.post("/api/v1/plan", json={"part": {"catalogue": "house"}}).json()
+    row = next(i for i in range(len(plan["options"])) if i != plan["bayes"])
+    option = plan["options"][row]
+    f = tmp_path / "row.json"
+    f.write_text(json.dumps(option))
+    code, cli = cli_json("simulate", "house", "--plan", str(f), "--trials", "20000", "--seed", "3")
+    assert code == 0, cli
+    body = {"part": {"catalogue": "house"}, "engine": "kinematic", "trials": 20000, "seed": 3}
+    doc = _wait(
+        client, client.post("/api/v1/simulate/jobs", json={**body, "plan": option}).json()["url"]
+    )
+    assert doc["status"] == "done", doc
+    result = doc["result"]
+    assert result["plan"]["steps"] == option["steps"]
+    assert result["predicted_success"] == pytest.approx(option["success_probability"], abs=1e-12)
+    assert result["predicted_success"] != plan["options"][plan["bayes"]]["success_probability"]
+    for key in ("observed_success", "per_orientation", "predicted_success", "ci95"):
+        assert result[key] == cli[key], key
+    assert result["provenance"]["plan"] == "request"
+
+
+def test_a_whole_plan_document_keeps_its_prior_and_goal(
+    client: Any, cli_json: Any, tmp_path: Path
+) -> None:
+    made = {"part": {"catalogue": "house"}, "prior": "vonmises:30,4", "goal": "symmetry"}
+    plan = client.post("/api/v1/plan", json=made).json()
+    bayes = plan["options"][plan["bayes"]]
+    f = tmp_path / "plan.json"
+    f.write_text(json.dumps(plan))
+    code, cli = cli_json("simulate", "house", "--plan", str(f), "--trials", "5000", "--seed", "1")
+    assert code == 0, cli
+    body = {"part": {"catalogue": "house"}, "trials": 5000, "seed": 1, "plan": plan}
+    doc = client.post("/api/v1/simulate", json=body).json()  # the direct route takes it too
+    assert doc["predicted_success"] == pytest.approx(bayes["success_probability"], abs=1e-12)
+    assert (
+        doc["provenance"]["prior"]["kind"] == "von-mises"
+        and doc["provenance"]["goal"] == "symmetry"
+    )
+    assert doc["observed_success"] == cli["observed_success"]
+    # a prior given in the request wins over the document's
+    uniform = client.post("/api/v1/simulate", json={**body, "prior": "uniform"}).json()
+    assert uniform["provenance"]["prior"]["kind"] == "uniform"
+    assert uniform["predicted_success"] != pytest.approx(doc["predicted_success"], abs=1e-3)
+
+
+def test_a_plan_under_noise_is_predicted_under_it(
+    client: Any, cli_json: Any, tmp_path: Path
+) -> None:
+    noisy = {"part": {"catalogue": "house"}, "turn_noise": "normal:3"}
+    plan = client.post("/api/v1/plan", json=noisy).json()
+    option = plan["options"][plan["bayes"]]
+    f = tmp_path / "noisy.json"
+    f.write_text(json.dumps(option))
+    args = ("--turn-noise", "normal:3", "--trials", "20000", "--seed", "2")
+    code, cli = cli_json("simulate", "house", "--plan", str(f), *args)
+    assert code == 0, cli
+    body = {**noisy, "engine": "kinematic", "trials": 20000, "seed": 2, "plan": option}
+    doc = _wait(client, client.post("/api/v1/simulate/jobs", json=body).json()["url"])
+    result = doc["result"]
+    assert result["predicted_success"] == pytest.approx(option["success_probability"], abs=1e-9)
+    assert result["observed_success"] == cli["observed_success"]
+    assert result["agrees"] is True
+
+
+def test_a_malformed_plan_is_one_line(client: Any) -> None:
+    body = {"part": {"catalogue": "key"}, "trials": 10}
+    for plan, detail in [
+        ({"steps": []}, "`steps` must be a non-empty list"),
+        ({"steps": [{"type": "squeeze", "alpha_rad": 0}]}, "a plan needs a finite"),
+        ("best", "plan"),
+    ]:
+        r = client.post("/api/v1/simulate", json={**body, "plan": plan})
+        assert r.status_code == 422, r.text
+        assert detail in r.json()["detail"] and "\n" not in r.json()["detail"]
 
 
 def test_a_job_past_its_time_limit_is_stopped(make_client: Any) -> None:

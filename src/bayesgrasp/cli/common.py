@@ -282,10 +282,8 @@ def _plan_file(
     path: Path, spec: ProblemSpec, part: Part, force: bool
 ) -> tuple[Problem, PlanOption, str]:
     """The plan of a plan file, checked against the part, and the problem it was made for."""
-    import dataclasses
-
     from ..io.plans import part_id, read_plan, same_part
-    from ..runs.specs import GoalKind
+    from ..runs.specs import spec_for_plan
 
     src = read_plan(path)
     if same_part(src.part, part) is False and not force:
@@ -296,9 +294,5 @@ def _plan_file(
             "use --force to run it anyway",
             param_hint="--plan",
         )
-    if "goal" not in spec.given and src.goal in tuple(GoalKind):
-        spec = dataclasses.replace(spec, goal=GoalKind(src.goal))
-    prior = None if "prior" in spec.given else src.prior
-    plan = src.option
-    missing = tuple(k for k in plan.kinds if k not in spec.actions)
-    return spec.build(part, missing, prior), plan, path.name
+    spec, prior = spec_for_plan(src, spec)
+    return spec.build(part, (), prior), src.option, path.name

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..io.plan_reader import PlanSource
     from ..model.prior import Prior
     from ..model.problem import Problem
     from ..planning.guaranteed import GuaranteedPlan
@@ -39,6 +40,7 @@ __all__ = [
     "problem_spec",
     "run_inputs",
     "simulate_inputs",
+    "spec_for_plan",
 ]
 
 PLAN_NAMES = {"bayes": "Bayes", "most-certain": "most certain", "guaranteed": "guaranteed"}
@@ -311,6 +313,33 @@ class SenseSpec:
         if first.units is None:
             return [first, *more]
         return [first, *(convert(p, first.units) if p.units else p for p in more)]
+
+
+def spec_for_plan(src: PlanSource, spec: ProblemSpec) -> tuple[ProblemSpec, Prior | None]:
+    """The options a read plan runs under (``simulate --plan FILE.json``), and its prior.
+
+    The plan's document records the goal and the prior it was made for: they apply unless
+    the options gave their own (``spec.given``); the plan's action kinds are added to the
+    options' (a plan with push-grasps runs where they were not asked for). The prior is
+    ``None`` where the options' own applies.
+
+    Examples
+    --------
+    >>> from bayesgrasp.io.plan_reader import read_plan
+    >>> step = {"type": "push-grasp", "alpha_rad": 0.5}
+    >>> src = read_plan({"steps": [step], "final_orientation_rad": 0.0})
+    >>> spec, prior = spec_for_plan(src, ProblemSpec())
+    >>> spec.actions, spec.goal.value, prior
+    (('squeeze', 'push-grasp'), 'single', None)
+    """
+    import dataclasses
+
+    goal = spec.goal
+    if "goal" not in spec.given and src.goal in tuple(GoalKind):
+        goal = GoalKind(src.goal)
+    prior = None if "prior" in spec.given else src.prior
+    actions = tuple(dict.fromkeys((*spec.actions, *src.option.kinds)))
+    return dataclasses.replace(spec, goal=goal, actions=actions), prior
 
 
 def guaranteed_plan(problem: Problem) -> GuaranteedPlan | str:

@@ -9,6 +9,7 @@ from fastapi import APIRouter, Request
 from fastapi.responses import JSONResponse, Response
 
 from .common import API, TIMEOUT
+from .documents import check_simulation
 from .models import (
     ERRORS,
     ErrorBody,
@@ -93,6 +94,7 @@ async def simulate_job(req: SimulateJobRequest, request: Request) -> JSONRespons
     service = service_of(request)
     jobs = request.app.state.jobs
     lim = service.limits
+    total = check_simulation(lim, req)  # a request it cannot run is answered now, not failed
     lane = service.lane("heavy")
     if lane.full():
         raise LimitError(
@@ -102,7 +104,6 @@ async def simulate_job(req: SimulateJobRequest, request: Request) -> JSONRespons
             kind="queue-full",
             retry_after=max(1, math.ceil(min(lim.time_limit, 60))),
         )
-    total = req.trials or (200 if req.engine == "mujoco" else 100_000)
 
     async def run(job: Any) -> dict[str, Any]:
         return await lane.run(  # type: ignore[no-any-return]

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 from pydantic import ValidationError
 
 from .common import one_line
+from .limits import Limits, engines
 from .models import (
     ExportRequest,
     FigureRequest,
@@ -32,6 +33,7 @@ from .problems import (
     check_within_stroke,
     chosen_option,
     exact_method,
+    given_option,
     prior_string,
     problem_spec,
     stroke_of,
@@ -46,6 +48,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "catalogue_document",
+    "check_simulation",
     "export_file",
     "export_strategy",
     "figure_bytes",
@@ -236,22 +239,9 @@ def simulate_document(
 
     engine = getattr(req, "engine", "kinematic")
     offset_mm = float(getattr(req, "offset_mm", 0.0))
-    trials = req.trials if req.trials is not None else (200 if engine == "mujoco" else 100_000)
-    most = service.limits.max_mujoco_trials if engine == "mujoco" else service.limits.max_trials
-    if trials > most:
-        raise LimitError(422, f"`trials` is {trials}; the limit is {most}")
+    trials = check_simulation(service.limits, req)
     spec = problem_spec(req)
     p = service.part(req.part)
-    if req.turn_noise is not None and (req.noise > 0 or req.noise_kind != "normal"):
-        raise LimitError(
-            422, "`noise`, `noise_kind`: the older spelling of `turn_noise`; give one of them"
-        )
-    if engine == "mujoco" and req.contact_noise is not None:
-        raise LimitError(
-            422,
-            "`contact_noise`: applies to the kinematic engine only (in MuJoCo the jaws' "
-            "contacts are the physics' own)",
-        )
     noise = req.noise_model()
     deg, kind = req.noise, req.noise_kind
     if req.turn_noise is None:
@@ -259,11 +249,13 @@ def simulate_document(
     else:
         deg, kind = float(req.turn_noise.partition(":")[2]), noise.turn.kind
     pay = req.payoff_model()
-    if (not noise.exact or pay is not None) and req.plan != "guaranteed":
+    if not isinstance(req.plan, str):
+        pb, option = given_option(req.plan, req, p, spec)
+    elif (not noise.exact or pay is not None) and req.plan != "guaranteed":
         exact_method(req)
         from ..planning.noisy import plan_noisy
 
-        pb = spec.build(p)
+        pb = build_problem(p, req, spec)
         res_n = plan_noisy(pb, noise, pay, spec.max_actions)
         option = res_n.options[res_n.bayes if req.plan == "bayes" else res_n.most_certain].option
     else:
@@ -281,11 +273,48 @@ def simulate_document(
     from ..runs.specs import run_inputs, simulate_inputs
 
     doc = report.simulate_json(res, p)  # with the provenance the command line writes
-    how = simulate_inputs(engine, req.plan, req.seed, trials, deg, kind, offset_mm)
+    which = req.plan if isinstance(req.plan, str) else "request"
+    how = simulate_inputs(engine, which, req.seed, trials, deg, kind, offset_mm)
     how["contact_noise"] = req.contact_noise
     how["payoff"] = None if req.payoff is None else "request"
     doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec))
     return doc
+
+
+def check_simulation(limits: Limits, req: SimulateRequest) -> int:
+    """The trials a simulation request runs, or its refusal (422) before any work.
+
+    A job's request is checked when it is posted, so that a request the server cannot run
+    is answered at once rather than as a failed job.
+    """
+    engine = getattr(req, "engine", "kinematic")
+    trials = req.trials if req.trials is not None else (200 if engine == "mujoco" else 100_000)
+    most = limits.max_mujoco_trials if engine == "mujoco" else limits.max_trials
+    if trials > most:
+        raise LimitError(422, f"`trials` is {trials}; the limit is {most}")
+    if req.turn_noise is not None and (req.noise > 0 or req.noise_kind != "normal"):
+        raise LimitError(
+            422, "`noise`, `noise_kind`: the older spelling of `turn_noise`; give one of them"
+        )
+    if engine == "kinematic" and getattr(req, "offset_mm", 0.0) > 0:
+        raise LimitError(
+            422,
+            "`offset_mm`: applies to the mujoco engine only (the kinematic model has no positions)",
+        )
+    if engine == "mujoco":
+        if req.contact_noise is not None:
+            raise LimitError(
+                422,
+                "`contact_noise`: applies to the kinematic engine only (in MuJoCo the jaws' "
+                "contacts are the physics' own)",
+            )
+        if "mujoco" not in engines():
+            raise LimitError(
+                422,
+                "`engine`: mujoco is not installed on this server (the `sim` extra); "
+                "use `kinematic`",
+            )
+    return trials
 
 
 def mujoco_result(

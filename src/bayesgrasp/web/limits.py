@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["Limits", "limits_document"]
+__all__ = ["Limits", "engines", "limits_document"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,6 +84,13 @@ class Limits:
             )
 
 
+def engines() -> list[str]:
+    """The simulation engines this server runs: kinematic, and MuJoCo where it is installed."""
+    import importlib.util
+
+    return ["kinematic"] + (["mujoco"] if importlib.util.find_spec("mujoco") else [])
+
+
 def limits_document(lim: Limits) -> dict[str, Any]:
     """The limits a request must keep to, as ``GET /api/v1/limits`` answers them.
 
@@ -105,4 +112,5 @@ def limits_document(lim: Limits) -> dict[str, Any]:
         "job_time_limit_s": lim.job_time_limit,
         "max_jobs": lim.max_jobs,
         "max_mujoco_trials": lim.max_mujoco_trials,
+        "engines": engines(),
     }

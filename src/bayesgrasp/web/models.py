@@ -294,7 +294,13 @@ class SimulateRequest(NoiseOptions):
     gives under them, as ``bayesgrasp simulate`` runs it.
     """
 
-    plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
+    plan: Literal["bayes", "most-certain", "guaranteed"] | dict[str, Any] = Field(
+        "bayes",
+        description="The plan to run: `bayes`, `most-certain`, `guaranteed`, or a plan itself "
+        "(--plan FILE.json): one of `plan`'s `options` (or its `guaranteed`), or a whole plan "
+        "document, whose part must be this one and whose goal and prior apply unless given "
+        "here.",
+    )
     trials: int = Field(100_000, ge=1, description="Executions (bounded by the server's limit).")
     noise: float = Field(
         0.0,

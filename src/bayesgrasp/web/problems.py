@@ -2,13 +2,15 @@
 
 :func:`problem_spec` makes the :class:`~bayesgrasp.runs.specs.ProblemSpec` of ``plan``'s
 options, :func:`build_problem` the problem (with an inline histogram or sample prior),
-:func:`chosen_option` the plan ``--plan`` names, :func:`stroke_of` the gripper's stroke.
+:func:`chosen_option` the plan ``--plan`` names, :func:`given_option` the plan of a
+plan document, :func:`stroke_of` the gripper's stroke.
 Options the command line would refuse are refused here with its reasons (422).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ..errors import NoPlanError
@@ -26,6 +28,7 @@ __all__ = [
     "check_within_stroke",
     "chosen_option",
     "exact_method",
+    "given_option",
     "prior_string",
     "problem_spec",
     "stroke_of",
@@ -51,6 +54,9 @@ def problem_spec(opts: ProblemOptions) -> Any:
 
     for name in (*opts.costs, *opts.first_costs):
         get_action(name)  # an unknown action: PlanningError naming the known ones
+    given = {k for k in ("prior", "goal") if k in opts.model_fields_set}
+    if opts.prior_histogram is not None or opts.prior_sample is not None:
+        given.add("prior")
     if isinstance(opts.actions, str):
         actions = [a.strip() for a in opts.actions.split(",") if a.strip()]
     else:
@@ -66,6 +72,7 @@ def problem_spec(opts: ProblemOptions) -> Any:
         accuracy_deg=opts.accuracy,
         method=Method(opts.method),
         max_actions=opts.max_actions,
+        given=frozenset(given),
     )
 
 
@@ -116,6 +123,31 @@ def chosen_option(
     result = spec.plan(problem)
     plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
     return problem, plan, PLAN_NAMES[which]
+
+
+def given_option(
+    doc: Mapping[str, Any], opts: ProblemOptions, part: Part, spec: Any
+) -> tuple[Problem, PlanOption]:
+    """The problem and the plan of a plan document or option object (``--plan FILE.json``).
+
+    A document made for another part is refused (the command line's ``--force`` has no
+    counterpart here); the document's goal and prior apply unless the request gave its own
+    (:func:`~bayesgrasp.runs.specs.spec_for_plan`).
+    """
+    from ..io.plans import part_id, read_plan, same_part
+    from ..runs.specs import spec_for_plan
+
+    src = read_plan(doc)
+    if same_part(src.part, part) is False:
+        theirs = src.part or {}
+        raise LimitError(
+            422,
+            f"`plan`: the plan document is for part {theirs.get('name', '?')!r} "
+            f"({theirs.get('id', 'other vertices')}), not {part.name!r} ({part_id(part)})",
+        )
+    spec, prior = spec_for_plan(src, spec)
+    problem = build_problem(part, opts, spec) if prior is None else spec.build(part, (), prior)
+    return problem, src.option
 
 
 def stroke_of(req: StrokeOptions) -> Stroke | None:
