@@ -230,6 +230,35 @@ def test_upload_with_options(client: TestClient, cli_json: CliJson, tmp_path: Pa
     assert up.json() == doc
 
 
+@pytest.mark.parametrize("fmt", ["csv", "json"])
+def test_an_uploaded_part_exports_the_cli_robot_file(
+    client: TestClient, cli_json: CliJson, tmp_path: Path, fmt: str
+) -> None:
+    """``export/upload`` answers the file ``plan PART.svg --export FILE`` writes, byte for byte."""
+    from bayesgrasp.cli import main
+
+    data = FILES["svg"]
+    (tmp_path / "tri.svg").write_bytes(data)
+    target = tmp_path / f"robot.{fmt}"
+    args = [str(tmp_path / "tri.svg"), "--prior", "vonmises:10,2", "--export", str(target)]
+    assert main(["plan", *args]) == 0
+    up = client.post(
+        "/api/v1/export/upload",
+        files={"file": ("tri.svg", data)},
+        data={"format": "svg", "options": json.dumps({"format": fmt, "prior": "vonmises:10,2"})},
+    )
+    assert up.status_code == 200, up.text
+    assert up.content == target.read_bytes()
+    assert up.headers["content-disposition"] == f'attachment; filename="tri-plan.{fmt}"'
+    # the robot file's format is required, as on /export
+    bad = client.post(
+        "/api/v1/export/upload",
+        files={"file": ("tri.svg", data)},
+        data={"format": "svg", "options": "{}"},
+    )
+    assert bad.status_code == 422 and "format" in bad.json()["detail"]
+
+
 def test_catalogue_endpoint(client: TestClient) -> None:
     doc = client.get("/api/v1/catalogue").json()
     assert [p["name"] for p in doc["parts"]] == list(CATALOGUE)

@@ -13,9 +13,17 @@ from fastapi import APIRouter, File, Form, Request, UploadFile
 from fastapi.responses import JSONResponse, Response
 from pydantic import BaseModel, ValidationError
 
+from .api_plans import robot_file
 from .common import TIMEOUT, error_response, one_line
 from .documents import catalogue_document
-from .models import ERRORS, PartRequest, PlanRequest, PolicyRequest, SimulateRequest
+from .models import (
+    ERRORS,
+    ExportRequest,
+    PartRequest,
+    PlanRequest,
+    PolicyRequest,
+    SimulateRequest,
+)
 from .service import service_of
 from .workers import LimitError
 
@@ -55,19 +63,34 @@ UPLOAD_MODELS: dict[str, type[BaseModel]] = {
     "plan": PlanRequest,
     "policy": PolicyRequest,
     "simulate": SimulateRequest,
+    "export": ExportRequest,
 }
 
 
-@router.post("/{command}/upload", responses=ERRORS)
+UPLOAD_ANSWER: dict[int | str, dict[str, Any]] = {
+    200: {
+        "content": {"application/json": {}, "text/csv": {}},
+        "description": "The command's JSON document; with `export`, the robot file as an "
+        "attachment (CSV or JSON).",
+    },
+    **ERRORS,
+}
+
+
+@router.post("/{command}/upload", responses=UPLOAD_ANSWER)
 async def upload(
-    command: Literal["squeeze", "push", "plan", "policy", "simulate"],
+    command: Literal["squeeze", "push", "plan", "policy", "simulate", "export"],
     request: Request,
     file: UploadFile = File(description="A part file (read in memory)."),  # noqa: B008
     format: str = Form(description="json, csv, wkt, geojson, svg or dxf."),
     options: str = Form("{}", description="The other members of the command's body, JSON."),
     timeout: float | None = TIMEOUT,
 ) -> Response:
-    """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``."""
+    """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``.
+
+    ``export`` answers the robot file (``options`` holds its ``format``, csv or json), the
+    others the JSON document of the command.
+    """
     service = service_of(request)
     data = await file.read(service.limits.max_body_bytes + 1)
     try:
@@ -86,4 +109,6 @@ async def upload(
         req: Any = UPLOAD_MODELS[command].model_validate({**extra, "part": part})
     except ValidationError as exc:
         return error_response(422, one_line(exc), "invalid-request")
+    if command == "export":
+        return await robot_file(service, req, timeout)
     return await service.answer(command, req, timeout)

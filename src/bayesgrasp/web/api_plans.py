@@ -23,7 +23,7 @@ from .models import (
 from .service import run_work, service_of
 from .workers import LimitError
 
-__all__ = ["router"]
+__all__ = ["robot_file", "router"]
 
 router = APIRouter(prefix=API, tags=["plans"])
 
@@ -67,7 +67,12 @@ async def export(req: ExportRequest, request: Request, timeout: float | None = T
     noise model); with ``sense``: the policy's state machine. Exact plans' files are made in
     the quick lane, policies' and noise-aware plans' in the heavy lane.
     """
-    name, data = await service_of(request).run("export", req, timeout=timeout)
+    return await robot_file(service_of(request), req, timeout)
+
+
+async def robot_file(service: Any, req: ExportRequest, timeout: float | None) -> Response:
+    """The answer of ``export``: the robot file as an attachment with its name."""
+    name, data = await service.run("export", req, timeout=timeout)
     media = "text/csv" if req.format == "csv" else "application/json"
     return Response(
         data,

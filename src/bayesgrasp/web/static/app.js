@@ -207,6 +207,18 @@ function partBody() {
   return { vertices: state.vertices, name: state.name };
 }
 
+// the animation's and the simulation's settings: in the address too, but they plan nothing
+const VIEW_SETTINGS = [
+  ["anim-plan", "anim_plan"],
+  ["anim-starts", "anim_starts"],
+  ["anim-n", "anim_n"],
+  ["anim-seed", "anim_seed"],
+  ["sim-engine", "sim_engine"],
+  ["sim-trials", "sim_trials"],
+  ["sim-offset", "sim_offset"],
+  ["sim-seed", "sim_seed"],
+];
+
 function writeHash() {
   const q = new URLSearchParams();
   if (state.catalogue) q.set("part", state.catalogue);
@@ -231,6 +243,8 @@ function writeHash() {
   if ($("payoff").value.trim()) q.set("payoff", $("payoff").value.trim());
   q.set("sense", $("sense").value.trim() || "width");
   q.set("sense_depth", $("sense-depth").value);
+  for (const [id, key] of VIEW_SETTINGS) if ($(id).value !== "") q.set(key, $(id).value);
+  if (!$("sim-trials").dataset.edited) q.delete("sim_trials"); // the engine's default
   window.history.replaceState(null, "", "#" + q.toString());
 }
 
@@ -281,6 +295,9 @@ async function readHash() {
   $("turn-kind").value = kind === "normal" || kind === "uniform" ? kind : "";
   if ($("turn-kind").value) $("turn-deg").value = turnDeg;
   $("contact-noise").value = q.has("contact_noise") ? q.get("contact_noise") : "";
+  for (const [id, key] of VIEW_SETTINGS) if (q.has(key) && id !== "anim-plan") $(id).value = q.get(key);
+  if (q.has("sim_trials")) $("sim-trials").dataset.edited = "1";
+  state.wantPlan = q.get("anim_plan"); // chosen once the plan's rows are known
   if (q.get("part")) {
     state.catalogue = q.get("part");
     $("catalogue").value = state.catalogue;
@@ -352,6 +369,7 @@ async function run() {
   }
   writeHash();
   const gen = ++generation;
+  clearSimulation(); // the simulation was of the previous plan
   setStatus("planning...");
   $("output").classList.add("stale");
   state.functions = null; // the figures follow the new plan, never show the previous one
@@ -374,6 +392,7 @@ async function run() {
     drawDiameter(plan.part, squeeze);
     drawTable(plan);
     fillPlanSelector(plan);
+    writeHash(); // with the row the selector shows
     clearInterval(animTimer);
     drawAnimationFrame(0);
     loadFunctions(part, o, gen);
@@ -557,6 +576,8 @@ function fillPlanSelector(plan) {
   });
   if (plan.guaranteed) add("guaranteed", `guaranteed: ${label(plan.guaranteed)}`);
   sel.value = String(plan.bayes); // a new plan's rows are other plans: start from its Bayes plan
+  if (state.wantPlan && [...sel.options].some((o) => o.value === state.wantPlan)) sel.value = state.wantPlan;
+  state.wantPlan = null; // an address's choice holds for the plan it opens with
 }
 
 // a small seeded generator (mulberry32), so a seed gives the same starts in every browser
@@ -875,6 +896,245 @@ async function downloadRobotFile(policy) {
   }
 }
 
+// ---- the plan run many times: a simulation job on the server (POST /simulate/jobs) --------
+
+const SIM_TRIALS = { kinematic: 100000, mujoco: 200 }; // the command line's defaults (200 MuJoCo)
+const SIM_POLL_MS = 500;
+let serverLimits = null; // GET /limits: the trials a job may ask, the engines the server runs
+let simToken = 0; // the simulation the panel follows; clearing the panel ends its polling
+
+async function loadLimits() {
+  try {
+    serverLimits = await (await fetch(`${API}/limits`)).json();
+  } catch (err) {
+    serverLimits = null; // the server still checks every request
+  }
+  const mujoco = $("sim-engine").querySelector('option[value="mujoco"]');
+  if (serverLimits && !(serverLimits.engines || []).includes("mujoco")) {
+    mujoco.disabled = true;
+    mujoco.textContent = "MuJoCo (not installed on this server)";
+    if ($("sim-engine").value === "mujoco") $("sim-engine").value = "kinematic";
+  }
+  simEngineChanged();
+}
+
+function simEngineChanged() {
+  // the trials follow the engine's default until the user types a number of their own
+  const engine = $("sim-engine").value;
+  if (!$("sim-trials").dataset.edited) $("sim-trials").value = String(SIM_TRIALS[engine]);
+  $("sim-offset").disabled = engine !== "mujoco";
+}
+
+function validateSimulation() {
+  // each message next to its input; the server's limits from /limits
+  const engine = $("sim-engine").value;
+  let ok = true;
+  const most = serverLimits ? (engine === "mujoco" ? serverLimits.max_mujoco_trials : serverLimits.max_trials) : Infinity;
+  const whole = (id, what, lo, hi, hiText) => {
+    const raw = $(id).value.trim();
+    const x = Number(raw);
+    let msg = "";
+    if (raw === "") msg = `${what}: enter a whole number`;
+    else if (!Number.isInteger(x)) msg = `${what}: a whole number`;
+    else if (x < lo) msg = `${what}: must be at least ${lo}`;
+    else if (x > hi) msg = `${what}: ${hiText}`;
+    fieldError(id, msg);
+    if (msg) ok = false;
+  };
+  const engineName = engine === "mujoco" ? "MuJoCo" : "kinematic";
+  whole("sim-trials", "trials", 1, most, `the server runs at most ${Number(most).toLocaleString("en")} ${engineName} trials a job`);
+  whole("sim-seed", "seed", 0, Number.MAX_SAFE_INTEGER, "too large");
+  if (engine === "mujoco") {
+    const raw = $("sim-offset").value.trim();
+    const msg = raw === "" || !Number.isFinite(Number(raw)) ? "offset: enter a number" : Number(raw) < 0 ? "offset: must be at least 0" : "";
+    fieldError("sim-offset", msg);
+    if (msg) ok = false;
+  } else fieldError("sim-offset", "");
+  const contact = Number($("contact-noise").value || 0) > 0;
+  const refused = engine === "mujoco" && contact;
+  fieldError("sim-engine", refused ? "MuJoCo: the contact noise applies to the kinematic engine only (in MuJoCo the jaws' contacts are the physics' own); clear it or choose kinematic" : "");
+  if (refused) ok = false;
+  return ok;
+}
+
+function simulationBody() {
+  // the plan the animation's selector names, sent as it is (simulate --plan FILE.json), with
+  // the problem's options and the noise it was planned under
+  const engine = $("sim-engine").value;
+  const n = noise();
+  if (!n.contact_noise) delete n.contact_noise; // zero is no contact noise
+  const body = {
+    part: partBody(),
+    ...options(),
+    ...n,
+    plan: chosenPlan(),
+    engine,
+    trials: Number($("sim-trials").value),
+    seed: Number($("sim-seed").value),
+  };
+  if (engine === "mujoco" && Number($("sim-offset").value) > 0) body.offset_mm = Number($("sim-offset").value);
+  return body;
+}
+
+function clearSimulation() {
+  simToken++;
+  $("sim-progress").hidden = true;
+  $("sim-progress").value = 0;
+  $("sim-status").textContent = "";
+  $("sim-status").classList.remove("error");
+  $("sim-result").replaceChildren();
+  $("simulate").disabled = false;
+  delete document.body.dataset.sim;
+}
+
+function simFailed(token, message) {
+  if (token !== simToken) return;
+  $("sim-progress").hidden = true;
+  $("sim-status").textContent = message;
+  $("sim-status").classList.add("error");
+  $("simulate").disabled = false;
+  document.body.dataset.sim = "error";
+}
+
+async function simulate() {
+  if (!state.last) {
+    clearSimulation();
+    simFailed(simToken, "plan a part first: the simulation runs the plan chosen above");
+    return;
+  }
+  if (!validateSimulation() || !validate()) return;
+  const body = simulationBody();
+  const what = $("anim-plan").selectedOptions[0]?.textContent || "the Bayes plan";
+  clearSimulation();
+  const token = simToken;
+  $("simulate").disabled = true;
+  $("sim-progress").hidden = false;
+  $("sim-status").textContent = "submitting the job...";
+  document.body.dataset.sim = "running";
+  let job;
+  try {
+    job = await post("/simulate/jobs", body);
+  } catch (err) {
+    simFailed(token, String(err.message || err));
+    return;
+  }
+  for (;;) {
+    if (token !== simToken) return; // a new plan, part or run replaced this one
+    let doc;
+    try {
+      const r = await fetch(job.url);
+      doc = await r.json();
+      if (!r.ok) throw new Error(doc.detail || `HTTP ${r.status}`);
+    } catch (err) {
+      simFailed(token, `the job cannot be read: ${err.message || err}`);
+      return;
+    }
+    if (token !== simToken) return;
+    const { done, total, fraction } = doc.progress;
+    $("sim-progress").value = fraction;
+    $("sim-status").textContent = `${doc.status === "queued" ? "queued" : "running"}: ${done.toLocaleString("en")} of ${total.toLocaleString("en")} trials`;
+    if (doc.status === "failed") {
+      simFailed(token, doc.error ? doc.error.detail : "the job failed");
+      return;
+    }
+    if (doc.status === "done") {
+      $("sim-progress").hidden = true;
+      $("simulate").disabled = false;
+      drawSimulation(doc.result, what);
+      document.body.dataset.sim = "done";
+      return;
+    }
+    await new Promise((wake) => setTimeout(wake, SIM_POLL_MS));
+  }
+}
+
+function verdictText(doc) {
+  // the verdict line of `bayesgrasp simulate` (each prediction within its z interval)
+  const claims = [["success", doc.predicted_success, doc.success_interval]];
+  if (doc.payoff) claims.unshift(["E[payoff]", doc.payoff.predicted, doc.payoff.interval]);
+  const said = claims
+    .map(([name, v, [lo, hi]]) => `predicted ${name} ${v.toFixed(4)} ${lo - 1e-9 <= v && v <= hi + 1e-9 ? "within" : "outside"} [${lo.toFixed(4)}, ${hi.toFixed(4)}]`)
+    .join("; ");
+  return `verdict: ${doc.agrees ? "agrees" : "DISAGREES"}: ${said} (z = ${doc.z})`;
+}
+
+function drawSimulation(doc, what) {
+  // the document of `bayesgrasp simulate --json`: the summary, then each final orientation
+  const out = $("sim-result");
+  out.replaceChildren();
+  out.dataset.engine = doc.engine;
+  out.dataset.trials = String(doc.trials);
+  out.dataset.predicted = String(doc.predicted_success);
+  out.dataset.observed = String(doc.observed_success);
+  out.dataset.agrees = String(doc.agrees);
+  const p4 = (x) => (x == null ? "-" : x.toFixed(4));
+  const interval = (iv) => `[${p4(iv[0])}, ${p4(iv[1])}]`;
+  const successes = Math.round(doc.observed_success * doc.trials);
+  const rows = [
+    ["plan", what, "plan"],
+    ["engine", `${doc.engine === "mujoco" ? "MuJoCo" : "kinematic"}, ${doc.trials.toLocaleString("en")} trials in ${round(doc.seconds, 2)} s`, "engine"],
+    ["predicted success", p4(doc.predicted_success), "predicted"],
+    ["observed success", `${p4(doc.observed_success)} (${successes.toLocaleString("en")} of ${doc.trials.toLocaleString("en")})`, "observed"],
+    ["observed, 95% interval", interval(doc.ci95), "ci95"],
+  ];
+  if (doc.prediction_interval95)
+    rows.push([`95% of runs of ${doc.trials} trials, if the prediction is right`, interval(doc.prediction_interval95), "prediction_interval95"]);
+  if (doc.success_p_value != null) rows.push(["p-value of the success (exact binomial)", doc.success_p_value.toPrecision(3), "success_p_value"]);
+  rows.push(["goodness of fit over the final orientations (chi-square)", doc.p_value == null ? `n/a (${doc.p_value_unavailable || "-"})` : `p = ${doc.p_value.toPrecision(3)}`, "p_value"]);
+  rows.push(["jams", `${doc.jams} (${doc.final_jams} in the last action)`, "jams"]);
+  if (doc.payoff) {
+    rows.push(["payoff: predicted E[payoff]", p4(doc.payoff.predicted), "payoff_predicted"]);
+    rows.push(["payoff: observed mean, 95% interval", `${p4(doc.payoff.observed)} ${interval(doc.payoff.ci95)}`, "payoff_observed"]);
+  }
+  const table = document.createElement("table");
+  table.className = "sim-summary";
+  for (const [name, text, key] of rows) {
+    const tr = document.createElement("tr");
+    const th = document.createElement("th");
+    th.textContent = name;
+    const td = document.createElement("td");
+    td.textContent = text;
+    td.dataset.key = key;
+    tr.append(th, td);
+    table.appendChild(tr);
+  }
+  out.appendChild(table);
+  for (const flag of doc.assumption_flags || []) {
+    const p = document.createElement("p");
+    p.className = "flags";
+    p.textContent = `model assumptions break: ${flag}`;
+    out.appendChild(p);
+  }
+  const verdict = document.createElement("p");
+  verdict.className = `verdict ${doc.agrees ? "agrees" : "disagrees"}`;
+  verdict.textContent = verdictText(doc);
+  out.appendChild(verdict);
+  const per = document.createElement("table");
+  per.className = "sim-orientations";
+  per.innerHTML = "<thead><tr><th>final (deg)</th><th>predicted</th><th>observed</th><th>count</th><th></th></tr></thead>";
+  const tbody = document.createElement("tbody");
+  for (const row of doc.per_orientation) {
+    const tr = document.createElement("tr");
+    const cells = [
+      round(((deg(row.orientation_rad) % 360) + 360) % 360, 2),
+      row.predicted.toFixed(4),
+      row.observed.toFixed(4),
+      row.count.toLocaleString("en"),
+      row.goal ? "goal" : "",
+    ];
+    for (const text of cells) {
+      const td = document.createElement("td");
+      td.textContent = text;
+      tr.appendChild(td);
+    }
+    tr.dataset.count = String(row.count);
+    tr.dataset.predicted = String(row.predicted);
+    tbody.appendChild(tr);
+  }
+  per.appendChild(tbody);
+  out.appendChild(per);
+}
+
 // ---- catalogue, file, gallery --------------------------------------------------------------
 
 async function loadCatalogue() {
@@ -1008,6 +1268,15 @@ function start() {
       clearInterval(animTimer);
       drawAnimationFrame(0);
     });
+  $("anim-plan").addEventListener("change", clearSimulation); // the simulation was of another plan
+  for (const [id] of VIEW_SETTINGS) $(id).addEventListener("change", writeHash);
+  $("simulate").addEventListener("click", simulate);
+  $("sim-engine").addEventListener("change", () => {
+    simEngineChanged();
+    validateSimulation();
+  });
+  $("sim-trials").addEventListener("input", () => ($("sim-trials").dataset.edited = "1"));
+  for (const id of ["sim-trials", "sim-offset", "sim-seed"]) $(id).addEventListener("change", validateSimulation);
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
   $("save").addEventListener("click", saveView);
@@ -1023,6 +1292,7 @@ function start() {
     if (state.catalogue || state.file || state.vertices.length >= 3) run();
   });
   loadGallery();
+  loadLimits();
 }
 
 start();
@@ -1144,6 +1414,7 @@ function validate() {
 
 function clearResults() {
   state.last = null;
+  clearSimulation();
   $("output").classList.remove("stale");
   $("plans").querySelector("tbody").replaceChildren();
   $("hull").replaceChildren();
