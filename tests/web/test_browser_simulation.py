@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
 import urllib.parse
@@ -102,6 +103,7 @@ def test_a_kinematic_job_shows_what_the_cli_prints(
     ]
     assert counts == [r["count"] for r in cli["per_orientation"]]
     assert not page.locator("#sim-progress").is_visible()
+    assert page.locator("#sim-status").text_content() == "done: 100,000 trials"
     if SHOTS is not None:
         page.locator("#sim-panel").screenshot(path=str(SHOTS / "web-simulation.png"))
 
@@ -196,6 +198,10 @@ def test_a_new_part_or_plan_clears_the_panel(server: str, page: Any) -> None:
     page.fill("#sim-trials", "1000000")
     page.click("#simulate")
     page.wait_for_function("() => !document.querySelector('#sim-progress').hidden")
+    status = page.locator("#sim-status").text_content()
+    assert re.fullmatch(
+        r"(submitting the job\.\.\.|(queued|running): [\d,]+ of 1,000,000 trials)", status
+    )
     page.select_option("#catalogue", "triangle")
     page.wait_for_function("() => state.last && state.last.plan.part.name === 'triangle'")
     page.wait_for_timeout(1200)  # two polls' time: nothing comes back to the panel

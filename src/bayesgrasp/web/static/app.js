@@ -1039,6 +1039,7 @@ async function simulate() {
     }
     if (doc.status === "done") {
       $("sim-progress").hidden = true;
+      $("sim-status").textContent = `done: ${total.toLocaleString("en")} trials`;
       $("simulate").disabled = false;
       drawSimulation(doc.result, what);
       document.body.dataset.sim = "done";
