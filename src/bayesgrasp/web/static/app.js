@@ -370,6 +370,7 @@ async function run() {
   writeHash();
   const gen = ++generation;
   clearSimulation(); // the simulation was of the previous plan
+  clearPolicy(); // and the policy of the previous options
   setStatus("planning...");
   $("output").classList.add("stale");
   state.functions = null; // the figures follow the new plan, never show the previous one
@@ -814,13 +815,26 @@ function policyLines(node, depth, first, unit, lines) {
   return lines;
 }
 
-async function showPolicy() {
-  if (!validate()) return;
-  const o = options();
-  const body = { part: partBody(), ...o, ...policyStroke(), sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
-  $("policy-summary").textContent = "planning the policy...";
+let policyToken = 0; // the policy the panel waits for; a new plan of other options ends the wait
+
+function clearPolicy() {
+  policyToken++;
   $("policy-tree").textContent = "";
   $("policy-nodes").replaceChildren();
+  $("policy-summary").textContent = "";
+  $("policy-summary").classList.remove("error");
+  delete document.body.dataset.policy;
+}
+
+async function showPolicy() {
+  if (!validate()) return;
+  clearPolicy();
+  const token = policyToken;
+  const o = options();
+  const n = noise();
+  const noisy = Boolean(n.turn_noise || n.contact_noise || n.payoff);
+  const body = { part: partBody(), ...o, ...n, ...policyStroke(), sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 };
+  $("policy-summary").textContent = "planning the policy...";
   try {
     const part = partBody();
     const [doc, squeeze, push] = await Promise.all([
@@ -828,28 +842,42 @@ async function showPolicy() {
       post("/squeeze", { part, prior: o.prior }),
       o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
+    if (token !== policyToken) return; // the options changed meanwhile: it is of others
     state.policyParts = doc.parts.length;
     const hullVerts = squeeze.part.vertices;
     const drawn = state.vertices.length >= 3 ? state.vertices : state.outline || hullVerts;
     const [mu] = o.prior.startsWith("vonmises:") ? o.prior.slice(9).split(",").map(Number) : [0];
     // the part drawings (one part only: several parts' trees name the part at each leaf)
-    state.policyDraw = doc.parts.length === 1 ? { hull: hullVerts, outline: drawn, squeeze, push, mode: (mu * Math.PI) / 180 } : null;
+    // under noise the page cannot follow the belief (the drawings of actions and rejects
+    // would be the noise-free model's guess): only the root and the declarations are drawn
+    state.policyDraw = doc.parts.length === 1 ? { hull: hullVerts, outline: drawn, squeeze, push, mode: (mu * Math.PI) / 180, noisy } : null;
     // the units of the last plan, when it was of this part (the policy document has none)
     const last = state.last && state.last.plan ? state.last.plan.part : null;
     const units = last && last.name === doc.parts[0] ? last.units : null;
     $("policy-tree").textContent = policyLines(doc.root, 0, true, units ? ` ${units}` : "", []).join("\n");
     $("policy-nodes").replaceChildren(policyNode(doc.root, true, units ? ` ${units}` : "", []));
     const blind = doc.sensorless_cost === null ? "" : ` (sensorless Bayes plan ${doc.sensorless_cost.toFixed(4)})`;
+    const under = noisy ? `; under ${noiseWords(n)}` : "";
     $("policy-summary").textContent =
       `expected cost ${doc.expected_cost.toFixed(4)}${blind}, success ${doc.success_probability.toFixed(4)} a cycle, ` +
-      `${doc.expected_actions.toFixed(3)} actions a cycle`;
+      `${doc.expected_actions.toFixed(3)} actions a cycle${under}`;
     $("policy-summary").classList.remove("error");
     document.body.dataset.policy = "done";
   } catch (err) {
+    if (token !== policyToken) return;
     $("policy-summary").textContent = String(err.message || err);
     $("policy-summary").classList.add("error");
     document.body.dataset.policy = "error";
   }
+}
+
+function noiseWords(n) {
+  // the noise and payoff of a request, for people
+  const words = [];
+  if (n.turn_noise) words.push(`turn error ${n.turn_noise} deg`);
+  if (n.contact_noise) words.push(`contact noise ${n.contact_noise}`);
+  if (n.payoff) words.push("the payoff");
+  return words.join(", ") || "no noise";
 }
 
 // ---- robot files (POST /export: the bytes of plan --export FILE.csv|json) ----------------
@@ -865,7 +893,7 @@ async function downloadRobotFile(policy) {
   if (!validate()) return;
   const format = $("export-format").value;
   const body = { part: partBody(), ...options(), format };
-  if (policy) Object.assign(body, policyStroke(), { sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 });
+  if (policy) Object.assign(body, noise(), policyStroke(), { sense: $("sense").value.trim() || "width", max_actions: Number($("sense-depth").value) || 3 });
   else Object.assign(body, noise(), stroke(), $("guaranteed").checked ? { guaranteed: true } : {});
   const where = policy ? $("policy-summary") : $("status");
   where.textContent = "writing the robot file...";
@@ -1427,9 +1455,7 @@ function clearResults() {
   $("belief").replaceChildren();
   state.functions = null;
   for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
-  $("policy-tree").textContent = "";
-  $("policy-nodes").replaceChildren();
-  $("policy-summary").textContent = "";
+  clearPolicy();
 }
 
 // ---- interactive figures drawn from the JSON of /views/functions ---------------------------
@@ -1612,7 +1638,7 @@ function policyNode(node, first, unit, belief) {
   const sum = document.createElement("summary");
   const a = round((act.alpha_rad * 180) / Math.PI, 2);
   const here = !state.policyDraw ? 0 : first ? state.policyDraw.mode : mostProbable(belief);
-  if (state.policyDraw) sum.appendChild(partAt(here, `most probable orientation here: ${round(((deg(here) % 360) + 360) % 360, 2)}°`));
+  if (state.policyDraw && (first || !state.policyDraw.noisy)) sum.appendChild(partAt(here, `most probable orientation here: ${round(((deg(here) % 360) + 360) % 360, 2)}°`));
   sum.append(first ? `${act.type} with the gripper at ${a}°` : `turn ${a}°, ${act.type}`);
   d.appendChild(sum);
   const after = state.policyDraw ? afterAction(belief, act, first) : null;
@@ -1631,7 +1657,7 @@ function policyNode(node, first, unit, belief) {
     if (n.action) {
       li.append(document.createTextNode(head + ":"), policyNode(n, false, unit, given));
     } else if (n.reject) {
-      if (given) li.appendChild(partAt(mostProbable(given), "most probable orientation here"));
+      if (given && !state.policyDraw.noisy) li.appendChild(partAt(mostProbable(given), "most probable orientation here"));
       li.append(`${head}: reject`);
     } else {
       const t = n.declare.orientation_rad;
