@@ -155,6 +155,38 @@ def test_figures(client: TestClient, figure: str, fmt: str) -> None:
     assert FIG_FORMATS[fmt] in r.content[:400]
 
 
+@pytest.mark.parametrize(
+    "options",
+    [
+        {},
+        {"turn_noise": "normal:2"},
+        {"contact_noise": 0.2, "plan": "most-certain"},
+        {"turn_noise": "uniform:3", "plan": "guaranteed"},
+    ],
+)
+def test_figures_are_the_cli_plot_files(
+    client: TestClient, tmp_path: Path, options: dict[str, Any]
+) -> None:
+    """Each figure is the PNG ``bayesgrasp plot`` writes with the same options, byte for byte."""
+    from bayesgrasp.cli import main
+
+    args = ["--actions", "squeeze,push-grasp"]
+    for key, flag in [("turn_noise", "--turn-noise"), ("contact_noise", "--contact-noise")]:
+        if key in options:
+            args += [flag, str(options[key])]
+    args += ["--plan", options.get("plan", "bayes")]
+    out = tmp_path / "figs"
+    code = main(
+        ["plot", "key", *args, "--out", str(out), "--image-formats", "png", "--no-animation"]
+    )
+    assert code == 0
+    body = {"part": {"catalogue": "key"}, "actions": "squeeze,push-grasp", **options}
+    for name in ("part", "diameter", "transfer", "plan"):
+        r = client.post(f"/api/v1/figures/{name}.png", json=body)
+        assert r.status_code == 200, r.text
+        assert r.content == (out / f"{name}.png").read_bytes(), name
+
+
 def test_figure_names_are_checked(client: TestClient) -> None:
     r = client.post("/api/v1/figures/nope.png", json={"part": {"catalogue": "triangle"}})
     assert r.status_code == 422

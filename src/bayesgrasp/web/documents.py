@@ -34,6 +34,7 @@ from .problems import (
     chosen_option,
     exact_method,
     given_option,
+    noisy_option,
     prior_string,
     problem_spec,
     stroke_of,
@@ -359,16 +360,26 @@ def figure_bytes(service: Service, req: FigureRequest, name: str, fmt: str) -> b
 
     spec = problem_spec(req)
     p = service.part(req.part)
-    pb, option, label = chosen_option(req.plan, req, p, spec)
+    qs, note = None, None
+    if req.noisy:  # as plot --turn-noise ...: the plan under the noise, its distributions
+        from ..figures.plans import noise_note
+        from ..planning.noisy import step_distributions_noisy
+
+        pb, option, label = noisy_option(req.plan, req, p, spec)
+        if name == "plan":
+            qs = step_distributions_noisy(pb, req.noise_model(), option.steps)
+            note = noise_note(req.noise_model(), req.payoff is not None)
+    else:
+        pb, option, label = chosen_option(req.plan, req, p, spec)
     with service.figure_lock:  # matplotlib's font cache and text engine are shared
         if name == "part":
             fig = part_figure(pb.part)
         elif name == "diameter":
-            fig = diameter_figure(pb, option.first_angle)
+            fig = diameter_figure(pb, option.first_angle, option.steps[0].kind)
         elif name == "transfer":
             fig = transfer_figure(pb, push_grasp=PUSH_GRASP.name in pb.action_kinds)
         else:
-            fig = evolution_figure(pb, option, label)
+            fig = evolution_figure(pb, option, label, qs, note)
         buf = io.BytesIO()
         meta = {"Software": None} if fmt == "png" else {"Date": None, "Creator": None}
         fig.savefig(buf, format=fmt, dpi=110, metadata=meta)

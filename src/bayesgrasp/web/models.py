@@ -313,8 +313,13 @@ class SimulateRequest(NoiseOptions):
     seed: int = Field(0, ge=0, le=2**63 - 1)
 
 
-class FigureRequest(ProblemOptions):
-    """The body of ``figures``: the figures ``plot`` makes."""
+class FigureRequest(NoiseOptions):
+    """The body of ``figures``: the figures ``plot`` makes.
+
+    With ``turn_noise``, ``contact_noise`` or ``payoff``: the plan is the one ``plan`` gives
+    under them, and the plan figure draws the exact distributions after each step under the
+    noise (``plot --turn-noise ...``).
+    """
 
     plan: Literal["bayes", "most-certain", "guaranteed"] = "bayes"
 

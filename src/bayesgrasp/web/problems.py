@@ -2,8 +2,8 @@
 
 :func:`problem_spec` makes the :class:`~bayesgrasp.runs.specs.ProblemSpec` of ``plan``'s
 options, :func:`build_problem` the problem (with an inline histogram or sample prior),
-:func:`chosen_option` the plan ``--plan`` names, :func:`given_option` the plan of a
-plan document, :func:`stroke_of` the gripper's stroke.
+:func:`chosen_option` the plan ``--plan`` names (:func:`noisy_option` under the noise),
+:func:`given_option` the plan of a plan document, :func:`stroke_of` the gripper's stroke.
 Options the command line would refuse are refused here with its reasons (422).
 """
 
@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ..errors import NoPlanError
-from .models import PartRequest, ProblemOptions, StrokeOptions
+from .models import NoiseOptions, PartRequest, ProblemOptions, StrokeOptions
 from .workers import LimitError
 
 if TYPE_CHECKING:
@@ -29,6 +29,7 @@ __all__ = [
     "chosen_option",
     "exact_method",
     "given_option",
+    "noisy_option",
     "prior_string",
     "problem_spec",
     "stroke_of",
@@ -123,6 +124,40 @@ def chosen_option(
     result = spec.plan(problem)
     plan = result.bayes_plan if which == "bayes" else result.most_certain_plan
     return problem, plan, PLAN_NAMES[which]
+
+
+def noisy_option(
+    which: str, opts: NoiseOptions, part: Part, spec: Any
+) -> tuple[Problem, PlanOption, str]:
+    """The problem and the plan ``which`` names under the request's noise and payoff.
+
+    The plans ``plan`` gives with the same options (:func:`bayesgrasp.planning.solve`):
+    ``bayes`` and ``most-certain`` of the noise-aware planner, ``guaranteed`` the plan
+    guaranteed under a bounded turn error (a normal error bounds none: 422). Their success
+    probabilities and costs are those under the noise.
+    """
+    from ..planning.noisy import NoisyPlanResult
+    from ..planning.robust import UNBOUNDED_GUARANTEE
+    from ..planning.strategy import solve
+    from ..runs.specs import PLAN_NAMES
+
+    exact_method(opts)
+    noise = opts.noise_model()
+    sure = which == "guaranteed"
+    if sure and not noise.turn.exact and noise.turn.kind == "normal":
+        raise LimitError(422, f"`plan`: guaranteed: {UNBOUNDED_GUARANTEE}")
+    pb = build_problem(part, opts, spec)
+    result = solve(
+        pb, noise=noise, payoff=opts.payoff_model(), max_actions=spec.max_actions, guaranteed=sure
+    )
+    src = result.source
+    assert isinstance(src, NoisyPlanResult)
+    if sure:
+        if result.guaranteed is None:
+            raise NoPlanError(result.guaranteed_missing or "no guaranteed plan")
+        return pb, result.guaranteed.option, "noise-aware guaranteed"  # as plot names it
+    option = src.options[src.bayes if which == "bayes" else src.most_certain].option
+    return pb, option, PLAN_NAMES[which]
 
 
 def given_option(

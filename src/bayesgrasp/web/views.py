@@ -122,46 +122,25 @@ def chosen_beliefs(
 
     Without noise options: the noise-free plan (as ``plot --plan``) and its beliefs
     (:func:`belief_steps`). With them: the plan ``plan`` gives under the noise and payoff
-    (:func:`bayesgrasp.planning.solve`; ``guaranteed``: the plan guaranteed under a bounded
-    turn error) and the exact distribution over the stable orientations after each step under
-    the noise (:func:`~bayesgrasp.planning.noisy.step_distributions_noisy`), whose mass at
-    the goal after the last step is the plan's success probability.
+    (:func:`~bayesgrasp.web.problems.noisy_option`) and the exact distribution over the
+    stable orientations after each step under the noise
+    (:func:`~bayesgrasp.planning.noisy.step_distributions_noisy`), whose mass at the goal
+    after the last step is the plan's success probability.
     """
     import numpy as np
 
-    from ..errors import NoPlanError
-    from ..runs.specs import PLAN_NAMES
-    from .problems import build_problem, chosen_option, exact_method
+    from .problems import chosen_option, noisy_option
 
     if not req.noisy:
         pb, option, label = chosen_option(req.plan, req, part, spec)
         return pb, option, label, belief_steps(pb, option.steps)
-    from ..planning.noisy import NoisyPlanResult, step_distributions_noisy
-    from ..planning.robust import UNBOUNDED_GUARANTEE
-    from ..planning.strategy import solve
-    from .workers import LimitError
+    from ..planning.noisy import step_distributions_noisy
 
-    exact_method(req)
-    noise = req.noise_model()
-    sure = req.plan == "guaranteed"
-    if sure and not noise.turn.exact and noise.turn.kind == "normal":
-        raise LimitError(422, f"`plan`: guaranteed: {UNBOUNDED_GUARANTEE}")
-    pb = build_problem(part, req, spec)
-    result = solve(
-        pb, noise=noise, payoff=req.payoff_model(), max_actions=spec.max_actions, guaranteed=sure
-    )
-    src = result.source
-    assert isinstance(src, NoisyPlanResult)
-    if sure:
-        if result.guaranteed is None:
-            raise NoPlanError(result.guaranteed_missing or "no guaranteed plan")
-        option = result.guaranteed.option
-    else:
-        option = src.options[src.bayes if req.plan == "bayes" else src.most_certain].option
+    pb, option, label = noisy_option(req.plan, req, part, spec)
     stable = np.asarray(pb.states.stable, dtype=float)
-    qs = step_distributions_noisy(pb, noise, option.steps)
+    qs = step_distributions_noisy(pb, req.noise_model(), option.steps)
     beliefs = [[(float(stable[k]), float(q[k])) for k in np.flatnonzero(q > 0)] for q in qs]
-    return pb, option, PLAN_NAMES[req.plan], beliefs
+    return pb, option, label, beliefs
 
 
 def function_samples(service: Any, req: FunctionsRequest, n: int = 721) -> dict[str, Any]:

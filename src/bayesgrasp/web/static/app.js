@@ -371,6 +371,7 @@ async function run() {
   const gen = ++generation;
   clearSimulation(); // the simulation was of the previous plan
   clearPolicy(); // and the policy of the previous options
+  clearFigureImages();
   setStatus("planning...");
   $("output").classList.add("stale");
   state.functions = null; // the figures follow the new plan, never show the previous one
@@ -736,15 +737,22 @@ function play() {
   }, 40);
 }
 
+function clearFigureImages() {
+  for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
+}
+
 async function showFigures() {
   if (!validate()) return;
-  const body = { part: partBody(), ...options() };
+  // the plan figure is of the table's Bayes plan: under the noise, the noise-aware one
+  const body = { part: partBody(), ...options(), ...noise() };
+  const gen = generation; // a new plan meanwhile makes these figures of other options
   for (const name of ["transfer", "plan"]) {
     const r = await fetch(`${API}/figures/${name}.svg`, {
       method: "POST",
       headers: { "content-type": "application/json" },
       body: JSON.stringify(body),
     });
+    if (gen !== generation) return;
     if (!r.ok) {
       setStatus((await r.json()).detail, true);
       return;
@@ -1454,7 +1462,7 @@ function clearResults() {
   $("functions").replaceChildren();
   $("belief").replaceChildren();
   state.functions = null;
-  for (const name of ["transfer", "plan"]) $(`fig-${name}`).removeAttribute("src");
+  clearFigureImages();
   clearPolicy();
 }
 
