@@ -117,3 +117,32 @@ def test_area_and_centroid_at_every_scale(scale: float) -> None:
     assert math.isfinite(area) and np.all(np.isfinite(centroid))
     assert_allclose(area / scale**2, a, rtol=1e-6)
     assert_allclose(centroid / scale - 0.5, c, atol=1e-6)
+
+
+@pytest.mark.parametrize("size", ["1e78", "2e149"])
+def test_a_path_arc_too_large_to_compute_says_so(tmp_path: Path, size: str) -> None:
+    """svgelements squares an arc's radii for its centre: past about 1e77 that overflows."""
+    f = tmp_path / "arc.svg"
+    d = f"M 0 0 A {size} {size} 0 0 1 {size} 0 L {size} {size} Z"
+    f.write_text(svg(f'<path d="{d}"/>'), encoding="utf-8")
+    done = run_cli("plan", str(f))
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.splitlines() == [
+        f"bayesgrasp: error: {f}: <path> number 0 has an arc too large to compute: its centre "
+        "overflows floating point (coordinates or radii beyond about 1e77); scale the drawing down"
+    ]
+
+
+def test_a_path_arc_of_1e77_plans_as_at_unit_size(tmp_path: Path) -> None:
+    rows = []
+    for size in ("1", "1e77"):
+        f = tmp_path / f"arc{size}.svg"
+        d = f"M 0 0 A {size} {size} 0 0 1 {size} 0 L {size} {size} Z"
+        f.write_text(svg(f'<path d="{d}"/>'), encoding="utf-8")
+        done = run_cli("plan", str(f), "--json")
+        assert done.returncode == 0, done.stderr
+        import json
+
+        doc = json.loads(done.stdout)
+        rows.append([o["success_probability"] for o in doc["options"]])
+    assert_allclose(rows[0], rows[1], atol=1e-9)

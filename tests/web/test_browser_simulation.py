@@ -129,6 +129,19 @@ def test_noise_reaches_the_simulation(server: str, page: Any, cli_json: CliJson)
     _, free = cli_json("plan", "key")  # noise-free: another prediction (0.484, not 0.385)
     free_p = free["options"][free["bayes"]]["success_probability"]
     assert abs(cli["predicted_success"] - free_p) > 0.01
+    # typed and clicked at once: the click ends the typing, the page plans for the new error
+    # and only then runs the job (which that plan would otherwise clear)
+    page.fill("#turn-deg", "5")
+    page.click("#simulate")
+    page.wait_for_function("() => ['done', 'error'].includes(document.body.dataset.sim)")
+    assert "turn_noise=normal%3A5" in page.url
+    code, five = cli_json(
+        "simulate", "key", "--turn-noise", "normal:5", "--trials", "30000", "--seed", "5"
+    )
+    assert float(result.get_attribute("data-predicted")) == pytest.approx(
+        five["predicted_success"], abs=1e-12
+    )
+    assert five["predicted_success"] != pytest.approx(cli["predicted_success"], abs=1e-3)
 
 
 def test_inputs_are_checked_before_a_job_is_sent(server: str, page: Any) -> None:
@@ -172,7 +185,7 @@ def test_inputs_are_checked_before_a_job_is_sent(server: str, page: Any) -> None
         assert "contact noise applies to the kinematic engine only" in (
             page.locator("#sim-engine-error").text_content()
         )
-        page.fill("#contact-noise", "")
+        page.fill("#contact-noise", "")  # planned again when the next click ends the typing
     assert sent == []  # no request reached the server
     # the server's own refusal (the offset is not less than the part's size) shows beside it
     if "mujoco" in limits["engines"]:

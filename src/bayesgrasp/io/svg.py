@@ -307,6 +307,13 @@ def _curves(
     return out
 
 
+def _overflowed_arc(seg: Any, svgelements: Any) -> bool:
+    """Whether svgelements' centre form of an arc overflowed (its squares pass 1e308)."""
+    if not isinstance(seg, svgelements.Arc) or seg.rx == 0 or seg.ry == 0:
+        return False
+    return not np.all(np.isfinite([*_xy(seg.center), float(seg.rx), float(seg.ry)]))
+
+
 def _arc(seg: Any, affine: _Affine) -> Curve:
     """An SVG arc (svgelements computes the centre form, radii corrected as the spec says)."""
     start, end = affine.points([_xy(seg.start), _xy(seg.end)])
@@ -385,6 +392,14 @@ def parse_svg(data: bytes, path: Path, options: ReadOptions) -> Part:
                 subpaths_of[id(element)] = _subpaths(element, svgelements)
             except (ArithmeticError, ValueError, TypeError) as exc:
                 raise fail(path, f"{label} cannot be read ({type(exc).__name__}: {exc})") from None
+            for segs, _ in subpaths_of[id(element)]:
+                if any(_overflowed_arc(seg, svgelements) for seg in segs):
+                    raise fail(
+                        path,
+                        f"{label} has an arc too large to compute: its centre overflows "
+                        "floating point (coordinates or radii beyond about 1e77); scale the "
+                        "drawing down",
+                    )
         return subpaths_of[id(element)]
 
     groups: list[tuple[str, list[Any]]]

@@ -34,19 +34,53 @@ function setStatus(text, error) {
 
 // ---- drawing ---------------------------------------------------------------------------
 
-const toPart = (px, py) => [(px / GRID) * UNIT, ((SIZE - py) / GRID) * UNIT];
-const toCanvas = (x, y) => [(x / UNIT) * GRID, SIZE - (y / UNIT) * GRID];
+// The canvas's view of the part's plane: part units per canvas pixel, and the point of the
+// plane at the canvas's bottom-left corner (y up). The default shows 0-100 mm on a 5 mm grid;
+// the wheel zooms about the pointer, shift+drag pans, Fit frames the part. A catalogue or
+// uploaded part is framed when chosen (auto), until the user zooms or pans.
+const DEFAULT_VIEW = { upp: UNIT / GRID, x0: 0, y0: 0 };
+const view = { ...DEFAULT_VIEW, auto: true };
+const toPart = (px, py) => [view.x0 + px * view.upp, view.y0 + (SIZE - py) * view.upp];
+const toCanvas = (x, y) => [(x - view.x0) / view.upp, SIZE - (y - view.y0) / view.upp];
+
+function gridStep() {
+  // a round step of the grid (1, 2 or 5 times a power of ten) about 20 pixels wide
+  const want = 20 * view.upp;
+  const p = 10 ** Math.floor(Math.log10(want));
+  return [1, 2, 5, 10].map((m) => m * p).find((step) => step >= 0.75 * want);
+}
+
+function canvasPixel(evt) {
+  const r = $("canvas").getBoundingClientRect();
+  return [((evt.clientX - r.left) * SIZE) / r.width, ((evt.clientY - r.top) * SIZE) / r.height];
+}
 
 function canvasPoint(evt) {
-  const svg = $("canvas");
-  const r = svg.getBoundingClientRect();
-  let px = ((evt.clientX - r.left) * SIZE) / r.width;
-  let py = ((evt.clientY - r.top) * SIZE) / r.height;
-  if ($("snap").checked) {
-    px = Math.round(px / GRID) * GRID;
-    py = Math.round(py / GRID) * GRID;
+  // the part's point under the pointer, on the grid when snapping
+  const step = gridStep();
+  const q = $("snap").checked ? step : step / 5000;
+  return toPart(...canvasPixel(evt)).map((v) => Number((Math.round(v / q) * q).toPrecision(12)));
+}
+
+function fitView(points) {
+  // frame the points with a margin of 24 pixels (nothing to frame: the default view)
+  if (!points || !points.length) {
+    Object.assign(view, DEFAULT_VIEW);
+    return;
   }
-  return toPart(px, py).map((v) => Math.round(v * 1000) / 1000);
+  const xs = points.map((p) => p[0]), ys = points.map((p) => p[1]);
+  const [lx, hx, ly, hy] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const span = Math.max(hx - lx, hy - ly);
+  if (span > 0) view.upp = span / (SIZE - 48);
+  view.x0 = (lx + hx) / 2 - (SIZE / 2) * view.upp;
+  view.y0 = (ly + hy) / 2 - (SIZE / 2) * view.upp;
+}
+
+function inView(points) {
+  return points.every(([x, y]) => {
+    const [px, py] = toCanvas(x, y);
+    return px >= 0 && px <= SIZE && py >= 0 && py <= SIZE;
+  });
 }
 
 function hull(points) {
@@ -75,14 +109,25 @@ let dragging = -1;
 function drawCanvas() {
   const svg = $("canvas");
   svg.replaceChildren();
-  for (let i = 0; i <= SIZE; i += GRID) {
-    el("line", { x1: i, y1: 0, x2: i, y2: SIZE, class: "grid" }, svg);
-    el("line", { x1: 0, y1: i, x2: SIZE, y2: i, class: "grid" }, svg);
+  const given = (state.catalogue || state.file) && state.outline && state.outline.length >= 3;
+  if (given && view.auto) fitView(state.outline);
+  const step = gridStep();
+  const [x0, y1] = toPart(0, 0), [x1, y0] = toPart(SIZE, SIZE);
+  for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+    const [px] = toCanvas(x, 0);
+    el("line", { x1: px, y1: 0, x2: px, y2: SIZE, class: "grid" }, svg);
   }
-  if ((state.catalogue || state.file) && state.outline && state.outline.length >= 3) {
-    // a catalogue or uploaded part, fitted to the canvas (it is not edited here)
-    const f = fit(state.outline, SIZE, 24);
-    el("polygon", { points: state.outline.map((p) => f(p).join(",")).join(" "), class: "poly", id: "given-part" }, svg);
+  for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+    const [, py] = toCanvas(0, y);
+    el("line", { x1: 0, y1: py, x2: SIZE, y2: py, class: "grid" }, svg);
+  }
+  svg.dataset.grid = String(step);
+  const units = !given ? "mm" : state.last ? state.last.plan.part.units || "" : "";
+  $("grid-step").textContent = `${Number(step.toPrecision(6))} ${units}`.trim();
+  if (given) {
+    // a catalogue or uploaded part (it is not edited here)
+    const pts = state.outline.map(([x, y]) => toCanvas(x, y).join(","));
+    el("polygon", { points: pts.join(" "), class: "poly", id: "given-part" }, svg);
   }
   const pts = state.vertices.map((v) => toCanvas(v[0], v[1]));
   if (pts.length >= 2) el("polygon", { points: pts.map((p) => p.join(",")).join(" "), class: "poly" }, svg);
@@ -103,28 +148,68 @@ function drawCanvas() {
   $("coords").value = state.vertices.map((v) => `${short(v[0])}, ${short(v[1])}`).join("\n");
 }
 
+let panning = null; // shift+drag: where the drag started, and the view then
+
 function setupCanvas() {
   const svg = $("canvas");
   svg.addEventListener("pointerdown", (evt) => {
+    if (evt.shiftKey || evt.button === 1) {
+      const [px, py] = canvasPixel(evt);
+      panning = { px, py, x0: view.x0, y0: view.y0 };
+      svg.setPointerCapture(evt.pointerId);
+      evt.preventDefault();
+      return;
+    }
     undoStack.push(state.vertices.map((v) => v.slice()));
     useVertices(state.vertices.concat([canvasPoint(evt)]), "drawn");
   });
   svg.addEventListener("pointermove", (evt) => {
+    if (panning) {
+      const [px, py] = canvasPixel(evt);
+      view.x0 = panning.x0 - (px - panning.px) * view.upp;
+      view.y0 = panning.y0 + (py - panning.py) * view.upp;
+      view.auto = false;
+      drawCanvas();
+      return;
+    }
     if (dragging < 0) return;
     state.vertices[dragging] = canvasPoint(evt);
     drawCanvas();
   });
   svg.addEventListener("pointerup", () => {
+    panning = null;
     if (dragging >= 0) {
       dragging = -1;
       useVertices(state.vertices, state.name);
     }
+  });
+  svg.addEventListener(
+    "wheel",
+    (evt) => {
+      // zoom about the pointer: the part's point under it stays there
+      evt.preventDefault();
+      const [px, py] = canvasPixel(evt);
+      const [x, y] = toPart(px, py);
+      view.upp *= evt.deltaY > 0 ? 1.25 : 0.8;
+      view.x0 = x - px * view.upp;
+      view.y0 = y - (SIZE - py) * view.upp;
+      view.auto = false;
+      drawCanvas();
+    },
+    { passive: false },
+  );
+  $("fit").addEventListener("click", () => {
+    const given = (state.catalogue || state.file) && state.outline;
+    fitView(given ? state.outline : state.vertices);
+    view.auto = Boolean(given);
+    drawCanvas();
   });
   $("undo").addEventListener("click", () => {
     if (undoStack.length) useVertices(undoStack.pop(), state.name);
   });
   $("clear").addEventListener("click", () => {
     undoStack.push(state.vertices.map((v) => v.slice()));
+    fitView([]); // drawing starts again on the 5 mm grid
     useVertices([], "drawn");
   });
   $("use-coords").addEventListener("click", () => {
@@ -139,6 +224,7 @@ function setupCanvas() {
       pts.push(nums);
     }
     undoStack.push(state.vertices.map((v) => v.slice()));
+    if (!inView(pts)) fitView(pts); // pasted coordinates are always seen whole
     useVertices(pts, "pasted");
   });
 }
@@ -256,6 +342,7 @@ async function readHash() {
       const format = q.get("format") || "svg";
       const name = q.get("name") || "part";
       state.file = { format, data_base64: btoa(text), name, packed: q.get("file") };
+      view.auto = true;
       state.catalogue = "";
       state.vertices = [];
       showFileName(`${name}.${format}`);
@@ -306,8 +393,10 @@ async function readHash() {
     showFileName("");
     const entry = (state.catalogueParts || []).find((p) => p.name === state.catalogue);
     state.outline = entry ? entry.outline : null;
+    view.auto = true; // framed when drawn
   } else if (q.get("v")) {
     state.vertices = q.get("v").split(";").map((s) => s.split(",").map(Number));
+    if (!inView(state.vertices)) fitView(state.vertices);
     state.name = "drawn";
     state.catalogue = "";
     state.file = null;
@@ -351,6 +440,7 @@ async function postWhenFree(path, body, gen) {
 
 let timer = null;
 let generation = 0;
+let planning = null; // the plan in progress, if any
 function schedule() {
   clearTimeout(timer);
   timer = setTimeout(run, 150);
@@ -358,6 +448,25 @@ function schedule() {
 
 async function run() {
   clearTimeout(timer); // a click on Plan replaces the run an input change scheduled
+  timer = null;
+  const p = planNow();
+  planning = p;
+  try {
+    await p;
+  } finally {
+    if (planning === p) planning = null;
+  }
+}
+
+async function settled() {
+  // An input's change plans 150 ms later; a click on Simulate, Plan the policy or Show
+  // figures right after typing (the click itself ends the typing) waits for that plan, so
+  // that what it shows is of the options on screen and the new plan does not clear it.
+  if (timer !== null) await run();
+  else if (planning) await planning;
+}
+
+async function planNow() {
   const part = partBody();
   if (!state.catalogue && !state.file && state.vertices.length < 3) {
     setStatus("add at least three vertices (or choose a part)");
@@ -742,6 +851,7 @@ function clearFigureImages() {
 }
 
 async function showFigures() {
+  await settled();
   if (!validate()) return;
   // the plan figure is of the table's Bayes plan: under the noise, the noise-aware one
   const body = { part: partBody(), ...options(), ...noise() };
@@ -835,6 +945,7 @@ function clearPolicy() {
 }
 
 async function showPolicy() {
+  await settled();
   if (!validate()) return;
   clearPolicy();
   const token = policyToken;
@@ -898,6 +1009,7 @@ function policyStroke() {
 }
 
 async function downloadRobotFile(policy) {
+  await settled();
   if (!validate()) return;
   const format = $("export-format").value;
   const body = { part: partBody(), ...options(), format };
@@ -1033,6 +1145,7 @@ function simFailed(token, message) {
 }
 
 async function simulate() {
+  await settled();
   if (!state.last) {
     clearSimulation();
     simFailed(simToken, "plan a part first: the simulation runs the plan chosen above");
@@ -1188,6 +1301,7 @@ async function loadCatalogue() {
   const given = doc.parts.find((p) => p.name === state.catalogue);
   if (given) {
     state.outline = given.outline;
+    view.auto = true; // framed when drawn
     drawCanvas();
   }
   $("catalogue").addEventListener("change", () => {
@@ -1200,6 +1314,7 @@ async function loadCatalogue() {
     showFileName("");
     state.vertices = [];
     state.outline = entry.outline;
+    view.auto = true; // framed when drawn
     drawCanvas();
     schedule();
   });
@@ -1218,6 +1333,7 @@ function setupFile() {
     const name = f.name.replace(/\.[^.]*$/, "").replace(/[^A-Za-z0-9_. -]/g, "_").slice(0, 64) || "part";
     state.file = { format: ext, data_base64: btoa(bin), name, packed: await pack(bin) };
     state.outline = null;
+    view.auto = true; // framed when drawn
     $("catalogue").value = "";
     drawCanvas();
     showFileName(f.name);
