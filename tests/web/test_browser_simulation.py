@@ -264,3 +264,16 @@ def test_a_mujoco_job_from_the_page(server: str, page: Any) -> None:
     assert s["engine"].startswith("MuJoCo, 4 trials in ")
     assert "prediction_interval95" in s and "jams" in s  # every trial counted, jams shown
     assert page.locator("#sim-result .verdict").text_content().startswith("verdict: ")
+
+
+def test_the_panel_fits_a_phone(server: str, browser: Any) -> None:
+    context = browser.new_context(viewport={"width": 390, "height": 844})
+    pg = context.new_page()
+    try:
+        _open(pg, server + "/#part=house&sim_engine=kinematic&sim_trials=5000")
+        assert _simulate(pg) == "done"
+        assert pg.locator("#sim-result table").count() == 2
+        width = pg.evaluate("document.documentElement.scrollWidth")
+        assert width <= 390, width
+    finally:
+        context.close()
