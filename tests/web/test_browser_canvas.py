@@ -122,3 +122,13 @@ def test_catalogue_parts_are_framed_and_zoomable(server: str, page: Any) -> None
     page.wait_for_function("() => state.catalogue === 'ic-chip'")
     c = box()
     assert 0 <= c[0] < c[2] <= 400 and c[2] - c[0] == pytest.approx(352, abs=0.5)
+
+
+def test_drawing_a_new_part_clears_the_results_of_the_old(server: str, page: Any) -> None:
+    page.goto(server + "/#part=house")
+    page.wait_for_selector("#plans tbody tr")
+    page.mouse.click(*_at(page, 100, 300))  # the first vertex of a new part
+    page.wait_for_function("() => document.querySelectorAll('#plans tbody tr').length === 0")
+    assert page.locator("#anim-plan option").count() == 0
+    assert "add at least three vertices" in page.locator("#status").text_content()
+    assert page.evaluate("() => state.last") is None

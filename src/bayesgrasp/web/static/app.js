@@ -469,10 +469,13 @@ async function settled() {
 async function planNow() {
   const part = partBody();
   if (!state.catalogue && !state.file && state.vertices.length < 3) {
+    generation++; // a plan still on its way is of the part before
+    clearResults(); // and so are the results on screen
     setStatus("add at least three vertices (or choose a part)");
     return;
   }
   if (!validate()) {
+    generation++;
     clearResults();
     return;
   }
