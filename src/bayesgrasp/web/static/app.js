@@ -484,20 +484,25 @@ async function planNow() {
   clearSimulation(); // the simulation was of the previous plan
   clearPolicy(); // and the policy of the previous options
   clearFigureImages();
+  clearInterval(animTimer); // its plan is being replaced
   setStatus("planning...");
   $("output").classList.add("stale");
   state.functions = null; // the figures follow the new plan, never show the previous one
   $("belief").replaceChildren();
   const o = options();
+  const n = noise();
   try {
     const [plan, squeeze, push] = await Promise.all([
-      postWhenFree("/plan", { part, ...o, ...noise(), ...stroke(), ...($("guaranteed").checked ? { guaranteed: true } : {}) }, gen),
+      postWhenFree("/plan", { part, ...o, ...n, ...stroke(), ...($("guaranteed").checked ? { guaranteed: true } : {}) }, gen),
       post("/squeeze", { part, prior: o.prior }),
-      o.actions.includes("push-grasp") ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
+      // the push-grasp function: an action, or what a squeeze becomes under contact noise
+      o.actions.includes("push-grasp") || n.contact_noise > 0 ? post("/push", { part, prior: o.prior }) : Promise.resolve(null),
     ]);
     if (gen !== generation) return;
     $("output").classList.remove("stale");
-    state.last = { plan, squeeze, push };
+    // with the options they were planned under: the animation draws those, not the inputs'
+    // values while the next plan is on its way
+    state.last = { plan, squeeze, push, noise: n, goal: o.goal, prior: o.prior };
     if (state.file) {
       state.outline = plan.part.vertices; // the hull of the exact model
       drawCanvas();
@@ -510,8 +515,8 @@ async function planNow() {
     clearInterval(animTimer);
     drawAnimationFrame(0);
     loadFunctions(part, o, gen);
-    const n = plan.options.length;
-    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${n} ${n === 1 ? "plan" : "plans"}`);
+    const rows = plan.options.length;
+    setStatus(`${plan.part.name}: ${plan.part.n_sides} sides, ${rows} ${rows === 1 ? "plan" : "plans"}`);
     document.body.dataset.planned = String(gen);
   } catch (err) {
     if (gen !== generation) return;
@@ -733,11 +738,21 @@ function startOrientations() {
   }
   const n = Math.max(1, Math.min(400, Math.floor(Number($("anim-n").value)) || 1));
   const rand = rng(Math.floor(Number($("anim-seed").value)) || 0);
-  const prior = options().prior;
+  const prior = state.last.prior; // the plan's, not an input's while the next plan is on its way
   const [mean, kappa] = prior.startsWith("vonmises:") ? prior.slice(9).split(",").map(Number) : [0, 0];
   const starts = [];
   for (let i = 0; i < n; i++) starts.push(kappa > 0 ? vonMises(rand, (mean * Math.PI) / 180, kappa) : rand() * TWO_PI);
   return starts;
+}
+
+function animationNoise() {
+  // the plan's turn error (radians) and contact noise, drawn as the kinematic simulator
+  // draws them (bayesgrasp.sim.kinematic): every commanded angle gets its own error e (the
+  // part turns by alpha + e), and a squeeze is, with probability q, a push-grasp from the
+  // gripper's -x side or its +x side, equally likely (a push-grasp step is not affected)
+  const n = state.last.noise;
+  const [kind, a] = (n.turn_noise || "").split(":");
+  return { kind, scale: n.turn_noise ? (Number(a) * Math.PI) / 180 : 0, contact: n.contact_noise || 0, payoff: Boolean(n.payoff) };
 }
 
 function trajectories() {
@@ -746,27 +761,46 @@ function trajectories() {
   const { plan, squeeze, push } = state.last;
   const o = chosenPlan();
   const order = plan.part.symmetry_order || 1;
-  const goalPeriod = $("goal").value === "symmetry" ? TWO_PI / order : TWO_PI;
+  const goalPeriod = state.last.goal === "symmetry" ? TWO_PI / order : TWO_PI;
+  const nz = animationNoise();
+  // the noise's draws: a stream of their own, so that the starts are those without noise
+  const rand = rng(((Math.floor(Number($("anim-seed").value)) || 0) + 0x9e3779b9) >>> 0);
+  const gauss = () => Math.sqrt(-2 * Math.log(1 - rand())) * Math.cos(TWO_PI * rand()); // Box-Muller
   return startOrientations().map((t0) => {
     const segs = [];
+    const errors = [];
+    const contacts = [];
     let t = t0;
     for (const s of o.steps) {
-      const turned = t - s.alpha_rad;
+      const e = nz.scale === 0 ? 0 : nz.kind === "normal" ? nz.scale * gauss() : nz.scale * (2 * rand() - 1);
+      const turned = t - s.alpha_rad - e;
+      errors.push(e);
       segs.push({ kind: "turn", from: t, to: turned });
-      if (s.type === "squeeze") {
+      let side = s.type === "squeeze" ? null : "left";
+      if (s.type === "squeeze" && nz.contact > 0) {
+        const u = rand();
+        side = u < nz.contact / 2 ? "left" : u < nz.contact ? "right" : null;
+        contacts.push(side || "");
+      } else contacts.push("");
+      if (!side) {
         t = transfer(turned, squeeze);
+        // under contact noise other cells push first: this one waits, so steps stay in time
+        if (nz.contact > 0) segs.push({ kind: "hold", from: turned, to: turned });
         segs.push({ kind: "squeeze", from: turned, to: t });
       } else {
-        const rest = near(transfer(turned, push), turned, TWO_PI);
-        const grasped = transfer(turned, push.push_grasp);
-        segs.push({ kind: "push", from: turned, to: rest });
-        segs.push({ kind: "close", from: rest, to: near(grasped, rest, TWO_PI) });
+        // pushed by the -x jaw: the push-grasp at the part's angle; by the +x jaw: the
+        // push-grasp of the part turned half a turn, turned back
+        const flip = side === "left" ? 0 : Math.PI;
+        const rest = near(transfer(turned - flip, push) + flip, turned, TWO_PI);
+        const grasped = transfer(turned - flip, push.push_grasp) + flip;
+        segs.push({ kind: "push", from: turned, to: rest, side });
+        segs.push({ kind: "close", from: rest, to: near(grasped, rest, TWO_PI), side });
         t = grasped;
       }
     }
     const gap = (t - o.final_orientation_rad) / goalPeriod;
     const ok = Math.abs(gap - Math.round(gap)) * goalPeriod < 1e-6;
-    return { start: t0, segs, final: t, ok };
+    return { start: t0, segs, final: t, ok, errors, contacts };
   });
 }
 
@@ -798,26 +832,31 @@ function drawAnimationFrame(frame) {
   svg.setAttribute("height", String(rows * 160 + 10));
   runs.forEach((run, i) => {
     const ox = 40 + (i % COLS) * 78, oy = 80 + Math.floor(i / COLS) * 160;
-    el("rect", { x: ox - 36, y: oy - 70, width: 72, height: 150, rx: 6, class: done ? (run.ok ? "cell-ok" : "cell-fail") : "cell", "data-ok": run.ok, "data-start": run.start, "data-final": run.final }, svg);
+    el("rect", { x: ox - 36, y: oy - 70, width: 72, height: 150, rx: 6, class: done ? (run.ok ? "cell-ok" : "cell-fail") : "cell", "data-ok": run.ok, "data-start": run.start, "data-final": run.final, "data-errors": run.errors.join(","), "data-contacts": run.contacts.join(",") }, svg);
     const sg = done ? { kind: "end", from: run.final, to: run.final } : run.segs[seg];
     const t = sg.from + (sg.to - sg.from) * u;
     const pts = rotate(centred, t);
     const xs = pts.map((p) => p[0]);
     const lo = Math.min(...xs), hi = Math.max(...xs);
-    let left = 8, right = 8; // the jaws' gaps to the part
+    // the jaws' gaps to the part; a push is made by the -x (left) jaw, or under contact noise
+    // by either, the other closing after it
+    const pushing = sg.kind === "push" || sg.kind === "close";
+    const fromRight = pushing && sg.side === "right";
+    let left = 8, right = 8;
     if (sg.kind === "squeeze") left = right = 8 * (1 - u);
-    else if (sg.kind === "push") left = 0;
-    else if (sg.kind === "close") [left, right] = [0, 8 * (1 - u)];
+    else if (sg.kind === "push") [left, right] = fromRight ? [8, 0] : [0, 8];
+    else if (sg.kind === "close") [left, right] = fromRight ? [8 * (1 - u), 0] : [0, 8 * (1 - u)];
     else if (sg.kind === "end") left = right = 0;
     el("polygon", { points: pts.map(([x, y]) => `${ox + x * k},${oy - y * k}`).join(" "), fill: "#9fb8d6", stroke: "#2f4b6e" }, svg);
-    const pushing = sg.kind === "push" || sg.kind === "close";
     const jaw = (x, cls) => el("line", { x1: ox + x, y1: oy - 45, x2: ox + x, y2: oy + 45, class: cls }, svg);
-    jaw(lo * k - left, pushing ? "jaw pusher" : sg.kind === "squeeze" ? "jaw closing" : "jaw");
-    jaw(hi * k + right, sg.kind === "close" || sg.kind === "squeeze" ? "jaw closing" : "jaw");
+    const closing = sg.kind === "squeeze" || sg.kind === "close";
+    jaw(lo * k - left, pushing && !fromRight ? "jaw pusher" : closing ? "jaw closing" : "jaw");
+    jaw(hi * k + right, pushing && fromRight ? "jaw pusher" : closing ? "jaw closing" : "jaw");
     if (sg.kind === "push") {
-      // the push: an arrow on the pushing jaw
-      const x = ox + lo * k - left - 4;
-      el("path", { d: `M${x - 10},${oy - 52} L${x},${oy - 52} M${x - 4},${oy - 56} L${x},${oy - 52} L${x - 4},${oy - 48}`, class: "push-arrow" }, svg);
+      // the push: an arrow on the pushing jaw, pointing the way it moves
+      const x = fromRight ? ox + hi * k + right + 4 : ox + lo * k - left - 4;
+      const d = fromRight ? 1 : -1; // the arrow's tail is outside the jaw
+      el("path", { d: `M${x - d * 10},${oy - 52} L${x},${oy - 52} M${x - d * 4},${oy - 56} L${x},${oy - 52} L${x - d * 4},${oy - 48}`, class: "push-arrow" }, svg);
     }
     const label = el("text", { x: ox, y: oy + 70, "text-anchor": "middle", "font-size": 11 }, svg);
     const fin = round(((deg(run.final) % 360) + 360) % 360, 0);
@@ -825,10 +864,15 @@ function drawAnimationFrame(frame) {
   });
   const ok = runs.filter((x) => x.ok).length;
   const stepOf = runs[0].segs.slice(0, seg + 1).filter((s) => s.kind === "turn").length;
-  const what = { turn: "turn", squeeze: "squeeze", push: "push", close: "the other jaw closes" }[kind];
+  const kinds = new Set(runs.map((x) => x.segs[seg].kind));
+  const words = { turn: "turn", squeeze: "squeeze", push: "push", close: "the other jaw closes", hold: "squeeze" };
+  const what = kinds.size > 1 ? "the jaws close (in the cells with an arrow one jaw touches first and pushes)" : words[kind];
+  const nz = animationNoise();
+  const under = [nz.scale > 0 ? `turn error ${state.last.noise.turn_noise} deg` : "", nz.contact > 0 ? `contact noise ${nz.contact}` : ""].filter(Boolean).join(", ");
   $("anim-status").textContent = done
     ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%` +
-      `${Object.keys(noise()).length ? ", which counts the noise and payoff the animation leaves out" : ""}` +
+      `${under ? ` under ${under}, drawn in every cell` : ""}` +
+      `${nz.payoff ? "; oriented means at the plan's final orientation, the payoff's other orientations not counted" : ""}` +
       `${$("anim-starts").value === "even" ? "; evenly spaced starts are not weighted by the prior" : ""})`
     : `step ${stepOf} of ${o.steps.length}: ${what}`;
   svg.dataset.frame = String(f);
@@ -836,6 +880,7 @@ function drawAnimationFrame(frame) {
   svg.dataset.kind = done ? "end" : kind;
   svg.dataset.steps = String(o.steps.length);
   svg.dataset.segments = runs[0].segs.map((s) => s.kind).join(",");
+  svg.dataset.pushSides = [...new Set(runs.flatMap((x) => x.segs.filter((g) => g.kind === "push").map((g) => g.side)))].sort().join(",");
   svg.dataset.oriented = String(ok);
   svg.dataset.success = String(o.success_probability);
   return !done;
