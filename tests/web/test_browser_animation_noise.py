@@ -191,3 +191,37 @@ def test_a_playing_animation_keeps_the_noise_of_its_plan(server: str, page: Any)
     page.wait_for_function("() => state.last && state.last.noise.contact_noise === 0.8")
     _finish(page)
     assert "contact noise 0.8, drawn in every cell" in page.locator("#anim-status").text_content()
+
+
+def test_with_a_payoff_a_cell_counts_where_the_payoff_is_positive(
+    server: str, page: Any, cli_json: CliJson, tmp_path: Any
+) -> None:
+    """The table's success under a payoff is the chance of ending where it pays; so is a cell's."""
+    import json
+    import urllib.parse
+
+    payoff = {"0": 1, "180": 0.5}
+    q = urllib.parse.quote(json.dumps(payoff))
+    page.goto(server + f"/#part=house&actions=squeeze&turn_noise=normal:3&payoff={q}")
+    page.wait_for_function("() => state.last !== null")
+    f = tmp_path / "payoff.json"
+    f.write_text(json.dumps({"payoff": payoff, "default": 0}))
+    code, want = cli_json("plan", "house", "--turn-noise", "normal:3", "--payoff", str(f))
+    assert code == 0, want
+    row = 0
+    p = want["options"][row]["success_probability"]
+    page.select_option("#anim-plan", str(row))
+    page.select_option("#anim-starts", "random")
+    page.fill("#anim-n", "400")
+    page.fill("#anim-seed", "3")
+    page.locator("#anim-seed").dispatch_event("change")
+    _finish(page)
+    cells = _cells(page)
+    k = sum(c["ok"] for c in cells)
+    assert _within(k, 400, p), (k, p)
+    final = want["options"][row]["final_orientation_rad"]
+    at_final = sum(
+        abs((c["final"] - final + math.pi) % (2 * math.pi) - math.pi) < 1e-6 for c in cells
+    )
+    assert at_final < k and not _within(at_final, 400, p)  # the final orientation alone: fewer
+    assert "positive payoff" in page.locator("#anim-status").text_content()

@@ -752,7 +752,14 @@ function animationNoise() {
   // gripper's -x side or its +x side, equally likely (a push-grasp step is not affected)
   const n = state.last.noise;
   const [kind, a] = (n.turn_noise || "").split(":");
-  return { kind, scale: n.turn_noise ? (Number(a) * Math.PI) / 180 : 0, contact: n.contact_noise || 0, payoff: Boolean(n.payoff) };
+  return { kind, scale: n.turn_noise ? (Number(a) * Math.PI) / 180 : 0, contact: n.contact_noise || 0, payoff: n.payoff ? n.payoff.payoff : null };
+}
+
+function positivePayoff(payoff, t) {
+  // whether a payoff's value at orientation t is positive: its listed orientations match a
+  // stable orientation within 0.05 deg (bayesgrasp.model.payoff.MATCH_DEG); others pay 0
+  const d = ((deg(t) % 360) + 360) % 360;
+  return Object.entries(payoff).some(([k, v]) => v > 0 && Math.abs((((d - Number(k)) % 360) + 540) % 360 - 180) <= 0.05);
 }
 
 function trajectories() {
@@ -799,7 +806,10 @@ function trajectories() {
       }
     }
     const gap = (t - o.final_orientation_rad) / goalPeriod;
-    const ok = Math.abs(gap - Math.round(gap)) * goalPeriod < 1e-6;
+    const reached = Math.abs(gap - Math.round(gap)) * goalPeriod < 1e-6;
+    // with a payoff the table's success is ending where the payoff is positive (the
+    // library's goal then), except for the guaranteed plan, which is of its final orientation
+    const ok = nz.payoff && o !== plan.guaranteed ? positivePayoff(nz.payoff, t) : reached;
     return { start: t0, segs, final: t, ok, errors, contacts };
   });
 }
@@ -872,7 +882,7 @@ function drawAnimationFrame(frame) {
   $("anim-status").textContent = done
     ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%` +
       `${under ? ` under ${under}, drawn in every cell` : ""}` +
-      `${nz.payoff ? "; oriented means at the plan's final orientation, the payoff's other orientations not counted" : ""}` +
+      `${nz.payoff && o !== state.last.plan.guaranteed ? "; oriented: at an orientation of positive payoff, as the table counts it" : ""}` +
       `${$("anim-starts").value === "even" ? "; evenly spaced starts are not weighted by the prior" : ""})`
     : `step ${stepOf} of ${o.steps.length}: ${what}`;
   svg.dataset.frame = String(f);
