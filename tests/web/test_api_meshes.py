@@ -161,3 +161,49 @@ def test_openapi_states_mesh_members(client: TestClient) -> None:
     assert "jaw_height" in schema["PlanRequest"]["properties"]
     assert {"goal_pose", "pose_prior"} <= set(schema["PolicyRequest"]["properties"])
     assert "/api/v1/poses" in client.get("/openapi.json").json()["paths"]
+
+
+def test_upload_of_a_mesh_equals_cli(client: TestClient, cli_json: CliJson) -> None:
+    _, poses = cli_json("poses", str(WEDGE))
+    up = client.post(
+        "/api/v1/poses/upload",
+        files={"file": ("wedge.stl", WEDGE.read_bytes())},
+        data={"format": "stl"},
+    )
+    assert up.status_code == 200, up.text
+    assert up.json() == poses
+    _, doc = cli_json("plan", str(WEDGE), "--pose", "2")
+    up = client.post(
+        "/api/v1/plan/upload",
+        files={"file": ("wedge.stl", WEDGE.read_bytes())},
+        data={"format": "stl", "options": '{"pose": 2}'},
+    )
+    assert up.status_code == 200, up.text
+    assert up.json() == doc
+
+
+def test_simulate_of_a_pose_equals_cli(client: TestClient, cli_json: CliJson) -> None:
+    args = ["--element", "1", "--trials", "2000", "--seed", "3", "--noise", "2"]
+    code, doc = cli_json("simulate", str(BRACKET), *args)
+    assert code == 0, doc
+    body = {"part": _part(BRACKET, pose=1), "trials": 2000, "seed": 3, "noise": 2}
+    r = client.post("/api/v1/simulate", json=body)
+    assert r.status_code == 200, r.text
+    got = r.json()
+    got.pop("seconds")
+    doc.pop("seconds")
+    assert got == doc
+
+
+def test_export_of_the_pose_policy_equals_cli(
+    client: TestClient, cli_json: CliJson, tmp_path: Path
+) -> None:
+    out = tmp_path / "policy.json"
+    code, _ = cli_json(
+        "plan", str(WEDGE), "--sense", "width", "--goal-pose", "any", "--export", str(out)
+    )
+    assert code == 0
+    body = {"part": _part(WEDGE), "sense": "width", "goal_pose": "any", "format": "json"}
+    r = client.post("/api/v1/export", json=body)
+    assert r.status_code == 200, r.text
+    assert r.content == out.read_bytes()

@@ -99,6 +99,8 @@ async def upload(
 ) -> Response:
     """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``.
 
+    A mesh's ``pose`` (of ``part.file``) may be given in ``options``.
+
     ``export`` answers the robot file (``options`` holds its ``format``, csv or json), the
     others the JSON document of the command.
     """
@@ -116,6 +118,8 @@ async def upload(
         "name": safe,
         "file": {"format": format, "data_base64": base64.b64encode(data).decode()},
     }
+    if "pose" in extra:  # a mesh's pose is the file's: `options` may carry it
+        part["file"]["pose"] = extra.pop("pose")
     try:
         req: Any = UPLOAD_MODELS[command].model_validate({**extra, "part": part})
     except ValidationError as exc:
