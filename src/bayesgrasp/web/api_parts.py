@@ -114,12 +114,10 @@ async def upload(
         raise LimitError(422, "`options` must be a JSON object without `part`")
     stem = Path(file.filename or "part").stem
     safe = "".join(c for c in stem if c.isalnum() or c in "_.- ")[:64] or "part"
-    part = {
-        "name": safe,
-        "file": {"format": format, "data_base64": base64.b64encode(data).decode()},
-    }
+    file_in: dict[str, Any] = {"format": format, "data_base64": base64.b64encode(data).decode()}
     if "pose" in extra:  # a mesh's pose is the file's: `options` may carry it
-        part["file"]["pose"] = extra.pop("pose")
+        file_in["pose"] = extra.pop("pose")
+    part = {"name": safe, "file": file_in}
     try:
         req: Any = UPLOAD_MODELS[command].model_validate({**extra, "part": part})
     except ValidationError as exc:
