@@ -207,3 +207,17 @@ def test_export_of_the_pose_policy_equals_cli(
     r = client.post("/api/v1/export", json=body)
     assert r.status_code == 200, r.text
     assert r.content == out.read_bytes()
+
+
+def test_figures_of_a_pose_are_the_cli_plot_files(client: TestClient, tmp_path: Path) -> None:
+    from bayesgrasp.cli import main
+
+    out = tmp_path / "figs"
+    args = ["--element", "2", "--jaw-height", "5", "--out", str(out)]
+    code = main(["plot", str(BRACKET), *args, "--image-formats", "png", "--no-animation"])
+    assert code == 0
+    body = {"part": _part(BRACKET, pose=2), "jaw_height": 5}
+    for name in ("part", "plan"):
+        r = client.post(f"/api/v1/figures/{name}.png", json=body)
+        assert r.status_code == 200, r.text
+        assert r.content == (out / f"{name}.png").read_bytes(), name
