@@ -14,6 +14,8 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 from pydantic_core import PydanticCustomError
 
+from ..solid.mesh import MESH_FORMATS as _MESH_FORMATS
+
 __all__ = [
     "MESH_FORMATS",
     "ErrorBody",
@@ -36,7 +38,7 @@ __all__ = [
 Cost = Annotated[float, Field(ge=0, le=1e12)]
 Name = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_. -]+$")]
 Format = Literal["json", "csv", "wkt", "geojson", "svg", "dxf", "stl", "obj", "ply", "3mf", "glb"]
-MESH_FORMATS = ("stl", "obj", "ply", "3mf", "glb")
+MESH_FORMATS = _MESH_FORMATS
 """The formats of :data:`Format` that are triangle meshes (a solid; one pose is planned)."""
 
 
