@@ -69,6 +69,12 @@ def test_bad_input_gives_the_cli_message(
         ("dxf", b"0\nSECTION\n"),
         ("json", b""),
         ("json", b"\xff\xfe"),
+        ("stl", b"solid x\n"),
+        ("stl", b"\0" * 84 + b"\1"),
+        ("obj", b"v 0 0 0\nf 1 2 3\n"),
+        ("ply", b"ply\nformat"),
+        ("3mf", b"PK\3\4"),
+        ("glb", b"glTF"),
     ],
 )
 def test_bad_files_give_the_cli_message(
@@ -266,7 +272,9 @@ part = st.one_of(
         {
             "file": st.fixed_dictionaries(
                 {
-                    "format": st.sampled_from(["csv", "json", "wkt", "svg", "dxf", "geojson"]),
+                    "format": st.sampled_from(
+                        ["csv", "json", "wkt", "svg", "dxf", "geojson", "stl", "obj", "glb"]
+                    ),
                     "data_base64": st.binary(max_size=200).map(
                         lambda b: base64.b64encode(b).decode()
                     ),
@@ -287,6 +295,7 @@ plan_body = st.fixed_dictionaries(
         "first_costs": st.dictionaries(st.sampled_from(["squeeze", "push-grasp"]), numbers),
         "verify_cost": numbers,
         "retry_cost": numbers,
+        "jaw_height": numbers,
         "goal": st.sampled_from(["single", "symmetry", "both"]),
         "actions": st.sampled_from(["squeeze", "push-grasp", "squeeze,push-grasp", "", ","])
         | st.lists(st.text(max_size=10), max_size=3),

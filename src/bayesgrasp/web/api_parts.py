@@ -22,6 +22,7 @@ from .models import (
     PartRequest,
     PlanRequest,
     PolicyRequest,
+    PosesRequest,
     SimulateRequest,
 )
 from .service import service_of
@@ -56,6 +57,15 @@ async def push(req: PartRequest, request: Request, timeout: float | None = TIMEO
     return await service_of(request).answer("push", req, timeout)
 
 
+@router.post("/poses", responses=ERRORS)
+async def poses(req: PosesRequest, request: Request, timeout: float | None = TIMEOUT) -> Response:
+    """The resting poses of a mesh part and their probabilities (``bayesgrasp poses --json``).
+
+    A pose's index is the `pose` (and `goal_pose`) of the other endpoints.
+    """
+    return await service_of(request).answer("poses", req, timeout)
+
+
 #: The request body of each command on an uploaded part.
 UPLOAD_MODELS: dict[str, type[BaseModel]] = {
     "squeeze": PartRequest,
@@ -64,6 +74,7 @@ UPLOAD_MODELS: dict[str, type[BaseModel]] = {
     "policy": PolicyRequest,
     "simulate": SimulateRequest,
     "export": ExportRequest,
+    "poses": PosesRequest,
 }
 
 
@@ -79,14 +90,16 @@ UPLOAD_ANSWER: dict[int | str, dict[str, Any]] = {
 
 @router.post("/{command}/upload", responses=UPLOAD_ANSWER)
 async def upload(
-    command: Literal["squeeze", "push", "plan", "policy", "simulate", "export"],
+    command: Literal["squeeze", "push", "plan", "policy", "simulate", "export", "poses"],
     request: Request,
     file: UploadFile = File(description="A part file (read in memory)."),  # noqa: B008
-    format: str = Form(description="json, csv, wkt, geojson, svg or dxf."),
+    format: str = Form(description="json, csv, wkt, geojson, svg, dxf, stl, obj, ply, 3mf or glb."),
     options: str = Form("{}", description="The other members of the command's body, JSON."),
     timeout: float | None = TIMEOUT,
 ) -> Response:
     """A command on an uploaded part file (multipart): ``file``, ``format``, ``options``.
+
+    A mesh's ``pose`` (of ``part.file``) may be given in ``options``.
 
     ``export`` answers the robot file (``options`` holds its ``format``, csv or json), the
     others the JSON document of the command.
@@ -101,10 +114,10 @@ async def upload(
         raise LimitError(422, "`options` must be a JSON object without `part`")
     stem = Path(file.filename or "part").stem
     safe = "".join(c for c in stem if c.isalnum() or c in "_.- ")[:64] or "part"
-    part = {
-        "name": safe,
-        "file": {"format": format, "data_base64": base64.b64encode(data).decode()},
-    }
+    file_in: dict[str, Any] = {"format": format, "data_base64": base64.b64encode(data).decode()}
+    if "pose" in extra:  # a mesh's pose is the file's: `options` may carry it
+        file_in["pose"] = extra.pop("pose")
+    part = {"name": safe, "file": file_in}
     try:
         req: Any = UPLOAD_MODELS[command].model_validate({**extra, "part": part})
     except ValidationError as exc:

@@ -21,11 +21,13 @@ from pydantic import ValidationError
 from .common import one_line
 from .limits import Limits, engines
 from .models import (
+    MESH_FORMATS,
     ExportRequest,
     FigureRequest,
     PartRequest,
     PlanRequest,
     PolicyRequest,
+    PosesRequest,
     SimulateRequest,
 )
 from .problems import (
@@ -49,6 +51,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "catalogue_document",
+    "check_mesh_options",
     "check_simulation",
     "export_file",
     "export_strategy",
@@ -58,6 +61,8 @@ __all__ = [
     "plan_strategy",
     "policy_document_of",
     "policy_strategy",
+    "pose_inputs",
+    "poses_document_of",
     "push_document",
     "simulate_document",
     "squeeze_document",
@@ -93,7 +98,7 @@ def plan_result_document(service: Service, req: PlanRequest) -> dict[str, Any]:
 
     spec = problem_spec(req)
     result = plan_strategy(service, req, spec)
-    return document(result, run_inputs(None, spec))
+    return document(result, run_inputs(None, spec) | pose_inputs(req))
 
 
 def plan_strategy(service: Service, req: PlanRequest, spec: Any) -> StrategyResult:
@@ -157,9 +162,17 @@ def policy_strategy(service: Service, req: PolicyRequest) -> StrategyResult:
     stroke = stroke_of(req)
     check_within_stroke(req, stroke, policy=True)
     spec = problem_spec(req)
-    parts = [service.part(p) for p in (req.part, *req.also)]
+    prior: str | None
+    if is_mesh(req.part):  # as plan MESH --sense: the candidates are the resting poses
+        parts, spec, prior = pose_candidates(service, req, spec)
+    else:
+        if req.goal_pose is not None or req.pose_prior is not None:
+            raise LimitError(422, "`goal_pose`, `pose_prior`: for a mesh part (policy over poses)")
+        if req.jaw_height is not None:
+            raise LimitError(422, "`jaw_height` needs a mesh part")
+        parts = [service.part(p) for p in (req.part, *req.also)]
+        prior = None if req.part_prior is None else ",".join(map(repr, req.part_prior))
     problems = [build_problem(p, req, spec) for p in parts]
-    prior = None if req.part_prior is None else ",".join(map(repr, req.part_prior))
     pol: Policy
     if not req.noisy:
         pol = plan_policy(problems, sensor=req.sense, max_actions=req.max_actions, part_prior=prior)
@@ -177,6 +190,127 @@ def policy_strategy(service: Service, req: PolicyRequest) -> StrategyResult:
     result = StrategyResult(tuple(problems), pol)
     check_stroke(result, stroke)
     return result
+
+
+def is_mesh(part: Any) -> bool:
+    """Whether a request's part is a mesh file (a solid, of resting poses)."""
+    return part.file is not None and part.file.format in MESH_FORMATS
+
+
+def pose_inputs(req: Any) -> dict[str, Any]:
+    """The provenance of a mesh part's pose, as the command line records ``--pose K``."""
+    f = req.part.file
+    if not is_mesh(req.part) or (f.pose is None and f.element is None):
+        return {}
+    return {"element": f.element if f.pose is None else str(f.pose)}
+
+
+def poses_document_of(service: Service, req: PosesRequest) -> dict[str, Any]:
+    """``bayesgrasp poses MESH --json``: the resting poses and their probabilities."""
+    from ..cli.poses import poses_document
+
+    if req.part.file is not None and req.part.file.pose is not None:
+        raise LimitError(422, "`pose`: `poses` lists every pose; give no pose")
+    solid, study = service.solid(req.part, "`poses`")
+    return poses_document(solid, study)
+
+
+def check_mesh_options(service: Service, req: Any) -> None:
+    """Refuse a request's ``jaw_height`` as the command line refuses ``--jaw-height``.
+
+    Without ``sense``: the part must be a mesh and no squeeze at that height may topple its
+    pose (the planar orientation is unknown, so a pose that some closing direction topples
+    may be met at any gripper angle; :func:`bayesgrasp.solid.topple.toppling_report`). With
+    ``sense`` the policy's own check applies (:func:`pose_candidates`). ``goal_pose`` and
+    ``pose_prior`` need ``sense``.
+    """
+    if getattr(req, "sense", None) is not None or not hasattr(req, "part"):
+        return
+    if getattr(req, "goal_pose", None) is not None or getattr(req, "pose_prior", None):
+        raise LimitError(422, "`goal_pose` and `pose_prior` plan a policy over poses: add `sense`")
+    height = getattr(req, "jaw_height", None)
+    if height is None:
+        return
+    if not is_mesh(req.part):
+        raise LimitError(422, "`jaw_height` needs a mesh part")
+    from ..solid.parts import pose_index
+    from ..solid.topple import toppling_report
+
+    f = req.part.file
+    _, study = service.solid(req.part)
+    chosen = f.element if f.pose is None else f.pose
+    k = pose_index(chosen, len(study.poses), f"{req.part.name}.{f.format}: pose")
+    found = toppling_report(study, height)[k]
+    if found.fraction > 0:
+        raise LimitError(
+            422,
+            f"`jaw_height`: a squeeze with the jaws at height {height:g} topples pose {k} (the "
+            f"push tips it before it slides at {found.describe()} of its frame; the planar "
+            "orientation is unknown, so every gripper angle may meet one): plan another "
+            "`pose` or lower the jaws",
+        )
+
+
+def pose_candidates(service: Service, req: PolicyRequest, spec: Any) -> tuple[Any, Any, str]:
+    """A mesh part's policy: its pose footprints, their problems and prior weights.
+
+    As ``plan MESH --sense S --goal-pose K|any --pose-prior P --jaw-height H``
+    (:func:`bayesgrasp.cli.meshes.pose_sensing`): the candidates are the footprints
+    ``pose-0``, ``pose-1``, ...; poses other than the goal pose may not be declared.
+    """
+    import contextlib
+    import dataclasses
+
+    import typer
+
+    from ..cli.meshes import PoseProblems, check_poses_toppling, pose_prior_weights
+    from ..runs.specs import ProblemSpec
+    from ..solid.parts import pose_index, pose_parts
+
+    if req.also or req.part_prior is not None:
+        raise LimitError(
+            422,
+            "with a mesh part and `sense` the candidates are its poses: drop `also` and "
+            "`part_prior` (`pose_prior` sets the poses' prior)",
+        )
+    if req.part.file is not None and req.part.file.pose is not None:
+        raise LimitError(
+            422,
+            "`sense` plans a policy over every pose: choose the pose to orient with "
+            "`goal_pose`, not `pose`",
+        )
+    kind = (req.pose_prior or "quasi-static").strip().lower()
+    if kind.startswith("drops:"):
+        raise LimitError(
+            422,
+            "`pose_prior` drops:N runs MuJoCo drops, longer than a request may take: give "
+            "quasi-static or perturbed (drops:N is the command line's --pose-prior)",
+        )
+    if kind not in ("quasi-static", "perturbed"):
+        raise LimitError(
+            422,
+            f"`pose_prior`: expected quasi-static or perturbed; got {req.pose_prior!r} (a "
+            "poses FILE is the command line's: the server reads no files)",
+        )
+    solid, study = service.solid(req.part)
+    n = len(study.poses)
+    goal: int | None = 0
+    if req.goal_pose is not None and req.goal_pose.strip().lower() == "any":
+        goal = None
+    elif req.goal_pose is not None:
+        goal = pose_index(req.goal_pose, n, "`goal_pose`")
+    with contextlib.redirect_stderr(io.StringIO()):  # the command line's notes
+        try:
+            weights = pose_prior_weights(kind, solid, study)
+            if req.jaw_height is not None:
+                check_poses_toppling(study, weights, req.jaw_height)
+        except typer.BadParameter as exc:
+            hint = str(exc.param_hint or "--pose-prior").lstrip("-").replace("-", "_")
+            raise LimitError(422, f"`{hint}`: {exc.message}") from None
+    undeclared = frozenset(f"pose-{k}" for k in range(n) if goal is not None and k != goal)
+    values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(ProblemSpec)}
+    problems = PoseProblems(**values, undeclared=undeclared)
+    return pose_parts(study, solid.units), problems, ",".join(repr(w) for w in weights)
 
 
 def export_file(service: Service, req: ExportRequest) -> tuple[str, bytes]:
@@ -278,7 +412,7 @@ def simulate_document(
     how = simulate_inputs(engine, which, req.seed, trials, deg, kind, offset_mm)
     how["contact_noise"] = req.contact_noise
     how["payoff"] = None if req.payoff is None else "request"
-    doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec))
+    doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec), **pose_inputs(req))
     return doc
 
 

@@ -14,7 +14,10 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 from pydantic_core import PydanticCustomError
 
+from ..solid.mesh import MESH_FORMATS as _MESH_FORMATS
+
 __all__ = [
+    "MESH_FORMATS",
     "ErrorBody",
     "ExportRequest",
     "FigureRequest",
@@ -25,6 +28,7 @@ __all__ = [
     "PayoffIn",
     "PlanRequest",
     "PolicyRequest",
+    "PosesRequest",
     "ProblemOptions",
     "SimulateJobRequest",
     "SimulateRequest",
@@ -33,7 +37,9 @@ __all__ = [
 
 Cost = Annotated[float, Field(ge=0, le=1e12)]
 Name = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_. -]+$")]
-Format = Literal["json", "csv", "wkt", "geojson", "svg", "dxf"]
+Format = Literal["json", "csv", "wkt", "geojson", "svg", "dxf", "stl", "obj", "ply", "3mf", "glb"]
+MESH_FORMATS = _MESH_FORMATS
+"""The formats of :data:`Format` that are triangle meshes (a solid; one pose is planned)."""
 
 
 class _Strict(BaseModel):
@@ -51,6 +57,13 @@ class FileIn(_Strict):
     layer: str | None = Field(None, max_length=200, description="DXF: only this layer (--layer).")
     flatten_tol: float | None = Field(
         None, gt=0, description="Chordal tolerance of curve flattening (--flatten-tol)."
+    )
+    pose: int | None = Field(
+        None,
+        ge=0,
+        le=100_000,
+        description="A mesh (stl, obj, ply, 3mf, glb): the resting pose whose footprint is the "
+        "part, as `poses` lists them (--pose; default 0, the most probable).",
     )
 
 
@@ -100,6 +113,12 @@ class PartRequest(_Strict):
     prior: str = Field("uniform", max_length=200, description="uniform | vonmises:MEAN_DEG,KAPPA")
 
 
+class PosesRequest(_Strict):
+    """The body of ``poses``: a mesh part (``bayesgrasp poses MESH --json``)."""
+
+    part: PartIn
+
+
 class ProblemOptions(_Strict):
     """The problem and planner options of ``bayesgrasp plan``."""
 
@@ -132,6 +151,14 @@ class ProblemOptions(_Strict):
     method: Literal["exact", "bfs"] = "exact"
     max_actions: int | None = Field(
         None, ge=1, le=1000, description="Longest plan to consider (--max-actions)."
+    )
+    jaw_height: float | None = Field(
+        None,
+        ge=0,
+        le=1e12,
+        description="A mesh part: height of the jaws' contact above the table, in the mesh's "
+        "units (--jaw-height). A pose a squeeze at this height may topple is refused (with "
+        "`sense`, every pose of positive weight).",
     )
 
 
@@ -356,6 +383,19 @@ class PolicyRequest(StrokeOptions):
     part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
         None, max_length=4, description="Weights of the candidate parts (--part-prior)."
     )
+    goal_pose: str | None = Field(
+        None,
+        max_length=16,
+        pattern=r"^\s*([0-9]+|any)\s*$",
+        description="A mesh part: the policy is over its resting poses; only pose K may be "
+        "declared (default 0), `any`: every pose may (--goal-pose).",
+    )
+    pose_prior: str | None = Field(
+        None,
+        max_length=64,
+        description="A mesh part: the poses' prior, the quasi-static estimate (default) or the "
+        "perturbed one (--pose-prior; drops:N and poses files are the command line's).",
+    )
     max_actions: int = Field(
         3,
         ge=1,
@@ -387,6 +427,19 @@ class ExportRequest(PlanRequest):
     )
     part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
         None, max_length=4, description="With `sense`: weights of the candidate parts."
+    )
+    goal_pose: str | None = Field(
+        None,
+        max_length=16,
+        pattern=r"^\s*([0-9]+|any)\s*$",
+        description="A mesh part: the policy is over its resting poses; only pose K may be "
+        "declared (default 0), `any`: every pose may (--goal-pose).",
+    )
+    pose_prior: str | None = Field(
+        None,
+        max_length=64,
+        description="A mesh part: the poses' prior, the quasi-static estimate (default) or the "
+        "perturbed one (--pose-prior; drops:N and poses files are the command line's).",
     )
 
 

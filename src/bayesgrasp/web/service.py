@@ -20,11 +20,13 @@ from fastapi.responses import Response
 from ..errors import BayesGraspError
 from . import documents, views
 from .limits import Limits
-from .models import PartIn
+from .models import MESH_FORMATS, PartIn
 from .workers import Lane, LimitError
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
+    from ..solid.mesh import Solid
+    from ..solid.poses import PoseStudy
     from .gallery import Gallery
 
 __all__ = ["WORK", "LaneName", "Service", "lane_of", "run_work", "service_of", "work_json"]
@@ -138,11 +140,45 @@ class Service:
         f = spec.file
         if f is None:  # unreachable: one of the three was given
             raise LimitError(422, "`part` needs exactly one of vertices, catalogue or file")
+        data = self.file_bytes(spec)
+        element = f.element
+        if f.format in MESH_FORMATS:  # a solid: the footprint of one resting pose
+            if f.pose is not None and f.element is not None:
+                raise LimitError(422, "give the pose once: `pose` (not `element`)")
+            element = f.element if f.pose is None else str(f.pose)
+        elif f.pose is not None:
+            raise LimitError(
+                422, f"`pose`: for a mesh part ({', '.join(MESH_FORMATS)}); this one is {f.format}"
+            )
+        return self.read_file(data, f.format, spec.name, element, f.layer, f.flatten_tol)
+
+    def file_bytes(self, spec: PartIn) -> bytes:
+        """The bytes of a part given as ``file`` (base64-decoded)."""
+        if spec.file is None:
+            raise LimitError(422, "`part` needs a `file` here")
         try:
-            data = base64.b64decode(f.data_base64, validate=True)
+            return base64.b64decode(spec.file.data_base64, validate=True)
         except (binascii.Error, ValueError):
             raise LimitError(422, "`part.file.data_base64` is not valid base64") from None
-        return self.read_file(data, f.format, spec.name, f.element, f.layer, f.flatten_tol)
+
+    def solid(self, spec: PartIn, what: str = "this") -> tuple[Solid, PoseStudy]:
+        """The solid of a mesh part and its quasi-static resting poses.
+
+        The same reading as the command line's (:meth:`~bayesgrasp.runs.specs.PartSpec.load_solid`
+        and :func:`~bayesgrasp.solid.parts.study_of`), from the file's bytes in memory.
+        """
+        from ..solid.mesh import read_mesh_bytes
+        from ..solid.parts import study_of
+
+        f = spec.file
+        if f is None or f.format not in MESH_FORMATS:
+            raise LimitError(
+                422, f"{what} needs a mesh part: a `file` of format {', '.join(MESH_FORMATS)}"
+            )
+        if f.layer is not None or f.flatten_tol is not None:
+            raise LimitError(422, "a mesh has no layers or curves: drop `layer`, `flatten_tol`")
+        solid = read_mesh_bytes(self.file_bytes(spec), f.format, f"{spec.name}.{f.format}")
+        return solid, study_of(solid)
 
     def read_file(
         self,
@@ -183,12 +219,18 @@ WORK: dict[str, Callable[..., Any]] = {
     "figure": documents.figure_bytes,
     "export": documents.export_file,
     "functions": lambda service, req: views.function_samples(service, req),
+    "poses": documents.poses_document_of,
 }
 
 
 def run_work(name: str, limits: Limits, req: Any, *extra: Any, **kwargs: Any) -> Any:
-    """Run ``WORK[name]`` in a worker process (with a service of its own, no gallery)."""
-    return WORK[name](Service(limits, None), req, *extra, **kwargs)
+    """Run ``WORK[name]`` in a worker process (with a service of its own, no gallery).
+
+    A request's mesh options are checked first (:func:`~.documents.check_mesh_options`).
+    """
+    service = Service(limits, None)
+    documents.check_mesh_options(service, req)
+    return WORK[name](service, req, *extra, **kwargs)
 
 
 def work_json(name: str, limits: Limits, req: Any) -> bytes:
