@@ -11,19 +11,19 @@ recognition policy's own path (:func:`.sensing.plan_policy_command`).
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import typer
 
+from ..runs.poses import PoseOptionError, PoseProblems, poses_toppling
+from ..runs.poses import pose_prior_weights as weights_of
 from ..solid.parts import study_of
 from .specs import PartSpec, ProblemSpec, SenseSpec
 
 if TYPE_CHECKING:
     from ..geometry.polygon import Part
-    from ..model.problem import Problem
     from ..solid.mesh import Solid
     from ..solid.poses import PoseStudy
 
@@ -93,23 +93,6 @@ class PoseSense(SenseSpec):
         return list(self.footprints)
 
 
-@dataclass(frozen=True, slots=True)
-class PoseProblems(ProblemSpec):
-    """The problem options, with the poses that may not be declared."""
-
-    undeclared: frozenset[str] = frozenset()
-
-    def build(self, part: Part, more_actions: tuple[str, ...] = (), prior: Any = None) -> Problem:
-        """The problem of a footprint; an undeclared pose's goal is no success."""
-        from ..model.problem import Problem
-        from ..solid.policy import NoDeclaration
-
-        inputs = self.problem_inputs(more_actions, prior)
-        if part.name in self.undeclared:
-            inputs["goal"] = NoDeclaration(inputs["goal"].kind)
-        return Problem.build(part, **inputs)
-
-
 def goal_pose_index(text: str | None, n: int) -> int | None:
     """``--goal-pose``: a pose index, or ``None`` for any."""
     from ..solid.parts import pose_index
@@ -123,81 +106,16 @@ def goal_pose_index(text: str | None, n: int) -> int | None:
 
 
 def pose_prior_weights(text: str | None, solid: Solid, study: PoseStudy) -> list[float]:
-    """``--pose-prior``: the poses' weights, in the study's order."""
-    import numpy as np
+    """``--pose-prior``: the poses' weights (:func:`bayesgrasp.runs.poses.pose_prior_weights`)."""
+    from .poses import drop_frequencies
 
-    if text is None or text.strip().lower() == "quasi-static":
-        return [p.probability for p in study.poses]
-    key = text.strip()
-    if key.lower() == "perturbed":
-        other = study_of(solid, "perturbed")
-        # Faces stable only for some perturbed centres are no pose of the mesh: left out.
-        return _match(other.normals, other.probabilities, study, "perturbed", strict=False)
-    if key.lower().startswith("drops:"):
-        try:
-            n = int(key.partition(":")[2])
-        except ValueError:
-            n = 0
-        if n < 1:
-            raise typer.BadParameter(
-                f"drops:N needs N >= 1 drops; got {key!r}", param_hint="--pose-prior"
-            )
-        from .poses import drop_frequencies
-
-        _, rows = drop_frequencies(solid, study, n, 0)
-        w = [r[0] for r in rows]
-        if not sum(w) > 0:
-            raise typer.BadParameter(
-                f"none of the {n} drops came to rest on a listed pose", param_hint="--pose-prior"
-            )
-        return w
-    path = Path(key)
-    if not path.is_file():
-        raise typer.BadParameter(
-            f"expected quasi-static, perturbed, drops:N or a poses file; got {key!r}",
-            param_hint="--pose-prior",
-        )
-    from .. import files
-    from ..errors import PartFileError
+    def drops(solid: Solid, study: PoseStudy, n: int) -> list[float]:
+        return [r[0] for r in drop_frequencies(solid, study, n, 0)[1]]
 
     try:
-        doc = json.loads(files.read_bytes(path, PartFileError, "poses file"))
-        normals = np.array([p["normal"] for p in doc["poses"]], dtype=float).reshape(-1, 3)
-        probs = np.array([p["probability"] for p in doc["poses"]], dtype=float)
-        if doc.get("schema") != "bayesgrasp.poses/1":
-            raise ValueError("its schema is not bayesgrasp.poses/1")
-    except (ValueError, KeyError, TypeError) as exc:
-        raise typer.BadParameter(
-            f"{key}: not a bayesgrasp.poses/1 document ({exc})", param_hint="--pose-prior"
-        ) from None
-    return _match(normals, probs, study, key)
-
-
-def _match(
-    normals: Any, probs: Any, study: PoseStudy, what: str, strict: bool = True
-) -> list[float]:
-    """The weights of ``study``'s poses from poses given by their normals (0 where absent).
-
-    ``strict``: a given pose that is not one of ``study``'s is refused (else left out).
-    """
-    import numpy as np
-
-    out = np.zeros(len(study.poses))
-    for n, p in zip(normals, probs, strict=True):
-        d = np.linalg.norm(study.normals - n, axis=1)
-        k = int(np.argmin(d))
-        if d[k] > 1e-6:
-            if not strict:
-                continue
-            raise typer.BadParameter(
-                f"{what}: a pose with normal {np.round(n, 6).tolist()} is not a stable pose of "
-                "this mesh",
-                param_hint="--pose-prior",
-            )
-        out[k] += p
-    if not np.all(np.isfinite(out)) or np.any(out < 0) or out.sum() <= 0:
-        raise typer.BadParameter(f"{what}: probabilities must be >= 0", param_hint="--pose-prior")
-    return [float(x) for x in out]
+        return weights_of(text, solid, study, drops)
+    except PoseOptionError as exc:
+        raise typer.BadParameter(str(exc), param_hint=exc.option) from None
 
 
 def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
@@ -239,29 +157,13 @@ def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
 def check_poses_toppling(study: PoseStudy, weights: list[float], jaw_height: float) -> None:
     """``plan MESH --sense --jaw-height H``: refuse the policy if a squeeze may topple a pose.
 
-    Every action of the policy squeezes whichever pose the part is in, at an unknown planar
-    orientation; a pose of positive prior weight that some closing direction topples would
-    be tipped, so the policy is refused, naming those poses. Poses of weight 0 do not count.
+    See :func:`bayesgrasp.runs.poses.poses_toppling`; else a note on stderr says none does.
     """
-    from ..solid.topple import toppling_report
-
-    report = toppling_report(study, jaw_height)
-    bad = [r for r in report if r.fraction > 0 and weights[r.pose] > 0]
-    if bad:
-        which = "; ".join(f"pose {r.pose} at {r.describe()}" for r in bad)
-        every = " (every pose that may occur)" if len(bad) == sum(w > 0 for w in weights) else ""
-        raise typer.BadParameter(
-            f"a squeeze with the jaws at height {jaw_height:g} topples{every}: {which} (closing "
-            "directions in each pose's frame; the planar orientation is unknown, so every "
-            "gripper angle may meet one): give those poses weight 0 (--pose-prior FILE) or "
-            "lower the jaws",
-            param_hint="--jaw-height",
-        )
-    typer.echo(
-        f"bayesgrasp: note: no squeeze with the jaws at height {jaw_height:g} topples a pose "
-        "of positive weight",
-        err=True,
-    )
+    try:
+        note = poses_toppling(study, weights, jaw_height)
+    except PoseOptionError as exc:
+        raise typer.BadParameter(str(exc), param_hint=exc.option) from None
+    typer.echo(f"bayesgrasp: note: {note}", err=True)
 
 
 def pose_sensing(

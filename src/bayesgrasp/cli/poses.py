@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from ..runs.poses import FRAME_TEXT, poses_document
 from .common import emit_json
 from .options import JsonOpt, command_app
 
@@ -16,13 +17,6 @@ if TYPE_CHECKING:
     from ..solid.poses import PoseStudy
 
 app = command_app()
-
-POSES_SCHEMA = "bayesgrasp.poses/1"
-FRAME_TEXT = (
-    "each pose's planar frame: z up (minus the supporting face's outward normal); x the mesh "
-    "axis most parallel to the table, projected on it; y = z cross x; origin the centre of "
-    "mass's projection on the table"
-)
 
 
 class Estimator(enum.StrEnum):
@@ -84,40 +78,6 @@ def drop_frequencies(
     band = drops.intervals(0.95)
     rows = [(float(freq[k]), float(band[k, 0]), float(band[k, 1])) for k in range(len(freq))]
     return drops, rows
-
-
-def poses_document(
-    solid: Solid, study: PoseStudy, drops: Any = None, rows: list[Any] | None = None
-) -> dict[str, Any]:
-    """The ``bayesgrasp.poses/1`` document (poses most probable first)."""
-    doc: dict[str, Any] = {
-        "schema": POSES_SCHEMA,
-        "poses": [
-            {
-                "probability": p.probability,
-                "normal": p.normal.tolist(),
-                "com_height": p.com_height,
-                "footprint": p.footprint.tolist(),
-            }
-            for p in study.poses
-        ],
-        "mesh": solid.name,
-        "units": solid.units,
-        "center_of_mass": study.center_of_mass.tolist(),
-        "estimator": study.estimator,
-        "frame": FRAME_TEXT,
-        "frames": [p.frame.tolist() for p in study.poses],
-    }
-    if drops is not None and rows is not None:
-        doc["drops"] = {
-            "trials": int(drops.trials),
-            "unmatched": int(drops.unmatched),
-            "settings": {k: float(v) for k, v in dict(drops.settings).items()},
-            "counts": [int(c) for c in drops.counts],
-            "frequencies": [r[0] for r in rows],
-            "intervals_95": [[r[1], r[2]] for r in rows],
-        }
-    return doc
 
 
 def poses_text(

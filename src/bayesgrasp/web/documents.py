@@ -207,7 +207,7 @@ def pose_inputs(req: Any) -> dict[str, Any]:
 
 def poses_document_of(service: Service, req: PosesRequest) -> dict[str, Any]:
     """``bayesgrasp poses MESH --json``: the resting poses and their probabilities."""
-    from ..cli.poses import poses_document
+    from ..runs.poses import poses_document
 
     if req.part.file is not None and req.part.file.pose is not None:
         raise LimitError(422, "`pose`: `poses` lists every pose; give no pose")
@@ -255,15 +255,12 @@ def pose_candidates(service: Service, req: PolicyRequest, spec: Any) -> tuple[An
     """A mesh part's policy: its pose footprints, their problems and prior weights.
 
     As ``plan MESH --sense S --goal-pose K|any --pose-prior P --jaw-height H``
-    (:func:`bayesgrasp.cli.meshes.pose_sensing`): the candidates are the footprints
-    ``pose-0``, ``pose-1``, ...; poses other than the goal pose may not be declared.
+    (:mod:`bayesgrasp.runs.poses`): the candidates are the footprints ``pose-0``,
+    ``pose-1``, ...; poses other than the goal pose may not be declared.
     """
-    import contextlib
     import dataclasses
 
-    import typer
-
-    from ..cli.meshes import PoseProblems, check_poses_toppling, pose_prior_weights
+    from ..runs.poses import PoseOptionError, PoseProblems, pose_prior_weights, poses_toppling
     from ..runs.specs import ProblemSpec
     from ..solid.parts import pose_index, pose_parts
 
@@ -299,14 +296,12 @@ def pose_candidates(service: Service, req: PolicyRequest, spec: Any) -> tuple[An
         goal = None
     elif req.goal_pose is not None:
         goal = pose_index(req.goal_pose, n, "`goal_pose`")
-    with contextlib.redirect_stderr(io.StringIO()):  # the command line's notes
-        try:
-            weights = pose_prior_weights(kind, solid, study)
-            if req.jaw_height is not None:
-                check_poses_toppling(study, weights, req.jaw_height)
-        except typer.BadParameter as exc:
-            hint = str(exc.param_hint or "--pose-prior").lstrip("-").replace("-", "_")
-            raise LimitError(422, f"`{hint}`: {exc.message}") from None
+    try:
+        weights = pose_prior_weights(kind, solid, study)
+        if req.jaw_height is not None:
+            poses_toppling(study, weights, req.jaw_height)
+    except PoseOptionError as exc:
+        raise LimitError(422, f"`{exc.option.lstrip('-').replace('-', '_')}`: {exc}") from None
     undeclared = frozenset(f"pose-{k}" for k in range(n) if goal is not None and k != goal)
     values = {f.name: getattr(spec, f.name) for f in dataclasses.fields(ProblemSpec)}
     problems = PoseProblems(**values, undeclared=undeclared)
