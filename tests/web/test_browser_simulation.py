@@ -246,6 +246,34 @@ def test_settings_are_in_the_address(server: str, page: Any) -> None:
     assert f"anim_plan={bayes}" in page.url
 
 
+def test_a_jaw_lag_reaches_a_mujoco_job(server: str, page: Any) -> None:
+    """The jaw lag is MuJoCo's: checked beside its input, sent as `jaw_lag_s`."""
+    _open(page, server + "/#part=triangle")
+    page.wait_for_function("() => serverLimits !== null")
+    if "mujoco" not in page.evaluate("() => serverLimits.engines"):
+        pytest.skip("MuJoCo is not installed")
+    assert page.locator("#sim-lag").is_disabled()  # kinematic: no jaws to lag
+    page.select_option("#sim-engine", "mujoco")
+    page.fill("#sim-lag", "-1")
+    page.click("#simulate")
+    assert page.locator("#sim-lag-error").text_content() == "jaw lag: must be at least 0"
+    bodies: list[Any] = []
+    page.on(
+        "request",
+        lambda r: bodies.append(json.loads(r.post_data)) if r.url.endswith("/jobs") else None,
+    )
+    page.fill("#sim-lag", "100")  # a push of 500 mm: the server's one line, beside Simulate
+    page.fill("#sim-trials", "1")
+    assert _simulate(page) == "error"
+    assert bodies and bodies[-1]["jaw_lag_s"] == 100 and bodies[-1]["engine"] == "mujoco"
+    assert (
+        page.locator("#sim-status")
+        .text_content()
+        .startswith("`jaw_lag_s`: a lag of 100 s pushes the part 500 mm")
+    )
+    assert "sim_lag=100" in page.url
+
+
 @pytest.mark.physics
 def test_a_mujoco_job_from_the_page(server: str, page: Any) -> None:
     pytest.importorskip("mujoco")

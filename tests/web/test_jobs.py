@@ -191,3 +191,49 @@ def test_a_mujoco_job_reports_progress(client: Any) -> None:
     assert doc["result"]["engine"] == "mujoco"
     assert doc["result"]["trials"] == 8
     assert doc["progress"]["done"] == 8
+
+
+def test_a_job_checks_the_offset_in_millimetres(client: Any) -> None:
+    """The triangle reaches 24.62 mm from its centroid: 30 mm is refused as the CLI does."""
+    body = {"part": {"catalogue": "triangle"}, "engine": "mujoco", "trials": 1, "offset_mm": 30}
+    doc = _wait(client, client.post("/api/v1/simulate/jobs", json=body).json()["url"])
+    assert doc["status"] == "failed"
+    assert doc["error"]["detail"] == (
+        "`offset_mm`: 30 mm is not less than the part's size (24.62 mm from its centroid to "
+        "its farthest vertex)"
+    )
+
+
+def test_jaw_lag_is_for_mujoco_and_bounded(client: Any) -> None:
+    kin = {"part": {"catalogue": "triangle"}, "engine": "kinematic", "trials": 5, "jaw_lag_s": 1}
+    r = client.post("/api/v1/simulate/jobs", json=kin)
+    assert r.status_code == 422
+    assert r.json()["detail"].startswith("`jaw_lag_s`: applies to the mujoco engine only")
+    body = {"part": {"catalogue": "triangle"}, "engine": "mujoco", "trials": 1, "jaw_lag_s": 100}
+    doc = _wait(client, client.post("/api/v1/simulate/jobs", json=body).json()["url"])
+    assert doc["status"] == "failed"
+    assert doc["error"]["detail"] == (
+        "`jaw_lag_s`: a lag of 100 s pushes the part 500 mm, more than twice its size "
+        "(24.62 mm from its centroid to its farthest vertex): give at most 9.847 s"
+    )
+
+
+@pytest.mark.physics
+def test_a_mujoco_job_with_a_jaw_lag_is_the_cli_run(client: Any, cli_json: Any) -> None:
+    pytest.importorskip("mujoco")
+    args = ("--engine", "mujoco", "--jaw-lag", "2", "--trials", "6", "--seed", "4")
+    code, cli = cli_json("simulate", "triangle", *args)
+    assert code == 0, cli
+    body = {
+        "part": {"catalogue": "triangle"},
+        "engine": "mujoco",
+        "trials": 6,
+        "seed": 4,
+        "jaw_lag_s": 2,
+    }
+    doc = _wait(client, client.post("/api/v1/simulate/jobs", json=body).json()["url"], 600)
+    assert doc["status"] == "done", doc
+    result = doc["result"]
+    assert result["provenance"]["jaw_lag_s"] == 2 == cli["provenance"]["jaw_lag_s"]
+    assert result["per_orientation"] == cli["per_orientation"]
+    assert result["jams"] == cli["jams"]

@@ -42,7 +42,7 @@ from .result import DEFAULT_BOUNDARY_MARGIN, boundary_distance
 from .squeezer import Squeezer
 from .stats import wilson_interval
 
-__all__ = ["AsynchronyResult", "measure_asynchrony"]
+__all__ = ["AsynchronyResult", "lagged_params", "measure_asynchrony"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -190,3 +190,36 @@ def measure_asynchrony(
         int((~near_g & ~near_s).sum()),
         seconds,
     )
+
+
+def lagged_params(lag: float, size: float) -> SimParams:
+    """The MuJoCo settings of a jaw lag: the lag, and room for the push it makes.
+
+    ``lag`` is in seconds of jaws closing at 1 cm/s (the push it makes is its meaning,
+    whatever the default jaw speed): the leading jaw pushes ``jaw_speed * lag / 2`` (5 mm a
+    second of lag) before the other touches. The clearance is raised to that push + 1 mm (as
+    :func:`measure_asynchrony` does) so the push does not saturate. A push of more than twice
+    the part's ``size`` (metres, centroid to farthest vertex: the travel of a push-grasp,
+    ``SimParams.push_distance``) is refused (:class:`~bayesgrasp.errors.SimulationError`):
+    it adds nothing but time.
+
+    Examples
+    --------
+    >>> p = lagged_params(2.0, 0.03)
+    >>> p.jaw_lag, round(p.clearance, 4)
+    (2.0, 0.011)
+    >>> lagged_params(20.0, 0.03)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bayesgrasp.errors.SimulationError: a lag of 20 s pushes the part 100 mm, more than twice...
+    """
+    base = replace(SimParams(), jaw_speed=0.01)
+    push = base.jaw_speed * lag / 2.0
+    if push > 2.0 * size:
+        most = 4.0 * size / base.jaw_speed
+        raise SimulationError(
+            f"a lag of {lag:g} s pushes the part {push * 1000:.4g} mm, more than twice its "
+            f"size ({size * 1000:.4g} mm from its centroid to its farthest vertex): give at "
+            f"most {most:.4g} s"
+        )
+    return replace(base, jaw_lag=lag, clearance=max(base.clearance, push + 0.001))

@@ -391,8 +391,9 @@ def simulate_document(
     else:
         pb, option, _ = chosen_option(req.plan, req, p, spec)
     u = None if pay is None else as_vector(pay, pb.states)
+    lag = float(getattr(req, "jaw_lag_s", 0.0))
     if engine == "mujoco":
-        res = mujoco_result(pb, option, trials, noise, req.seed, offset_mm, u, progress)
+        res = mujoco_result(pb, option, trials, noise, req.seed, offset_mm, u, progress, lag)
     else:
         from ..sim.kinematic import simulate_kinematic
 
@@ -406,6 +407,7 @@ def simulate_document(
     which = req.plan if isinstance(req.plan, str) else "request"
     how = simulate_inputs(engine, which, req.seed, trials, deg, kind, offset_mm)
     how["contact_noise"] = req.contact_noise
+    how["jaw_lag_s"] = lag or None
     how["payoff"] = None if req.payoff is None else "request"
     doc["provenance"] = provenance(pb, None, **how, **run_inputs(None, spec), **pose_inputs(req))
     return doc
@@ -425,6 +427,12 @@ def check_simulation(limits: Limits, req: SimulateRequest) -> int:
     if req.turn_noise is not None and (req.noise > 0 or req.noise_kind != "normal"):
         raise LimitError(
             422, "`noise`, `noise_kind`: the older spelling of `turn_noise`; give one of them"
+        )
+    if engine == "kinematic" and getattr(req, "jaw_lag_s", 0.0) > 0:
+        raise LimitError(
+            422,
+            "`jaw_lag_s`: applies to the mujoco engine only (the kinematic model's contact "
+            "asynchrony is `contact_noise`)",
         )
     if engine == "kinematic" and getattr(req, "offset_mm", 0.0) > 0:
         raise LimitError(
@@ -456,18 +464,27 @@ def mujoco_result(
     offset_mm: float,
     payoff: Any,
     progress: Callable[[int, int], None] | None,
+    jaw_lag: float = 0.0,
 ) -> Any:
     """The MuJoCo trials of ``simulate --engine mujoco`` (one process: the job's worker)."""
+    from ..errors import SimulationError
     from ..sim import simulate_mujoco
+    from ..sim.asynchrony import lagged_params
     from ..sim.noise import GripperNoise
     from ..sim.result import with_prediction
+    from ..sim.scene import units_scale
 
-    if offset_mm > 0 and offset_mm / 1000.0 >= pb.part.hull.size:
+    size = pb.part.hull.size * units_scale(pb.part.units)  # metres, as MuJoCo builds it
+    if offset_mm > 0 and offset_mm / 1000.0 >= size:
         raise LimitError(
             422,
             f"`offset_mm`: {offset_mm:g} mm is not less than the part's size "
-            f"({pb.part.hull.size * 1000:.4g} mm from its centroid to its farthest vertex)",
+            f"({size * 1000:.4g} mm from its centroid to its farthest vertex)",
         )
+    try:
+        params = lagged_params(jaw_lag, size) if jaw_lag else None
+    except SimulationError as exc:
+        raise LimitError(422, f"`jaw_lag_s`: {exc}") from None
     res = simulate_mujoco(
         pb,
         option,
@@ -477,6 +494,7 @@ def mujoco_result(
         rng=seed,
         workers=1,
         progress=progress,
+        params=params,
     )
     exact = noise.exact and payoff is None
     return res if exact else with_prediction(res, pb, noise, payoff)

@@ -466,6 +466,14 @@ class SimulateJobRequest(SimulateRequest):
         le=1e6,
         description="mujoco: the part's centre is this far off the gripper centre (--offset).",
     )
+    jaw_lag_s: float = Field(
+        0.0,
+        ge=0,
+        le=1e4,
+        description="mujoco: contact asynchrony (--jaw-lag): in each squeeze one jaw (either, "
+        "equally likely) starts closing this many seconds early and pushes the part 5 mm a "
+        "second of lag before the other touches.",
+    )
 
 
 class ErrorBody(BaseModel):

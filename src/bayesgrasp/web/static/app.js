@@ -302,6 +302,7 @@ const VIEW_SETTINGS = [
   ["sim-engine", "sim_engine"],
   ["sim-trials", "sim_trials"],
   ["sim-offset", "sim_offset"],
+  ["sim-lag", "sim_lag"],
   ["sim-seed", "sim_seed"],
 ];
 
@@ -1129,6 +1130,7 @@ function simEngineChanged() {
   const engine = $("sim-engine").value;
   if (!$("sim-trials").dataset.edited) $("sim-trials").value = String(SIM_TRIALS[engine]);
   $("sim-offset").disabled = engine !== "mujoco";
+  $("sim-lag").disabled = engine !== "mujoco";
 }
 
 function validateSimulation() {
@@ -1150,12 +1152,13 @@ function validateSimulation() {
   const engineName = engine === "mujoco" ? "MuJoCo" : "kinematic";
   whole("sim-trials", "trials", 1, most, `the server runs at most ${Number(most).toLocaleString("en")} ${engineName} trials a job`);
   whole("sim-seed", "seed", 0, Number.MAX_SAFE_INTEGER, "too large");
-  if (engine === "mujoco") {
-    const raw = $("sim-offset").value.trim();
-    const msg = raw === "" || !Number.isFinite(Number(raw)) ? "offset: enter a number" : Number(raw) < 0 ? "offset: must be at least 0" : "";
-    fieldError("sim-offset", msg);
+  for (const [id, what] of [["sim-offset", "offset"], ["sim-lag", "jaw lag"]]) {
+    const raw = $(id).value.trim();
+    const bad = raw === "" || !Number.isFinite(Number(raw)) ? `${what}: enter a number` : Number(raw) < 0 ? `${what}: must be at least 0` : "";
+    const msg = engine === "mujoco" ? bad : "";
+    fieldError(id, msg);
     if (msg) ok = false;
-  } else fieldError("sim-offset", "");
+  }
   const contact = Number($("contact-noise").value || 0) > 0;
   const refused = engine === "mujoco" && contact;
   fieldError("sim-engine", refused ? "MuJoCo: the contact noise applies to the kinematic engine only (in MuJoCo the jaws' contacts are the physics' own); clear it or choose kinematic" : "");
@@ -1179,6 +1182,7 @@ function simulationBody() {
     seed: Number($("sim-seed").value),
   };
   if (engine === "mujoco" && Number($("sim-offset").value) > 0) body.offset_mm = Number($("sim-offset").value);
+  if (engine === "mujoco" && Number($("sim-lag").value) > 0) body.jaw_lag_s = Number($("sim-lag").value);
   return body;
 }
 
@@ -1487,7 +1491,7 @@ function start() {
     validateSimulation();
   });
   $("sim-trials").addEventListener("input", () => ($("sim-trials").dataset.edited = "1"));
-  for (const id of ["sim-trials", "sim-offset", "sim-seed"]) $(id).addEventListener("change", validateSimulation);
+  for (const id of ["sim-trials", "sim-offset", "sim-lag", "sim-seed"]) $(id).addEventListener("change", validateSimulation);
   $("figures").addEventListener("click", showFigures);
   $("policy").addEventListener("click", showPolicy);
   $("save").addEventListener("click", saveView);
