@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from ..runs.poses import PoseOptionError, PoseProblems, poses_toppling
+from ..runs.poses import PoseOptionError, PoseProblems, pose_toppling, poses_toppling
 from ..runs.poses import pose_prior_weights as weights_of
 from ..solid.parts import study_of
 from .specs import PartSpec, ProblemSpec, SenseSpec
@@ -135,23 +135,14 @@ def check_pose_toppling(part: PartSpec, jaw_height: float | None) -> None:
             param_hint="--jaw-height",
         )
     from ..solid.parts import pose_index
-    from ..solid.topple import toppling_report
 
     study = study_of(part.load_solid())
     k = pose_index(part.element, len(study.poses), f"{part.part}: pose")
-    found = toppling_report(study, jaw_height)[k]
-    if found.fraction > 0:
-        raise typer.BadParameter(
-            f"a squeeze with the jaws at height {jaw_height:g} topples pose {k} (the push tips "
-            f"it before it slides at {found.describe()} of its frame; the "
-            "planar orientation is unknown, so every gripper angle may meet one): plan another "
-            "--pose or lower the jaws",
-            param_hint="--jaw-height",
-        )
-    typer.echo(
-        f"bayesgrasp: note: no squeeze with the jaws at height {jaw_height:g} topples pose {k}",
-        err=True,
-    )
+    try:
+        note = pose_toppling(study, k, jaw_height)
+    except PoseOptionError as exc:
+        raise typer.BadParameter(str(exc), param_hint=exc.option) from None
+    typer.echo(f"bayesgrasp: note: {note}", err=True)
 
 
 def check_poses_toppling(study: PoseStudy, weights: list[float], jaw_height: float) -> None:

@@ -30,6 +30,7 @@ __all__ = [
     "PoseProblems",
     "match_weights",
     "pose_prior_weights",
+    "pose_toppling",
     "poses_document",
     "poses_toppling",
 ]
@@ -195,6 +196,29 @@ def match_weights(
     if not np.all(np.isfinite(out)) or np.any(out < 0) or out.sum() <= 0:
         raise PoseOptionError(f"{what}: probabilities must be >= 0", "--pose-prior")
     return [float(x) for x in out]
+
+
+def pose_toppling(study: PoseStudy, k: int, jaw_height: float, pose_option: str = "--pose") -> str:
+    """Pose ``k`` squeezed with the jaws at ``jaw_height``: refused if a squeeze may topple it.
+
+    The part's planar orientation is unknown, so a squeeze at any gripper angle may meet the
+    pose at any closing direction: a pose that topples at some direction
+    (:func:`bayesgrasp.solid.topple.toppling_report`) topples under every gripper angle
+    (:class:`PoseOptionError`; ``pose_option`` is how the message names the pose's option).
+    Returns the note that it does not topple.
+    """
+    from ..solid.topple import toppling_report
+
+    found = toppling_report(study, jaw_height)[k]
+    if found.fraction > 0:
+        raise PoseOptionError(
+            f"a squeeze with the jaws at height {jaw_height:g} topples pose {k} (the push tips "
+            f"it before it slides at {found.describe()} of its frame; the planar orientation "
+            f"is unknown, so every gripper angle may meet one): plan another {pose_option} or "
+            "lower the jaws",
+            "--jaw-height",
+        )
+    return f"no squeeze with the jaws at height {jaw_height:g} topples pose {k}"
 
 
 def poses_toppling(study: PoseStudy, weights: list[float], jaw_height: float) -> str:

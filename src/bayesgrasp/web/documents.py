@@ -233,22 +233,17 @@ def check_mesh_options(service: Service, req: Any) -> None:
         return
     if not is_mesh(req.part):
         raise LimitError(422, "`jaw_height` needs a mesh part")
+    from ..runs.poses import PoseOptionError, pose_toppling
     from ..solid.parts import pose_index
-    from ..solid.topple import toppling_report
 
     f = req.part.file
     _, study = service.solid(req.part)
     chosen = f.element if f.pose is None else f.pose
     k = pose_index(chosen, len(study.poses), f"{req.part.name}.{f.format}: pose")
-    found = toppling_report(study, height)[k]
-    if found.fraction > 0:
-        raise LimitError(
-            422,
-            f"`jaw_height`: a squeeze with the jaws at height {height:g} topples pose {k} (the "
-            f"push tips it before it slides at {found.describe()} of its frame; the planar "
-            "orientation is unknown, so every gripper angle may meet one): plan another "
-            "`pose` or lower the jaws",
-        )
+    try:
+        pose_toppling(study, k, height, "`pose`")
+    except PoseOptionError as exc:
+        raise LimitError(422, f"`jaw_height`: {exc}") from None
 
 
 def pose_candidates(service: Service, req: PolicyRequest, spec: Any) -> tuple[Any, Any, str]:
