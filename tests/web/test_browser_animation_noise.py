@@ -24,6 +24,16 @@ def _finish(page: Any) -> None:
     page.wait_for_selector("#anim[data-done=true]")
 
 
+def _animate(page: Any, row: int, seed: int, n: int = 400) -> None:
+    """Animate the table's row ``row`` from ``n`` random starts with ``seed``, to its end."""
+    page.select_option("#anim-plan", str(row))
+    page.select_option("#anim-starts", "random")
+    page.fill("#anim-n", str(n))
+    page.fill("#anim-seed", str(seed))
+    page.locator("#anim-seed").dispatch_event("change")
+    _finish(page)
+
+
 def _cells(page: Any) -> list[dict[str, Any]]:
     raw = page.evaluate(
         """() => [...document.querySelectorAll('#anim rect')].map((r) => ({
@@ -89,12 +99,7 @@ def test_the_cells_draw_the_noise(
     code, want = cli_json("plan", name, *args)
     assert code == 0, want
     option = want["options"][row]
-    page.select_option("#anim-plan", str(row))
-    page.select_option("#anim-starts", "random")
-    page.fill("#anim-n", "400")
-    page.fill("#anim-seed", "7")
-    page.locator("#anim-seed").dispatch_event("change")
-    _finish(page)
+    _animate(page, row, 7)
     cells = _cells(page)
     assert len(cells) == 400
     # the page's final orientations are the library's for the same starts and draws
@@ -210,12 +215,7 @@ def test_with_a_payoff_a_cell_counts_where_the_payoff_is_positive(
     assert code == 0, want
     row = 0
     p = want["options"][row]["success_probability"]
-    page.select_option("#anim-plan", str(row))
-    page.select_option("#anim-starts", "random")
-    page.fill("#anim-n", "400")
-    page.fill("#anim-seed", "3")
-    page.locator("#anim-seed").dispatch_event("change")
-    _finish(page)
+    _animate(page, row, 3)
     cells = _cells(page)
     k = sum(c["ok"] for c in cells)
     assert _within(k, 400, p), (k, p)

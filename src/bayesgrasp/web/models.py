@@ -38,6 +38,24 @@ __all__ = [
 Cost = Annotated[float, Field(ge=0, le=1e12)]
 Name = Annotated[str, Field(min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_. -]+$")]
 Format = Literal["json", "csv", "wkt", "geojson", "svg", "dxf", "stl", "obj", "ply", "3mf", "glb"]
+#: ``--goal-pose`` and ``--pose-prior`` of a policy over a mesh's poses (policy, export).
+GoalPose = Annotated[
+    str | None,
+    Field(
+        max_length=16,
+        pattern=r"^\s*([0-9]+|any)\s*$",
+        description="A mesh part: the policy is over its resting poses; only pose K may be "
+        "declared (default 0), `any`: every pose may (--goal-pose).",
+    ),
+]
+PosePrior = Annotated[
+    str | None,
+    Field(
+        max_length=64,
+        description="A mesh part: the poses' prior, the quasi-static estimate (default) or the "
+        "perturbed one (--pose-prior; drops:N and poses files are the command line's).",
+    ),
+]
 MESH_FORMATS = _MESH_FORMATS
 """The formats of :data:`Format` that are triangle meshes (a solid; one pose is planned)."""
 
@@ -383,19 +401,8 @@ class PolicyRequest(StrokeOptions):
     part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
         None, max_length=4, description="Weights of the candidate parts (--part-prior)."
     )
-    goal_pose: str | None = Field(
-        None,
-        max_length=16,
-        pattern=r"^\s*([0-9]+|any)\s*$",
-        description="A mesh part: the policy is over its resting poses; only pose K may be "
-        "declared (default 0), `any`: every pose may (--goal-pose).",
-    )
-    pose_prior: str | None = Field(
-        None,
-        max_length=64,
-        description="A mesh part: the poses' prior, the quasi-static estimate (default) or the "
-        "perturbed one (--pose-prior; drops:N and poses files are the command line's).",
-    )
+    goal_pose: GoalPose = None
+    pose_prior: PosePrior = None
     max_actions: int = Field(
         3,
         ge=1,
@@ -428,19 +435,8 @@ class ExportRequest(PlanRequest):
     part_prior: list[Annotated[float, Field(ge=0)]] | None = Field(
         None, max_length=4, description="With `sense`: weights of the candidate parts."
     )
-    goal_pose: str | None = Field(
-        None,
-        max_length=16,
-        pattern=r"^\s*([0-9]+|any)\s*$",
-        description="A mesh part: the policy is over its resting poses; only pose K may be "
-        "declared (default 0), `any`: every pose may (--goal-pose).",
-    )
-    pose_prior: str | None = Field(
-        None,
-        max_length=64,
-        description="A mesh part: the poses' prior, the quasi-static estimate (default) or the "
-        "perturbed one (--pose-prior; drops:N and poses files are the command line's).",
-    )
+    goal_pose: GoalPose = None
+    pose_prior: PosePrior = None
 
 
 class SimulateJobRequest(SimulateRequest):

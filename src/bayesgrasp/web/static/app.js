@@ -879,7 +879,8 @@ function drawAnimationFrame(frame) {
   const words = { turn: "turn", squeeze: "squeeze", push: "push", close: "the other jaw closes", hold: "squeeze" };
   const what = kinds.size > 1 ? "the jaws close (in the cells with an arrow one jaw touches first and pushes)" : words[kind];
   const nz = animationNoise();
-  const under = [nz.scale > 0 ? `turn error ${state.last.noise.turn_noise} deg` : "", nz.contact > 0 ? `contact noise ${nz.contact}` : ""].filter(Boolean).join(", ");
+  const { turn_noise: turn, contact_noise: contact } = state.last.noise; // the payoff is said below
+  const under = turn || contact ? noiseWords({ turn_noise: turn, contact_noise: contact }) : "";
   $("anim-status").textContent = done
     ? `${ok} of ${runs.length} oriented (${round((100 * ok) / runs.length, 1)}%; the plan's success probability ${round(100 * o.success_probability, 1)}%` +
       `${under ? ` under ${under}, drawn in every cell` : ""}` +
